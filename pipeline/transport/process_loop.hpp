@@ -1,0 +1,73 @@
+// The process skeleton every sss-slam service runs: one thread polls the LCM socket, extra file
+// descriptors (TCP, UDP, serial) and timers; SIGINT/SIGTERM stop it gracefully; under systemd it
+// sends READY, STATUS and WATCHDOG (from this loop, so a stuck handler makes systemd restart
+// the process); every status period it publishes SSS_STATUS from the HealthMonitor.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "pipeline/core/health.hpp"
+#include "pipeline/transport/lcm_bus.hpp"
+#include "pipeline/transport/process_options.hpp"
+#include "pipeline/transport/systemd_notifier.hpp"
+#include "sss_msgs/status_t.hpp"
+
+namespace sss::transport {
+
+class ProcessLoop {
+ public:
+  // Installs the SIGINT/SIGTERM handlers and opens the LCM URL.
+  explicit ProcessLoop(ProcessOptions options);
+  ~ProcessLoop();
+  ProcessLoop(const ProcessLoop&) = delete;
+  ProcessLoop& operator=(const ProcessLoop&) = delete;
+
+  LcmBus& bus() { return bus_; }
+  sss::core::HealthMonitor& health() { return health_; }
+  const ProcessOptions& options() const { return options_; }
+
+  // Calls callback every period_s (first call one period after run() starts).
+  void addTimer(double period_s, std::function<void()> callback);
+  // Calls on_readable when fd has data (or is closed/in error: POLLIN|POLLHUP|POLLERR).
+  void addFileDescriptor(int fd, std::function<void()> on_readable);
+  void removeFileDescriptor(int fd);
+
+  // Runs until stop() or a termination signal. Sends READY=1 first. Returns the exit code:
+  // 0 after a graceful stop, 1 when the LCM URL could not be opened.
+  int run();
+  // Thread- and signal-safe request to leave run().
+  void stop();
+  bool stopRequested() const;
+
+  // Builds the status message of this process now (also used by tests).
+  sss_msgs::status_t buildStatus();
+
+ private:
+  struct Timer {
+    int64_t period_us;
+    int64_t next_due_us;
+    std::function<void()> callback;
+  };
+  struct WatchedFd {
+    int fd;
+    std::function<void()> on_readable;
+  };
+
+  void publishStatus();
+  int64_t nextDeadlineUs() const;
+  void runDueTimers(int64_t now_us);
+
+  ProcessOptions options_;
+  int64_t start_monotonic_us_;
+  sss::core::HealthMonitor health_;
+  LcmBus bus_;
+  SystemdNotifier notifier_;
+  std::vector<Timer> timers_;
+  std::vector<WatchedFd> watched_fds_;
+  int wake_fd_ = -1;  // eventfd written by stop() and the signal handler
+};
+
+}  // namespace sss::transport

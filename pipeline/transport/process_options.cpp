@@ -1,0 +1,21 @@
+// Shared process options, see process_options.hpp.
+#include "pipeline/transport/process_options.hpp"
+
+namespace sss::transport {
+
+void readProcessOptions(sss::core::ConfigSection& section, ProcessOptions& options) {
+  using namespace sss::core;
+  section.optional("lcm_url", options.lcm_url,
+                   {satisfies<std::string>(
+                       [](const std::string& url) {
+                         return url.rfind("udpm://", 0) == 0 || url.rfind("memq://", 0) == 0 ||
+                                url.rfind("file://", 0) == 0 || url.rfind("tcpq://", 0) == 0;
+                       },
+                       "an LCM URL: udpm://, memq://, file:// or tcpq://")});
+  section.optional("status_channel", options.status_channel, {nonEmpty()});
+  section.optional("status_period_s", options.status_period_s, {inRange(0.05, 60.0)});
+  section.optional("log_level", options.log_level,
+                   {oneOf({"trace", "debug", "info", "warn", "error", "critical", "off"})});
+}
+
+}  // namespace sss::transport

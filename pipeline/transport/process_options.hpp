@@ -1,0 +1,27 @@
+// Options every process shares: its name, the LCM URL, the status channel and period, logging.
+#pragma once
+
+#include <string>
+
+#include "pipeline/core/config.hpp"
+
+namespace sss::transport {
+
+// Multicast on the local host only (ttl=0), with a receive buffer that holds a burst of
+// multi-megabyte subframes: LCM drops fragmented messages that overflow the socket buffer.
+// The kernel caps it at net.core.rmem_max (raise it on the vehicle, see systemd/).
+inline constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=16777216";
+
+struct ProcessOptions {
+  std::string process_name = "sss";
+  std::string lcm_url = kDefaultLcmUrl;
+  std::string status_channel = "SSS_STATUS";
+  double status_period_s = 1.0;
+  std::string log_level = "info";
+};
+
+// Reads the "process" keys of a process's section (lcm_url, status_channel, status_period_s,
+// log_level); process_name is set by the program.
+void readProcessOptions(sss::core::ConfigSection& section, ProcessOptions& options);
+
+}  // namespace sss::transport
