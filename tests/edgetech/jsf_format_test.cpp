@@ -1,0 +1,134 @@
+// JSF type 80 encoding at exact byte offsets, decoding, and bad bodies.
+#include "drivers/edgetech/jsf_format.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "jsf_test_data.hpp"
+
+namespace sss::edgetech {
+namespace {
+
+template <typename T>
+T at(const std::vector<uint8_t>& bytes, size_t offset) {
+  T value;
+  std::memcpy(&value, bytes.data() + offset, sizeof(T));  // the test host is little-endian x86-64
+  return value;
+}
+
+TEST(JsfFormat, EncodesHeaderAndSonarFieldsAtTheirByteOffsets) {
+  SonarChannelRecord record = test::makeRecord(1234, kChannelStarboard);
+  record.weighting_factor = 3;
+  const std::vector<uint16_t> codes = {0, 1, 65535, 4096};
+  const std::vector<uint8_t> bytes = encodeSonarData(record, codes, 9);
+  ASSERT_EQ(bytes.size(), 16u + 240u + 8u);
+  // 16-byte message header.
+  EXPECT_EQ(at<uint16_t>(bytes, 0), 0x1601);
+  EXPECT_EQ(bytes[2], 0x0D);
+  EXPECT_EQ(at<uint16_t>(bytes, 4), 80);
+  EXPECT_EQ(bytes[6], 2);
+  EXPECT_EQ(bytes[7], 20);
+  EXPECT_EQ(bytes[8], 1);
+  EXPECT_EQ(bytes[9], 9);
+  EXPECT_EQ(at<int32_t>(bytes, 12), 248);
+  // 240-byte sonar data header, offsets from the body start (16).
+  const size_t b = 16;
+  EXPECT_EQ(at<int32_t>(bytes, b + 0), 1780300800 + 308);  // 2026-06-01T08:05:08 (1234 pings x 0.25 s)
+  EXPECT_EQ(at<uint32_t>(bytes, b + 8), 1234u);
+  EXPECT_EQ(at<int16_t>(bytes, b + 28), 1);
+  EXPECT_EQ(at<int16_t>(bytes, b + 34), 0);
+  EXPECT_EQ(at<int32_t>(bytes, b + 80), static_cast<int32_t>(std::lround(18.071234 * 600000)));
+  EXPECT_EQ(at<int32_t>(bytes, b + 84), static_cast<int32_t>(std::lround(59.351234 * 600000)));
+  EXPECT_EQ(at<int16_t>(bytes, b + 88), 2);
+  EXPECT_EQ(at<uint16_t>(bytes, b + 114), 4);
+  EXPECT_EQ(at<uint32_t>(bytes, b + 116), 20000u);
+  EXPECT_EQ(at<uint16_t>(bytes, b + 126), 39000);
+  EXPECT_EQ(at<uint16_t>(bytes, b + 128), 42000);
+  EXPECT_EQ(at<int32_t>(bytes, b + 136), 42125);
+  EXPECT_EQ(at<int32_t>(bytes, b + 144), 18250);
+  EXPECT_FLOAT_EQ(at<float>(bytes, b + 148), 1500.0f);
+  EXPECT_EQ(at<int16_t>(bytes, b + 156), 2026);
+  EXPECT_EQ(at<int16_t>(bytes, b + 158), 152);  // 1 June = day 152
+  EXPECT_EQ(at<int16_t>(bytes, b + 160), 8);
+  EXPECT_EQ(at<int16_t>(bytes, b + 162), 5);
+  EXPECT_EQ(at<int16_t>(bytes, b + 164), 8);
+  EXPECT_EQ(at<int16_t>(bytes, b + 168), 3);
+  EXPECT_EQ(at<uint16_t>(bytes, b + 172), 7073);  // 1.2345 rad = 70.73 deg
+  EXPECT_EQ(at<int16_t>(bytes, b + 174), static_cast<int16_t>(std::lround(0.02 * 180 / M_PI / (180.0 / 32768))));
+  EXPECT_EQ(at<uint32_t>(bytes, b + 200), (8u * 3600 + 5 * 60 + 8) * 1000 + 623);  // .123 + 0.5 s
+  EXPECT_EQ(at<uint16_t>(bytes, b + 240 + 4), 65535);
+}
+
+TEST(JsfFormat, DecodeGivesBackTheRecordWithinTheWireResolution) {
+  const SonarChannelRecord sent = test::makeRecord(77, kChannelPort);
+  const std::vector<uint8_t> bytes = test::encodeRecord(sent, 1000);
+  const auto header = decodeHeader(bytes.data());
+  ASSERT_TRUE(header);
+  const SonarDecodeResult result = decodeSonarData(*header, bytes.data() + 16, bytes.size() - 16);
+  ASSERT_TRUE(result.record) << result.error;
+  const SonarChannelRecord& r = *result.record;
+  EXPECT_EQ(r.ping_number, 77u);
+  EXPECT_EQ(r.channel, kChannelPort);
+  EXPECT_EQ(r.ping_time_us, sent.ping_time_us);  // whole milliseconds survive
+  EXPECT_NEAR(r.latitude_deg, sent.latitude_deg, 1.0 / 600000);  // 0.0001 minute of arc
+  EXPECT_NEAR(r.longitude_deg, sent.longitude_deg, 1.0 / 600000);
+  EXPECT_NEAR(r.depth_m, sent.depth_m, 1e-3);
+  EXPECT_NEAR(r.altitude_m, sent.altitude_m, 1e-3);
+  EXPECT_NEAR(r.heading_rad, sent.heading_rad, 0.005 * M_PI / 180);
+  EXPECT_NEAR(r.pitch_rad, sent.pitch_rad, 180.0 / 32768 * M_PI / 180);
+  EXPECT_NEAR(r.roll_rad, sent.roll_rad, 180.0 / 32768 * M_PI / 180);
+  EXPECT_DOUBLE_EQ(r.sample_interval_s, 20e-6);
+  ASSERT_EQ(r.samples.size(), 1000u);
+  const std::vector<float> magnitudes = test::makeMagnitudes(1000, 77);
+  // 16-bit quantisation of values up to 150 with N chosen to fill the range: error <= 2^-N / 2.
+  for (size_t i = 0; i < magnitudes.size(); ++i) EXPECT_NEAR(r.samples[i], magnitudes[i], 150.0 / 65535.0);
+  EXPECT_NEAR(r.slantRangeM(100), 100 * 20e-6 * 750.0, 1e-9);
+}
+
+TEST(JsfFormat, QuantiseChoosesTheWeightingThatFillsSixteenBits) {
+  int16_t n = 0;
+  const std::vector<uint16_t> codes = quantiseEnvelope({0.0f, 1.0f, 2.0f}, n);
+  EXPECT_EQ(n, 14);  // 2 * 2^14 = 32768 <= 65535 < 2 * 2^15
+  EXPECT_EQ(codes[2], 32768);
+  const std::vector<uint16_t> loud = quantiseEnvelope({1e6f, -5.0f, NAN}, n);
+  EXPECT_EQ(n, -4);
+  EXPECT_EQ(loud[0], 62500);
+  EXPECT_EQ(loud[1], 0);  // negatives and NaN become silence, not garbage
+  EXPECT_EQ(loud[2], 0);
+}
+
+TEST(JsfFormat, DecodesAnalyticIqAsMagnitude) {
+  std::vector<uint8_t> bytes = test::encodeRecord(test::makeRecord(1, kChannelPort), 2);
+  // Rewrite as I/Q: format 1, two samples of (3, 4) and (-6, 8), weighting 0.
+  bytes[16 + 34] = 1;
+  bytes[16 + 168] = 0;
+  bytes[16 + 169] = 0;
+  bytes.resize(16 + 240);
+  for (int16_t v : {int16_t(3), int16_t(4), int16_t(-6), int16_t(8)}) {
+    bytes.push_back(static_cast<uint8_t>(v & 0xFF));
+    bytes.push_back(static_cast<uint8_t>((v >> 8) & 0xFF));
+  }
+  const auto header = decodeHeader(bytes.data());
+  const SonarDecodeResult result = decodeSonarData(*header, bytes.data() + 16, bytes.size() - 16);
+  ASSERT_TRUE(result.record) << result.error;
+  EXPECT_FLOAT_EQ(result.record->samples[0], 5.0f);
+  EXPECT_FLOAT_EQ(result.record->samples[1], 10.0f);
+}
+
+TEST(JsfFormat, BadBodiesAreErrorsNotCrashes) {
+  const std::vector<uint8_t> bytes = test::encodeRecord(test::makeRecord(1, kChannelPort), 100);
+  const auto header = decodeHeader(bytes.data());
+  EXPECT_NE(decodeSonarData(*header, bytes.data() + 16, 100).error.find("shorter than its 240-byte header"),
+            std::string::npos);
+  EXPECT_NE(decodeSonarData(*header, bytes.data() + 16, 240 + 10).error.find("needs 440 bytes"), std::string::npos);
+  std::vector<uint8_t> odd = bytes;
+  odd[16 + 34] = 7;
+  EXPECT_NE(decodeSonarData(*header, odd.data() + 16, odd.size() - 16).error.find("format 7"), std::string::npos);
+  std::vector<uint8_t> wrong_marker = bytes;
+  wrong_marker[1] = 0x17;
+  EXPECT_FALSE(decodeHeader(wrong_marker.data()));
+}
+
+}  // namespace
+}  // namespace sss::edgetech
