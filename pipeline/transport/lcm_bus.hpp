@@ -32,9 +32,11 @@ class LcmBus {
     lcm_subscribe(lcm_->getUnderlyingLCM(), channel.c_str(), &HandlerBase::onMessage, handlers_.back().get());
   }
 
+  // The latency recorded for the channel is the time from since_monotonic_us (e.g. the arrival
+  // of the data the message was made from) to the end of the publish; by default the publish.
   template <typename Message>
-  bool publish(const std::string& channel, const Message& message) {
-    const int64_t start_us = sss::core::monotonicUtime();
+  bool publish(const std::string& channel, const Message& message, int64_t since_monotonic_us = -1) {
+    const int64_t start_us = since_monotonic_us >= 0 ? since_monotonic_us : sss::core::monotonicUtime();
     const int result = lcm_->publish(channel, &message);
     health_.recordMessage(channel, true, sss::core::monotonicUtime() - start_us);
     if (result != 0) {

@@ -1,0 +1,64 @@
+// Joins the port and starboard channel messages of one ping by ping number. A ping whose other
+// side does not come within a timeout (or is pushed out by newer pings) is handed out with the
+// side it has and a flag, never held forever and never dropped silently.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <vector>
+
+#include "drivers/edgetech/jsf_format.hpp"
+
+namespace sss::edgetech {
+
+struct AssembledPing {
+  uint32_t ping_number = 0;
+  std::optional<SonarChannelRecord> port;
+  std::optional<SonarChannelRecord> starboard;
+  int64_t last_arrival_us = 0;  // monotonic arrival of the last channel (latency reference)
+  bool complete() const { return port && starboard; }
+  // The sonar's ping time (both sides carry the same one).
+  int64_t pingTimeUs() const { return port ? port->ping_time_us : starboard->ping_time_us; }
+};
+
+struct PingAssemblerOptions {
+  uint8_t subsystem = kSubsystemSideScanLow;  // the side-scan frequency to use; others are ignored
+  double missing_side_timeout_s = 1.0;        // a lone side waits this long for its partner
+  int max_pending_pings = 8;                   // more incomplete pings than this: the oldest goes out
+};
+
+struct PingAssemblerCounters {
+  uint64_t complete_pings = 0;
+  uint64_t incomplete_pings = 0;   // handed out with one side missing
+  uint64_t duplicate_channels = 0; // a side seen twice for one ping: the later one is kept
+  uint64_t other_subsystem = 0;    // messages of another subsystem, ignored
+};
+
+class PingAssembler {
+ public:
+  explicit PingAssembler(PingAssemblerOptions options = {});
+
+  // Adds one channel record that arrived at monotonic time arrival_us; completed pings go to out.
+  void add(SonarChannelRecord record, int64_t arrival_us, std::vector<AssembledPing>& out);
+  // Hands out pings whose partner timed out by now_us (call from a timer).
+  void expire(int64_t now_us, std::vector<AssembledPing>& out);
+  // Hands out everything pending (end of a file).
+  void flush(std::vector<AssembledPing>& out);
+
+  size_t pending() const { return pending_.size(); }
+  const PingAssemblerCounters& counters() const { return counters_; }
+
+ private:
+  struct Pending {
+    AssembledPing ping;
+    int64_t first_arrival_us = 0;
+  };
+  void emit(Pending&& pending, std::vector<AssembledPing>& out);
+
+  PingAssemblerOptions options_;
+  std::deque<Pending> pending_;  // in arrival order
+  PingAssemblerCounters counters_;
+};
+
+}  // namespace sss::edgetech

@@ -1,0 +1,108 @@
+// EdgeTech driver logic, see sonar_driver.hpp.
+#include "drivers/edgetech/sonar_driver.hpp"
+
+namespace sss::edgetech {
+
+SonarDriver::SonarDriver(SonarDriverOptions options)
+    : options_(options),
+      parser_(options.parser),
+      assembler_(options.assembler),
+      clock_(options.clock),
+      recorder_(options.recorder) {}
+
+void SonarDriver::onBytes(const uint8_t* data, size_t size, int64_t host_utime_us, int64_t monotonic_us,
+                          std::vector<DriverPing>& out) {
+  recorder_.write(data, size, host_utime_us);
+  messages_.clear();
+  parser_.feed(data, size, messages_);
+  assembled_.clear();
+  handleMessages(host_utime_us, monotonic_us);
+  convert(assembled_, out);
+}
+
+void SonarDriver::handleMessages(int64_t host_utime_us, int64_t monotonic_us) {
+  for (const JsfMessage& message : messages_) {
+    if (message.header.message_type != kJsfSonarData) continue;  // nav types: not used by this driver yet
+    SonarDecodeResult decoded = decodeSonarData(message.header, message.body.data(), message.body.size());
+    if (!decoded.record) {
+      ++sonar_decode_errors_;
+      if (!decode_error_reported_) {
+        decode_error_reported_ = true;
+        new_faults_.push_back("JSF sonar message at byte " + std::to_string(message.stream_offset) + ": " +
+                              decoded.error + "; skipped");
+      }
+      continue;
+    }
+    const SonarChannelRecord& r = *decoded.record;
+    // The clock sees every channel: the end of acquisition is the last sample's time.
+    const int64_t acquisition_us = static_cast<int64_t>(static_cast<double>(r.start_depth_samples + r.samples.size()) *
+                                                        r.sample_interval_s * 1e6);
+    clock_.add(r.ping_time_us + acquisition_us, host_utime_us);
+    assembler_.add(std::move(*decoded.record), monotonic_us, assembled_);
+  }
+}
+
+void SonarDriver::onTimer(int64_t monotonic_us, std::vector<DriverPing>& out) {
+  assembled_.clear();
+  assembler_.expire(monotonic_us, assembled_);
+  convert(assembled_, out);
+}
+
+void SonarDriver::finish(int64_t host_utime_us, int64_t monotonic_us, std::vector<DriverPing>& out) {
+  messages_.clear();
+  parser_.finish(messages_);
+  assembled_.clear();
+  handleMessages(host_utime_us, monotonic_us);
+  assembler_.flush(assembled_);
+  convert(assembled_, out);
+}
+
+void SonarDriver::convert(std::vector<AssembledPing>& pings, std::vector<DriverPing>& out) {
+  for (AssembledPing& ping : pings) {
+    DriverPing driver_ping;
+    driver_ping.sonar_utime_us = ping.pingTimeUs();
+    if (options_.time_source == TimeSource::kSonarClock) {
+      driver_ping.utime_us = driver_ping.sonar_utime_us;
+    } else {
+      const auto offset = clock_.offsetUs();
+      if (!offset) {
+        // Not enough pings yet to know the sonar clock: publishing a guessed time would put the
+        // ping at the wrong place. Counted; the estimate settles after a few pings.
+        ++pings_without_offset_;
+        continue;
+      }
+      driver_ping.utime_us = driver_ping.sonar_utime_us + *offset;
+    }
+    driver_ping.ping = std::move(ping);
+    out.push_back(std::move(driver_ping));
+  }
+}
+
+std::vector<std::string> SonarDriver::takeNewFaultMessages() {
+  std::vector<std::string> faults = parser_.takeNewFaultMessages();
+  for (std::string& fault : new_faults_) faults.push_back(std::move(fault));
+  new_faults_.clear();
+  const std::string recorder_error = recorder_.takeNewError();
+  if (!recorder_error.empty()) faults.push_back(recorder_error);
+  return faults;
+}
+
+void readSonarDriverOptions(sss::core::ConfigSection& section, SonarDriverOptions& options) {
+  using namespace sss::core;
+  int subsystem = options.assembler.subsystem;
+  section.optional("subsystem", subsystem, {inRange(0, 255)});
+  options.assembler.subsystem = static_cast<uint8_t>(subsystem);
+  section.optional("missing_side_timeout_s", options.assembler.missing_side_timeout_s, {inRange(0.01, 60.0)});
+  section.optional("max_pending_pings", options.assembler.max_pending_pings, {inRange(1, 1000)});
+  section.optional("max_message_bytes", options.parser.max_body_bytes, {inRange(1024, 64 * 1024 * 1024)});
+  section.optional("clock_window_s", options.clock.window_s, {inRange(1.0, 3600.0)});
+  std::string time_source = options.time_source == TimeSource::kSonarClock ? "sonar" : "estimate";
+  section.optional("time_source", time_source, {oneOf({"estimate", "sonar"})});
+  options.time_source = time_source == "sonar" ? TimeSource::kSonarClock : TimeSource::kEstimateOffset;
+  section.optional("record_directory", options.recorder.directory);
+  double record_max_file_mb = static_cast<double>(options.recorder.max_file_bytes) / (1024.0 * 1024.0);
+  section.optional("record_max_file_mb", record_max_file_mb, {inRange(1.0, 1e6)});
+  options.recorder.max_file_bytes = static_cast<uint64_t>(record_max_file_mb * 1024.0 * 1024.0);
+}
+
+}  // namespace sss::edgetech

@@ -1,0 +1,81 @@
+// The EdgeTech 2205 driver's logic, free of sockets and LCM: raw bytes in (from TCP or a file),
+// joined pings out with their measurement time in the vehicle's time base; the raw stream is
+// recorded as received; every fault is counted.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "drivers/edgetech/clock_offset.hpp"
+#include "drivers/edgetech/jsf_stream_parser.hpp"
+#include "drivers/edgetech/ping_assembler.hpp"
+#include "drivers/edgetech/raw_recorder.hpp"
+#include "pipeline/core/config.hpp"
+
+namespace sss::edgetech {
+
+enum class TimeSource {
+  kEstimateOffset,  // live: host time = sonar time + estimated offset
+  kSonarClock,      // replay or a sonar synchronised by PTP/NTP: trust its clock
+};
+
+struct SonarDriverOptions {
+  JsfParserOptions parser;
+  PingAssemblerOptions assembler;
+  ClockOffsetOptions clock;
+  RawRecorderOptions recorder;
+  TimeSource time_source = TimeSource::kEstimateOffset;
+};
+
+struct DriverPing {
+  AssembledPing ping;
+  int64_t utime_us = 0;     // ping time in the vehicle's time base
+  int64_t sonar_utime_us = 0;
+};
+
+class SonarDriver {
+ public:
+  explicit SonarDriver(SonarDriverOptions options);
+
+  // Bytes as received; host_utime_us: wall clock, monotonic_us: for timeouts and latency.
+  void onBytes(const uint8_t* data, size_t size, int64_t host_utime_us, int64_t monotonic_us,
+               std::vector<DriverPing>& out);
+  // Periodic: pings whose other side never came.
+  void onTimer(int64_t monotonic_us, std::vector<DriverPing>& out);
+  // End of input (file): everything pending.
+  void finish(int64_t host_utime_us, int64_t monotonic_us, std::vector<DriverPing>& out);
+
+  // Faults since the last call, one text per kind the first time it happens (log these).
+  std::vector<std::string> takeNewFaultMessages();
+
+  const JsfParserCounters& parserCounters() const { return parser_.counters(); }
+  const PingAssemblerCounters& assemblerCounters() const { return assembler_.counters(); }
+  const RawRecorder& recorder() const { return recorder_; }
+  uint64_t sonarDecodeErrors() const { return sonar_decode_errors_; }
+  uint64_t pingsWithoutOffset() const { return pings_without_offset_; }
+  // host = sonar + offset; empty before enough pings.
+  std::optional<int64_t> clockOffsetUs() const { return clock_.offsetUs(); }
+  uint64_t clockResets() const { return clock_.resets(); }
+
+ private:
+  void handleMessages(int64_t host_utime_us, int64_t monotonic_us);
+  void convert(std::vector<AssembledPing>& pings, std::vector<DriverPing>& out);
+
+  SonarDriverOptions options_;
+  JsfStreamParser parser_;
+  PingAssembler assembler_;
+  ClockOffsetEstimator clock_;
+  RawRecorder recorder_;
+  std::vector<JsfMessage> messages_;      // reused between calls
+  std::vector<AssembledPing> assembled_;  // reused between calls
+  uint64_t sonar_decode_errors_ = 0;
+  uint64_t pings_without_offset_ = 0;
+  std::vector<std::string> new_faults_;
+  bool decode_error_reported_ = false;
+};
+
+// Reads the sonar_driver section's library keys (see config/sss-slam.yaml).
+void readSonarDriverOptions(sss::core::ConfigSection& section, SonarDriverOptions& options);
+
+}  // namespace sss::edgetech

@@ -1,0 +1,222 @@
+// sss-sonar-driver: EdgeTech 2205 JSF from the sonar processor's TCP data port (or a .jsf file
+// for replay) -> SSS_PING on LCM. Translation only; the logic is in SonarDriver.
+//   sss-sonar-driver [--config FILE] [--file FILE.jsf [--speed X]] [--lcm-url URL]
+#include <cstdio>
+#include <cstdlib>
+#include <deque>
+#include <fstream>
+#include <string>
+
+#include "drivers/edgetech/ping_message.hpp"
+#include "drivers/edgetech/sonar_driver.hpp"
+#include "pipeline/core/time.hpp"
+#include "pipeline/transport/logging.hpp"
+#include "pipeline/transport/process_loop.hpp"
+#include "pipeline/transport/tcp_client.hpp"
+
+namespace {
+
+using sss::core::monotonicUtime;
+using sss::core::nowUtime;
+
+struct NodeOptions {
+  sss::transport::ProcessOptions process;
+  sss::edgetech::SonarDriverOptions driver;
+  sss::transport::TcpClientOptions tcp;
+  std::string ping_channel = "SSS_PING";
+  std::string replay_file;      // non-empty: read this file instead of TCP
+  double replay_speed = 1.0;    // 0: as fast as possible
+};
+
+void usage(const char* program) {
+  std::fprintf(stderr, "usage: %s [--config FILE] [--file FILE.jsf [--speed X]] [--lcm-url URL]\n", program);
+}
+
+// Replays a file through the same byte path as TCP, publishing each ping at its sonar time
+// divided by the speed factor.
+class FileReplay {
+ public:
+  FileReplay(const std::string& path, double speed) : file_(path, std::ios::binary), speed_(speed) {}
+  bool isOpen() const { return file_.is_open(); }
+  bool done() const { return eof_ && queue_.empty(); }
+
+  template <typename Publish>
+  void step(sss::edgetech::SonarDriver& driver, Publish publish) {
+    // Keep a small queue of decoded pings ahead of the pace.
+    std::vector<char> chunk(1 << 16);
+    while (!eof_ && queue_.size() < 64) {
+      file_.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+      const size_t n = static_cast<size_t>(file_.gcount());
+      std::vector<sss::edgetech::DriverPing> pings;
+      if (n > 0) driver.onBytes(reinterpret_cast<const uint8_t*>(chunk.data()), n, nowUtime(), monotonicUtime(), pings);
+      if (n < chunk.size()) {
+        driver.finish(nowUtime(), monotonicUtime(), pings);
+        eof_ = true;
+      }
+      for (auto& p : pings) queue_.push_back(std::move(p));
+    }
+    const int64_t now = monotonicUtime();
+    int budget = 200;  // per step: keep the loop responsive to signals and status
+    while (!queue_.empty() && budget-- > 0) {
+      sss::edgetech::DriverPing& next = queue_.front();
+      if (speed_ > 0.0) {
+        if (first_sonar_us_ < 0) {
+          first_sonar_us_ = next.sonar_utime_us;
+          start_monotonic_us_ = now;
+        }
+        const int64_t due = start_monotonic_us_ + static_cast<int64_t>((next.sonar_utime_us - first_sonar_us_) / speed_);
+        if (due > now) break;
+      }
+      next.ping.last_arrival_us = now;
+      publish(next);
+      queue_.pop_front();
+    }
+  }
+
+ private:
+  std::ifstream file_;
+  double speed_;
+  bool eof_ = false;
+  std::deque<sss::edgetech::DriverPing> queue_;
+  int64_t first_sonar_us_ = -1;
+  int64_t start_monotonic_us_ = 0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string config_path;
+  std::string lcm_url_override;
+  NodeOptions options;
+  bool speed_given = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--config" && i + 1 < argc) {
+      config_path = argv[++i];
+    } else if (arg == "--file" && i + 1 < argc) {
+      options.replay_file = argv[++i];
+    } else if (arg == "--speed" && i + 1 < argc) {
+      options.replay_speed = std::atof(argv[++i]);
+      speed_given = true;
+    } else if (arg == "--lcm-url" && i + 1 < argc) {
+      lcm_url_override = argv[++i];
+    } else {
+      usage(argv[0]);
+      return arg == "--help" ? 0 : 2;
+    }
+  }
+
+  options.process.process_name = "sss-sonar-driver";
+  if (!config_path.empty()) {
+    sss::core::Config config = sss::core::Config::fromFile(config_path);
+    sss::core::ConfigSection section = config.section("sonar_driver");
+    sss::transport::readProcessOptions(section, options.process);
+    sss::edgetech::readSonarDriverOptions(section, options.driver);
+    section.optional("host", options.tcp.host, {sss::core::nonEmpty()});
+    section.optional("port", options.tcp.port, {sss::core::inRange(1, 65535)});
+    section.optional("reconnect_min_s", options.tcp.reconnect_min_s, {sss::core::inRange(0.01, 60.0)});
+    section.optional("reconnect_max_s", options.tcp.reconnect_max_s, {sss::core::inRange(0.1, 600.0)});
+    section.optional("silence_timeout_s", options.tcp.silence_timeout_s, {sss::core::inRange(0.0, 3600.0)});
+    section.optional("ping_channel", options.ping_channel, {sss::core::nonEmpty()});
+    section.optional("replay_file", options.replay_file);
+    if (!speed_given) section.optional("replay_speed", options.replay_speed, {sss::core::inRange(0.0, 1000.0)});
+    section.rejectUnknownKeys();
+    if (!config.ok()) {
+      std::fprintf(stderr, "sss-sonar-driver: invalid configuration:\n%s", config.problemReport().c_str());
+      return 2;
+    }
+  }
+  if (!lcm_url_override.empty()) options.process.lcm_url = lcm_url_override;
+  // A file carries the sonar's own clock; there is no arrival time to compare it with.
+  if (!options.replay_file.empty()) options.driver.time_source = sss::edgetech::TimeSource::kSonarClock;
+
+  sss::transport::initLogging(options.process.process_name, options.process.log_level);
+  sss::transport::ProcessLoop loop(options.process);
+  sss::core::HealthMonitor& health = loop.health();
+  sss::edgetech::SonarDriver driver(options.driver);
+
+  auto publish = [&](const sss::edgetech::DriverPing& ping) {
+    loop.bus().publish(options.ping_channel, sss::edgetech::toPingMessage(ping), ping.ping.last_arrival_us);
+  };
+  auto logFaults = [&] {
+    for (const std::string& fault : driver.takeNewFaultMessages()) {
+      health.recordError("sonar_input", fault, nowUtime());
+      spdlog::warn("{} (further faults of this kind are counted in SSS_STATUS)", fault);
+    }
+  };
+  auto updateCounters = [&] {
+    const auto& parser = driver.parserCounters();
+    const auto& assembler = driver.assemblerCounters();
+    health.setCounter("jsf_messages", static_cast<double>(parser.messages));
+    health.setCounter("jsf_bytes_skipped", static_cast<double>(parser.bytes_skipped));
+    health.setCounter("jsf_bad_headers", static_cast<double>(parser.bad_headers));
+    health.setCounter("jsf_truncated_messages", static_cast<double>(parser.truncated_messages));
+    health.setCounter("jsf_sonar_decode_errors", static_cast<double>(driver.sonarDecodeErrors()));
+    health.setCounter("pings_complete", static_cast<double>(assembler.complete_pings));
+    health.setCounter("pings_one_side_missing", static_cast<double>(assembler.incomplete_pings));
+    health.setCounter("pings_before_clock_estimate", static_cast<double>(driver.pingsWithoutOffset()));
+    if (const auto offset = driver.clockOffsetUs()) health.setCounter("clock_offset_s", *offset * 1e-6);
+    health.setCounter("clock_resets", static_cast<double>(driver.clockResets()));
+    if (driver.recorder().enabled()) {
+      health.setCounter("recorded_bytes", static_cast<double>(driver.recorder().bytesWritten()));
+      health.setCounter("record_errors", static_cast<double>(driver.recorder().writeErrors()));
+    }
+    logFaults();
+  };
+  loop.addTimer(1.0, updateCounters);
+
+  std::unique_ptr<FileReplay> replay;
+  std::unique_ptr<sss::transport::TcpClient> tcp;
+  int registered_fd = -1;
+  std::vector<sss::edgetech::DriverPing> pings;  // reused by the TCP callbacks below
+  if (!options.replay_file.empty()) {
+    replay = std::make_unique<FileReplay>(options.replay_file, options.replay_speed);
+    if (!replay->isOpen()) {
+      spdlog::critical("cannot open sonar file '{}'", options.replay_file);
+      return 1;
+    }
+    loop.addTimer(0.002, [&] {
+      replay->step(driver, publish);
+      if (replay->done()) {
+        updateCounters();
+        spdlog::info("replay of '{}' finished: {} pings", options.replay_file,
+                     driver.assemblerCounters().complete_pings + driver.assemblerCounters().incomplete_pings);
+        loop.stop();
+      }
+    });
+  } else {
+    tcp = std::make_unique<sss::transport::TcpClient>(
+        options.tcp,
+        [&](const uint8_t* data, size_t size) {
+          pings.clear();
+          driver.onBytes(data, size, nowUtime(), monotonicUtime(), pings);
+          for (const auto& ping : pings) publish(ping);
+        },
+        [&](sss::transport::LinkState state, const std::string& reason) {
+          health.setState(state == sss::transport::LinkState::kConnected ? sss::core::HealthState::kOk
+                                                                         : sss::core::HealthState::kWarning,
+                          "sonar link: " + reason);
+          if (state == sss::transport::LinkState::kConnected) {
+            spdlog::info("sonar link: {}", reason);
+          } else if (state == sss::transport::LinkState::kDisconnected) {
+            spdlog::warn("sonar link: {}", reason);
+          }
+        });
+    // Service the link and expire lone sides; (re)register the socket with the loop.
+    loop.addTimer(0.05, [&] {
+      const int64_t now = monotonicUtime();
+      tcp->service(now);
+      if (tcp->fd() != registered_fd) {
+        if (registered_fd >= 0) loop.removeFileDescriptor(registered_fd);
+        registered_fd = tcp->fd();
+        if (registered_fd >= 0) loop.addFileDescriptor(registered_fd, [&] { tcp->onReadable(monotonicUtime()); });
+      }
+      health.setCounter("link_connects", static_cast<double>(tcp->connects()));
+      health.setCounter("link_disconnects", static_cast<double>(tcp->disconnects()));
+      pings.clear();
+      driver.onTimer(now, pings);
+      for (const auto& ping : pings) publish(ping);
+    });
+  }
+  return loop.run();
+}
