@@ -48,11 +48,17 @@ void SonarDriver::onTimer(int64_t monotonic_us, std::vector<DriverPing>& out) {
   convert(assembled_, out);
 }
 
-void SonarDriver::finish(int64_t host_utime_us, int64_t monotonic_us, std::vector<DriverPing>& out) {
+void SonarDriver::onStreamEnd(int64_t host_utime_us, int64_t monotonic_us, std::vector<DriverPing>& out) {
   messages_.clear();
   parser_.finish(messages_);
   assembled_.clear();
   handleMessages(host_utime_us, monotonic_us);
+  convert(assembled_, out);
+}
+
+void SonarDriver::finish(int64_t host_utime_us, int64_t monotonic_us, std::vector<DriverPing>& out) {
+  onStreamEnd(host_utime_us, monotonic_us, out);
+  assembled_.clear();
   assembler_.flush(assembled_);
   convert(assembled_, out);
 }

@@ -43,7 +43,10 @@ class SonarDriver {
                std::vector<DriverPing>& out);
   // Periodic: pings whose other side never came.
   void onTimer(int64_t monotonic_us, std::vector<DriverPing>& out);
-  // End of input (file): everything pending.
+  // The byte stream ended (connection lost): whatever it completes is decided now; a
+  // reconnection starts a new stream. Pings waiting for their other side keep waiting.
+  void onStreamEnd(int64_t host_utime_us, int64_t monotonic_us, std::vector<DriverPing>& out);
+  // End of input (file): everything pending, including lone sides.
   void finish(int64_t host_utime_us, int64_t monotonic_us, std::vector<DriverPing>& out);
 
   // Faults since the last call, one text per kind the first time it happens (log these).

@@ -12,6 +12,7 @@
 #include "pipeline/core/time.hpp"
 #include "pipeline/transport/logging.hpp"
 #include "pipeline/transport/process_loop.hpp"
+#include "pipeline/transport/replay_pacer.hpp"
 #include "pipeline/transport/tcp_client.hpp"
 
 namespace {
@@ -36,7 +37,7 @@ void usage(const char* program) {
 // divided by the speed factor.
 class FileReplay {
  public:
-  FileReplay(const std::string& path, double speed) : file_(path, std::ios::binary), speed_(speed) {}
+  FileReplay(const std::string& path, double speed) : file_(path, std::ios::binary), pacer_(speed) {}
   bool isOpen() const { return file_.is_open(); }
   bool done() const { return eof_ && queue_.empty(); }
 
@@ -59,14 +60,7 @@ class FileReplay {
     int budget = 200;  // per step: keep the loop responsive to signals and status
     while (!queue_.empty() && budget-- > 0) {
       sss::edgetech::DriverPing& next = queue_.front();
-      if (speed_ > 0.0) {
-        if (first_sonar_us_ < 0) {
-          first_sonar_us_ = next.sonar_utime_us;
-          start_monotonic_us_ = now;
-        }
-        const int64_t due = start_monotonic_us_ + static_cast<int64_t>((next.sonar_utime_us - first_sonar_us_) / speed_);
-        if (due > now) break;
-      }
+      if (!pacer_.due(next.sonar_utime_us, now)) break;
       next.ping.last_arrival_us = now;
       publish(next);
       queue_.pop_front();
@@ -75,11 +69,9 @@ class FileReplay {
 
  private:
   std::ifstream file_;
-  double speed_;
+  sss::transport::ReplayPacer pacer_;
   bool eof_ = false;
   std::deque<sss::edgetech::DriverPing> queue_;
-  int64_t first_sonar_us_ = -1;
-  int64_t start_monotonic_us_ = 0;
 };
 
 }  // namespace
@@ -200,6 +192,9 @@ int main(int argc, char** argv) {
             spdlog::info("sonar link: {}", reason);
           } else if (state == sss::transport::LinkState::kDisconnected) {
             spdlog::warn("sonar link: {}", reason);
+            pings.clear();
+            driver.onStreamEnd(nowUtime(), monotonicUtime(), pings);
+            for (const auto& ping : pings) publish(ping);
           }
         });
     // Service the link and expire lone sides; (re)register the socket with the loop.

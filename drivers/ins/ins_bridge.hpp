@@ -1,0 +1,75 @@
+// The INS bridge's logic, free of sockets and LCM: NMEA bytes in (UDP datagrams, a TCP stream,
+// a serial port, a file), complete navigation samples out with local NED position, body-frame
+// velocity, distance travelled and validity/staleness flags; every fault counted.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "drivers/ins/ins_state_assembler.hpp"
+#include "drivers/ins/nmea_stream_parser.hpp"
+#include "pipeline/core/config.hpp"
+#include "pipeline/core/geodesy.hpp"
+
+namespace sss::ins {
+
+struct InsBridgeOptions {
+  double origin_latitude_deg = 59.35;   // mission origin of the local NED frame
+  double origin_longitude_deg = 18.07;
+  InsAssemblerOptions assembler;
+  NmeaStreamOptions stream;
+};
+
+struct NavSample {
+  InsState ins;                          // as assembled (geodetic, attitude, NED velocity, std)
+  Eigen::Vector3d position_ned_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d velocity_body_m_s = Eigen::Vector3d::Zero();  // FRD
+  double distance_travelled_m = 0.0;     // horizontal path length of the DR track so far
+};
+
+class InsBridge {
+ public:
+  explicit InsBridge(const InsBridgeOptions& options);
+
+  // Bytes as received; host_monotonic_us stamps them for the silence check.
+  void onBytes(const uint8_t* data, size_t size, int64_t host_monotonic_us, std::vector<NavSample>& out);
+  // End of a UDP datagram (a sentence may omit its CR/LF there) or of a file.
+  void onChunkEnd(int64_t host_monotonic_us, std::vector<NavSample>& out);
+  // End of input: the open epoch too.
+  void finish(int64_t host_monotonic_us, std::vector<NavSample>& out);
+
+  // Staleness now, also when the INS went silent: INS time is extrapolated from the last epoch
+  // by the host time elapsed since it arrived.
+  uint32_t staleFlagsAt(int64_t host_monotonic_us) const;
+  // "no heading for 1.5 s, no position for 6.0 s" or empty.
+  std::string describeStale(int64_t host_monotonic_us) const;
+
+  std::vector<std::string> takeNewFaultMessages();
+  const NmeaStreamCounters& streamCounters() const { return parser_.counters(); }
+  const InsAssemblerCounters& assemblerCounters() const { return assembler_.counters(); }
+  uint64_t epochsOutOfOrder() const { return epochs_out_of_order_; }
+
+ private:
+  void assemble(std::vector<std::string>& sentences, int64_t host_monotonic_us, std::vector<NavSample>& out);
+  void emit(const InsState& state, int64_t host_monotonic_us, std::vector<NavSample>& out);
+
+  InsBridgeOptions options_;
+  sss::core::LocalTangentPlane plane_;
+  NmeaStreamParser parser_;
+  InsStateAssembler assembler_;
+  std::vector<std::string> sentences_;  // reused
+  std::optional<Eigen::Vector3d> last_position_ned_m_;
+  double distance_travelled_m_ = 0.0;
+  int64_t last_ins_utime_us_ = 0;
+  int64_t last_epoch_host_us_ = 0;
+  uint64_t epochs_out_of_order_ = 0;
+  std::vector<std::string> reported_;  // fault kinds already handed out
+};
+
+// Reads the ins_bridge section's library keys and the mission origin.
+void readInsBridgeOptions(sss::core::ConfigSection& section, InsBridgeOptions& options);
+
+}  // namespace sss::ins

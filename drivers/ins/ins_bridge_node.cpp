@@ -1,0 +1,286 @@
+// sss-ins-bridge: iXblue NMEA from UDP, TCP, a serial port or a file -> SSS_NAV on LCM, with
+// staleness in the message flags and in SSS_STATUS. Translation only; the logic is in InsBridge.
+//   sss-ins-bridge [--config FILE] [--file ins.nmea [--speed X]] [--lcm-url URL]
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <deque>
+#include <fstream>
+#include <string>
+
+#include "drivers/ins/ins_bridge.hpp"
+#include "drivers/ins/nav_message.hpp"
+#include "pipeline/core/time.hpp"
+#include "pipeline/transport/logging.hpp"
+#include "pipeline/transport/process_loop.hpp"
+#include "pipeline/transport/replay_pacer.hpp"
+#include "pipeline/transport/tcp_client.hpp"
+
+namespace {
+
+using sss::core::monotonicUtime;
+
+struct NodeOptions {
+  sss::transport::ProcessOptions process;
+  sss::ins::InsBridgeOptions bridge;
+  std::string source = "udp";  // udp | tcp | serial | file
+  std::string bind_address = "0.0.0.0";
+  int udp_port = 8110;
+  sss::transport::TcpClientOptions tcp;
+  std::string serial_device = "/dev/ttyS0";
+  int serial_baud = 115200;
+  std::string file;
+  double replay_speed = 1.0;
+  std::string nav_channel = "SSS_NAV";
+};
+
+speed_t baudConstant(int baud) {
+  switch (baud) {
+    case 9600: return B9600;
+    case 19200: return B19200;
+    case 38400: return B38400;
+    case 57600: return B57600;
+    case 230400: return B230400;
+    case 460800: return B460800;
+    default: return B115200;
+  }
+}
+
+int openUdp(const NodeOptions& options, std::string& error) {
+  const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+  const int one = 1;
+  ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof(one));
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(static_cast<uint16_t>(options.udp_port));
+  ::inet_pton(AF_INET, options.bind_address.c_str(), &address.sin_addr);
+  if (::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0) {
+    error = "cannot bind UDP " + options.bind_address + ":" + std::to_string(options.udp_port) + ": " + std::strerror(errno);
+    ::close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+int openSerial(const NodeOptions& options, std::string& error) {
+  const int fd = ::open(options.serial_device.c_str(), O_RDONLY | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
+    error = "cannot open serial port '" + options.serial_device + "': " + std::strerror(errno);
+    return -1;
+  }
+  termios tty{};
+  if (::tcgetattr(fd, &tty) == 0) {
+    ::cfmakeraw(&tty);
+    ::cfsetispeed(&tty, baudConstant(options.serial_baud));
+    tty.c_cflag |= CLOCAL | CREAD;
+    ::tcsetattr(fd, TCSANOW, &tty);
+  }
+  return fd;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string config_path, lcm_url_override;
+  NodeOptions options;
+  bool speed_given = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--config" && i + 1 < argc) {
+      config_path = argv[++i];
+    } else if (arg == "--file" && i + 1 < argc) {
+      options.file = argv[++i];
+      options.source = "file";
+    } else if (arg == "--speed" && i + 1 < argc) {
+      options.replay_speed = std::atof(argv[++i]);
+      speed_given = true;
+    } else if (arg == "--lcm-url" && i + 1 < argc) {
+      lcm_url_override = argv[++i];
+    } else {
+      std::fprintf(stderr, "usage: %s [--config FILE] [--file ins.nmea [--speed X]] [--lcm-url URL]\n", argv[0]);
+      return arg == "--help" ? 0 : 2;
+    }
+  }
+  options.process.process_name = "sss-ins-bridge";
+  if (!config_path.empty()) {
+    using namespace sss::core;
+    Config config = Config::fromFile(config_path);
+    ConfigSection mission = config.section("mission");
+    mission.optional("origin_latitude_deg", options.bridge.origin_latitude_deg, {inRange(-90.0, 90.0)});
+    mission.optional("origin_longitude_deg", options.bridge.origin_longitude_deg, {inRange(-180.0, 180.0)});
+    ConfigSection section = config.section("ins_bridge");
+    sss::transport::readProcessOptions(section, options.process);
+    sss::ins::readInsBridgeOptions(section, options.bridge);
+    const bool file_given = options.source == "file";
+    section.optional("source", options.source, {oneOf({"udp", "tcp", "serial", "file"})});
+    if (file_given) options.source = "file";
+    section.optional("bind_address", options.bind_address, {nonEmpty()});
+    section.optional("udp_port", options.udp_port, {inRange(1, 65535)});
+    section.optional("host", options.tcp.host, {nonEmpty()});
+    section.optional("port", options.tcp.port, {inRange(1, 65535)});
+    section.optional("serial_device", options.serial_device, {nonEmpty()});
+    section.optional("serial_baud", options.serial_baud,
+                     {satisfies<int>([](int b) { return b == 9600 || b == 19200 || b == 38400 || b == 57600 ||
+                                                        b == 115200 || b == 230400 || b == 460800; },
+                                     "a standard baud rate (9600 ... 460800)")});
+    if (!file_given) section.optional("file", options.file);
+    if (!speed_given) section.optional("replay_speed", options.replay_speed, {inRange(0.0, 1000.0)});
+    section.optional("nav_channel", options.nav_channel, {nonEmpty()});
+    section.rejectUnknownKeys();
+    if (!config.ok()) {
+      std::fprintf(stderr, "sss-ins-bridge: invalid configuration:\n%s", config.problemReport().c_str());
+      return 2;
+    }
+  }
+  if (!lcm_url_override.empty()) options.process.lcm_url = lcm_url_override;
+
+  sss::transport::initLogging(options.process.process_name, options.process.log_level);
+  sss::transport::ProcessLoop loop(options.process);
+  sss::core::HealthMonitor& health = loop.health();
+  sss::ins::InsBridge bridge(options.bridge);
+  std::vector<sss::ins::NavSample> samples;
+
+  auto publishAll = [&](int64_t since_us) {
+    for (const auto& sample : samples) {
+      loop.bus().publish(options.nav_channel, sss::ins::toNavMessage(sample), since_us);
+    }
+    samples.clear();
+  };
+  // Health: staleness (recovers by itself when data returns), counters, faults logged once.
+  loop.addTimer(0.5, [&] {
+    const std::string stale = bridge.describeStale(monotonicUtime());
+    health.setState(stale.empty() ? sss::core::HealthState::kOk : sss::core::HealthState::kWarning,
+                    stale.empty() ? "navigation ok" : stale);
+    const auto& stream = bridge.streamCounters();
+    health.setCounter("nmea_sentences", static_cast<double>(stream.sentences));
+    health.setCounter("nmea_bad_checksum", static_cast<double>(stream.bad_checksum));
+    health.setCounter("nmea_missing_checksum", static_cast<double>(stream.missing_checksum));
+    health.setCounter("nmea_overlong", static_cast<double>(stream.overlong));
+    health.setCounter("nmea_truncated", static_cast<double>(stream.truncated));
+    health.setCounter("nmea_garbage_bytes", static_cast<double>(stream.garbage_bytes));
+    health.setCounter("ins_epochs", static_cast<double>(bridge.assemblerCounters().epochs));
+    health.setCounter("ins_epochs_out_of_order", static_cast<double>(bridge.epochsOutOfOrder()));
+    for (const std::string& fault : bridge.takeNewFaultMessages()) {
+      health.recordError("ins_input", fault, sss::core::nowUtime());
+      spdlog::warn("{} (further faults of this kind are counted in SSS_STATUS)", fault);
+    }
+  });
+
+  std::string error;
+  int input_fd = -1;
+  std::unique_ptr<sss::transport::TcpClient> tcp;
+  int tcp_registered_fd = -1;
+  std::ifstream file;
+  std::deque<sss::ins::NavSample> replay_queue;
+  sss::transport::ReplayPacer pacer(options.replay_speed);
+  bool replay_eof = false;
+
+  if (options.source == "udp") {
+    input_fd = openUdp(options, error);
+    if (input_fd < 0) {
+      spdlog::critical("{}", error);
+      return 1;
+    }
+    loop.addFileDescriptor(input_fd, [&] {
+      uint8_t datagram[65536];
+      ssize_t n;
+      while ((n = ::recv(input_fd, datagram, sizeof(datagram), 0)) > 0) {
+        const int64_t now = monotonicUtime();
+        bridge.onBytes(datagram, static_cast<size_t>(n), now, samples);
+        bridge.onChunkEnd(now, samples);
+        publishAll(now);
+      }
+    });
+  } else if (options.source == "serial") {
+    // A serial port can vanish (USB adapter): reopen every 2 s until it is back.
+    auto tryOpen = [&] {
+      if (input_fd >= 0) return;
+      input_fd = openSerial(options, error);
+      if (input_fd < 0) {
+        if (health.recordError("serial_open", error, sss::core::nowUtime())) spdlog::warn("{}; retrying", error);
+        return;
+      }
+      spdlog::info("reading INS from {}", options.serial_device);
+      loop.addFileDescriptor(input_fd, [&] {
+        uint8_t buffer[4096];
+        const ssize_t n = ::read(input_fd, buffer, sizeof(buffer));
+        if (n > 0) {
+          const int64_t now = monotonicUtime();
+          bridge.onBytes(buffer, static_cast<size_t>(n), now, samples);
+          publishAll(now);
+        } else if (n == 0 || (errno != EAGAIN && errno != EINTR)) {
+          spdlog::warn("serial port '{}' closed; reopening", options.serial_device);
+          loop.removeFileDescriptor(input_fd);
+          ::close(input_fd);
+          input_fd = -1;
+        }
+      });
+    };
+    tryOpen();
+    loop.addTimer(2.0, tryOpen);
+  } else if (options.source == "tcp") {
+    tcp = std::make_unique<sss::transport::TcpClient>(
+        options.tcp,
+        [&](const uint8_t* data, size_t size) {
+          const int64_t now = monotonicUtime();
+          bridge.onBytes(data, size, now, samples);
+          publishAll(now);
+        },
+        [&](sss::transport::LinkState state, const std::string& reason) {
+          if (state == sss::transport::LinkState::kDisconnected) {
+            spdlog::warn("INS link: {}", reason);
+            bridge.onChunkEnd(monotonicUtime(), samples);
+            publishAll(monotonicUtime());
+          } else if (state == sss::transport::LinkState::kConnected) {
+            spdlog::info("INS link: {}", reason);
+          }
+        });
+    loop.addTimer(0.05, [&] {
+      tcp->service(monotonicUtime());
+      if (tcp->fd() != tcp_registered_fd) {
+        if (tcp_registered_fd >= 0) loop.removeFileDescriptor(tcp_registered_fd);
+        tcp_registered_fd = tcp->fd();
+        if (tcp_registered_fd >= 0) loop.addFileDescriptor(tcp_registered_fd, [&] { tcp->onReadable(monotonicUtime()); });
+      }
+    });
+  } else {
+    file.open(options.file, std::ios::binary);
+    if (!file) {
+      spdlog::critical("cannot open INS file '{}'", options.file);
+      return 1;
+    }
+    loop.addTimer(0.002, [&] {
+      char chunk[16384];
+      while (!replay_eof && replay_queue.size() < 256) {
+        file.read(chunk, sizeof(chunk));
+        const size_t n = static_cast<size_t>(file.gcount());
+        std::vector<sss::ins::NavSample> read;
+        bridge.onBytes(reinterpret_cast<const uint8_t*>(chunk), n, monotonicUtime(), read);
+        if (n < sizeof(chunk)) {
+          bridge.finish(monotonicUtime(), read);
+          replay_eof = true;
+        }
+        replay_queue.insert(replay_queue.end(), read.begin(), read.end());
+      }
+      const int64_t now = monotonicUtime();
+      for (int budget = 500; budget > 0 && !replay_queue.empty() && pacer.due(replay_queue.front().ins.utime_us, now); --budget) {
+        samples.push_back(replay_queue.front());
+        replay_queue.pop_front();
+        publishAll(now);
+      }
+      if (replay_eof && replay_queue.empty()) {
+        spdlog::info("replay of '{}' finished: {} epochs", options.file, bridge.assemblerCounters().epochs);
+        loop.stop();
+      }
+    });
+  }
+  const int code = loop.run();
+  if (input_fd >= 0) ::close(input_fd);
+  return code;
+}

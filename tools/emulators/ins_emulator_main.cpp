@@ -1,0 +1,69 @@
+// sss-ins-emulator: sends a recorded iXblue NMEA stream as the INS does, one datagram per output
+// burst over UDP (default) or as a TCP server, paced by the epoch times, with fault injection.
+//   sss-ins-emulator --file ins.nmea [--udp | --tcp] [--host 127.0.0.1] [--port 8110] [--speed 1]
+#include <csignal>
+#include <cstdio>
+#include <string>
+
+#include "tools/emulators/emulator_options.hpp"
+#include "tools/emulators/recorded_streams.hpp"
+
+namespace {
+std::atomic<bool> g_stop{false};
+void onSignal(int) { g_stop = true; }
+}  // namespace
+
+int main(int argc, char** argv) {
+  sss::emulators::StreamServerOptions options;
+  options.port = 8110;
+  std::string file;
+  bool tcp = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    std::string error;
+    if (arg == "--file" && i + 1 < argc) {
+      file = argv[++i];
+    } else if (arg == "--tcp") {
+      tcp = true;
+    } else if (arg == "--udp") {
+      tcp = false;
+    } else if (!sss::emulators::parseStreamOption(argc, argv, i, options, error) || !error.empty()) {
+      if (!error.empty()) std::fprintf(stderr, "sss-ins-emulator: %s\n", error.c_str());
+      std::fprintf(stderr,
+                   "usage: sss-ins-emulator --file ins.nmea [--udp | --tcp] [--host ADDR] [--port 8110] [options]\n"
+                   "  UDP sends to --host:--port; TCP listens on --host:--port\n%s",
+                   sss::emulators::streamOptionsHelp());
+      return arg == "--help" ? 0 : 2;
+    }
+  }
+  if (file.empty()) {
+    std::fprintf(stderr, "sss-ins-emulator: --file is required\n");
+    return 2;
+  }
+  std::signal(SIGINT, onSignal);
+  std::signal(SIGTERM, onSignal);
+  std::string error;
+  std::vector<sss::emulators::TimedChunk> chunks = sss::emulators::loadInsChunks(file, error);
+  if (!error.empty() || chunks.empty()) {
+    std::fprintf(stderr, "sss-ins-emulator: %s\n", error.empty() ? "no NMEA bursts in the file" : error.c_str());
+    return 1;
+  }
+  std::printf("sss-ins-emulator: %zu bursts from %s %s %s:%d at speed %g\n", chunks.size(), file.c_str(),
+              tcp ? "served on" : "sent to", options.bind_address.c_str(), options.port, options.speed);
+  std::fflush(stdout);
+  if (tcp) {
+    sss::emulators::TcpStreamServer server(options, std::move(chunks));
+    if (!server.listen(error)) {
+      std::fprintf(stderr, "sss-ins-emulator: %s\n", error.c_str());
+      return 1;
+    }
+    server.run(g_stop);
+  } else {
+    sss::emulators::UdpStreamSender sender(options, std::move(chunks));
+    if (!sender.run(g_stop, error)) {
+      std::fprintf(stderr, "sss-ins-emulator: %s\n", error.c_str());
+      return 1;
+    }
+  }
+  return 0;
+}

@@ -1,0 +1,72 @@
+// Recorded sensor files -> timed chunks, see recorded_streams.hpp.
+#include "tools/emulators/recorded_streams.hpp"
+
+#include <fstream>
+
+#include "drivers/edgetech/jsf_file_reader.hpp"
+#include "drivers/ins/ins_state_assembler.hpp"
+#include "drivers/ins/nmea_stream_parser.hpp"
+
+namespace sss::emulators {
+
+std::vector<TimedChunk> loadJsfChunks(const std::string& path, std::string& error) {
+  std::vector<TimedChunk> chunks;
+  sss::edgetech::JsfFileReader reader(path);
+  if (!reader.isOpen()) {
+    error = reader.error();
+    return chunks;
+  }
+  sss::edgetech::JsfMessage message;
+  int64_t last_time_us = 0;
+  while (reader.next(message)) {
+    TimedChunk chunk;
+    chunk.bytes.resize(sss::edgetech::kJsfHeaderSize);
+    sss::edgetech::encodeHeader(message.header, chunk.bytes.data());
+    chunk.bytes.insert(chunk.bytes.end(), message.body.begin(), message.body.end());
+    if (message.header.message_type == sss::edgetech::kJsfSonarData) {
+      const auto decoded = sss::edgetech::decodeSonarData(message.header, message.body.data(), message.body.size());
+      if (decoded.record) last_time_us = decoded.record->ping_time_us;
+    }
+    chunk.time_us = last_time_us;  // other types go out with the ping before them
+    chunks.push_back(std::move(chunk));
+  }
+  return chunks;
+}
+
+std::vector<TimedChunk> loadInsChunks(const std::string& path, std::string& error) {
+  std::vector<TimedChunk> chunks;
+  std::ifstream file(path);
+  if (!file) {
+    error = "cannot open INS file '" + path + "'";
+    return chunks;
+  }
+  sss::ins::InsStateAssembler assembler;
+  TimedChunk pending;
+  int64_t last_time_us = 0;
+  std::string line;
+  while (std::getline(file, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) continue;
+    pending.bytes.insert(pending.bytes.end(), line.begin(), line.end());
+    pending.bytes.push_back('\r');
+    pending.bytes.push_back('\n');
+    sss::ins::NmeaStreamParser parser;
+    const std::vector<std::string> bodies = parser.feed(line + "\r\n");
+    for (const std::string& body : bodies) {
+      for (const sss::ins::InsState& state : assembler.addSentence(body)) last_time_us = state.utime_us;
+    }
+    if (line.rfind("$PIXSE,STATUS", 0) == 0) {
+      pending.time_us = last_time_us;
+      chunks.push_back(std::move(pending));
+      pending = TimedChunk{};
+    }
+  }
+  if (!pending.bytes.empty()) {
+    if (const auto state = assembler.flush()) last_time_us = state->utime_us;
+    pending.time_us = last_time_us;
+    chunks.push_back(std::move(pending));
+  }
+  return chunks;
+}
+
+}  // namespace sss::emulators

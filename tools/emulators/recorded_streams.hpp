@@ -1,0 +1,18 @@
+// Cuts recorded sensor files into the time-stamped chunks the real sensor would send: one JSF
+// message per chunk (at its ping time), one INS output burst per chunk (at its epoch time).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "tools/emulators/stream_server.hpp"
+
+namespace sss::emulators {
+
+// Every framed message of a .jsf file, re-encoded byte for byte; error set when unreadable.
+std::vector<TimedChunk> loadJsfChunks(const std::string& path, std::string& error);
+// The NMEA lines of an INS file grouped into bursts ending with $PIXSE,STATUS (the iXblue
+// output period), each stamped with the epoch time the INS assembler reads from it.
+std::vector<TimedChunk> loadInsChunks(const std::string& path, std::string& error);
+
+}  // namespace sss::emulators

@@ -1,0 +1,65 @@
+// sss-sonar-emulator: serves a .jsf file over TCP as an EdgeTech 2205 sonar processor's data
+// port does, paced by the ping times, with optional fault injection.
+//   sss-sonar-emulator --file sonar.jsf [--bind 127.0.0.1] [--port 1701] [--speed 1] [faults]
+#include <csignal>
+#include <cstdio>
+#include <string>
+
+#include "tools/emulators/emulator_options.hpp"
+#include "tools/emulators/recorded_streams.hpp"
+
+namespace {
+std::atomic<bool> g_stop{false};
+void onSignal(int) { g_stop = true; }
+}  // namespace
+
+int main(int argc, char** argv) {
+  sss::emulators::StreamServerOptions options;
+  std::string file;
+  bool repeat = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    std::string error;
+    if (arg == "--file" && i + 1 < argc) {
+      file = argv[++i];
+    } else if (arg == "--repeat") {
+      repeat = true;
+    } else if (!sss::emulators::parseStreamOption(argc, argv, i, options, error) || !error.empty()) {
+      if (!error.empty()) std::fprintf(stderr, "sss-sonar-emulator: %s\n", error.c_str());
+      std::fprintf(stderr,
+                   "usage: sss-sonar-emulator --file FILE.jsf [--bind ADDR] [--port 1701] [--repeat] [options]\n%s",
+                   sss::emulators::streamOptionsHelp());
+      return arg == "--help" ? 0 : 2;
+    }
+  }
+  if (file.empty()) {
+    std::fprintf(stderr, "sss-sonar-emulator: --file is required\n");
+    return 2;
+  }
+  std::signal(SIGINT, onSignal);
+  std::signal(SIGTERM, onSignal);
+  std::string error;
+  std::vector<sss::emulators::TimedChunk> chunks = sss::emulators::loadJsfChunks(file, error);
+  if (!error.empty() || chunks.empty()) {
+    std::fprintf(stderr, "sss-sonar-emulator: %s\n", error.empty() ? "no JSF messages in the file" : error.c_str());
+    return 1;
+  }
+  do {
+    sss::emulators::TcpStreamServer server(options, chunks);
+    if (!server.listen(error)) {
+      std::fprintf(stderr, "sss-sonar-emulator: %s\n", error.c_str());
+      return 1;
+    }
+    std::printf("sss-sonar-emulator: %zu messages from %s on %s:%d at speed %g\n", chunks.size(), file.c_str(),
+                options.bind_address.c_str(), server.port(), options.speed);
+    std::fflush(stdout);
+    server.run(g_stop);
+    const auto& s = server.stats();
+    std::printf("sss-sonar-emulator: sent %llu whole, %llu faulted, %llu garbage runs, %llu connections, %llu drops\n",
+                static_cast<unsigned long long>(s.chunks_sent), static_cast<unsigned long long>(s.chunks_faulted),
+                static_cast<unsigned long long>(s.garbage_runs), static_cast<unsigned long long>(s.connections),
+                static_cast<unsigned long long>(s.drops));
+    std::fflush(stdout);
+  } while (repeat && !g_stop);
+  return 0;
+}

@@ -1,0 +1,81 @@
+// Serves a recorded stream (time-stamped chunks: JSF messages, INS sentence bursts) to a live
+// client the way the real sensor would: TCP server or UDP sender, paced by the chunk times at a
+// speed factor, tolerating client disconnects, and injecting faults on demand for tests.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace sss::emulators {
+
+struct TimedChunk {
+  int64_t time_us = 0;  // sensor time of the chunk (pacing only)
+  std::vector<uint8_t> bytes;
+};
+
+struct FaultPlan {
+  int corrupt_every = 0;        // every Kth chunk: garbage_bytes random bytes are sent before it
+  int garbage_bytes = 64;
+  int flip_every = 0;           // every Kth chunk: one byte inside it is flipped (bad checksum / data)
+  int truncate_every = 0;       // every Kth chunk: only its first half is sent
+  int drop_connection_every = 0;  // TCP: close the connection after every Kth chunk
+  int pause_every = 0;          // every Kth chunk: stop sending for pause_s
+  double pause_s = 0.0;
+  uint32_t seed = 1;
+};
+
+struct StreamServerOptions {
+  std::string bind_address = "127.0.0.1";
+  int port = 1701;              // 0: any free port (see port())
+  double speed = 1.0;           // 1 = real time, 10 = ten times faster, 0 = as fast as the client reads
+  FaultPlan faults;
+};
+
+struct StreamStats {
+  uint64_t chunks_sent = 0;     // sent whole and untouched
+  uint64_t chunks_faulted = 0;  // flipped or truncated
+  uint64_t garbage_runs = 0;
+  uint64_t connections = 0;
+  uint64_t drops = 0;
+  uint64_t pauses = 0;
+};
+
+class TcpStreamServer {
+ public:
+  TcpStreamServer(StreamServerOptions options, std::vector<TimedChunk> chunks);
+  ~TcpStreamServer();
+
+  // Binds and listens; false with error set when the port is taken or the address is wrong.
+  bool listen(std::string& error);
+  int port() const { return port_; }
+  // Waits for a client, sends every chunk (continuing after a drop once a client reconnects),
+  // returns when all are sent or stop becomes true. Closes the connection at the end.
+  void run(const std::atomic<bool>& stop);
+  const StreamStats& stats() const { return stats_; }
+
+ private:
+  int acceptClient(const std::atomic<bool>& stop);
+  StreamServerOptions options_;
+  std::vector<TimedChunk> chunks_;
+  int listen_fd_ = -1;
+  int port_ = 0;
+  StreamStats stats_;
+};
+
+// Sends each chunk as one UDP datagram to host:port (an INS's usual output), paced and faulted
+// like the TCP server (drops do not apply).
+class UdpStreamSender {
+ public:
+  UdpStreamSender(StreamServerOptions options, std::vector<TimedChunk> chunks);
+  bool run(const std::atomic<bool>& stop, std::string& error);
+  const StreamStats& stats() const { return stats_; }
+
+ private:
+  StreamServerOptions options_;
+  std::vector<TimedChunk> chunks_;
+  StreamStats stats_;
+};
+
+}  // namespace sss::emulators
