@@ -56,12 +56,15 @@ bool ConfigSection::has(const std::string& key) const {
 
 ConfigSection ConfigSection::section(const std::string& key) {
   read_keys_.insert(key);
-  YAML::Node child = lookup(key);
-  if (child.IsDefined() && !child.IsNull() && !child.IsMap()) {
+  const YAML::Node child = lookup(key);
+  if (!child.IsDefined() || child.IsNull()) {
+    // A fresh empty map: assigning to the invalid node yaml-cpp returns for a missing key throws.
+    return ConfigSection(YAML::Node(YAML::NodeType::Map), keyPath(key), problems_);
+  }
+  if (!child.IsMap()) {
     addProblem(key, describeYamlValue(child), "wrong type; expected a section (a map of keys)");
     return ConfigSection(YAML::Node(YAML::NodeType::Map), keyPath(key), problems_);
   }
-  if (!child.IsDefined() || child.IsNull()) child = YAML::Node(YAML::NodeType::Map);
   return ConfigSection(child, keyPath(key), problems_);
 }
 

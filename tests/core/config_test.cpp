@@ -101,6 +101,19 @@ TEST(Config, SyntaxErrorAndMissingFileAreProblemsNotExceptions) {
   EXPECT_NE(missing.problems()[0].reason.find("cannot open config file '/nonexistent/sss.yaml'"), std::string::npos);
 }
 
+TEST(Config, MissingSectionKeepsEveryDefault) {
+  Config config = Config::fromString("other:\n  x: 1\n");
+  ExampleOptions options;
+  ConfigSection section = config.section("matcher");
+  section.optional("max_offset_px", options.max_offset_px, {greaterThan(0.0)});
+  ConfigSection nested = section.section("deeper");
+  nested.optional("mode", options.mode);
+  nested.rejectUnknownKeys();
+  EXPECT_TRUE(config.ok()) << config.problemReport();
+  EXPECT_DOUBLE_EQ(options.max_offset_px, 5.0);
+  EXPECT_EQ(options.mode, "dense");
+}
+
 TEST(Config, SectionThatIsNotAMapIsReported) {
   Config config = Config::fromString("matcher: 3\n");
   ExampleOptions options;

@@ -1,0 +1,98 @@
+// INS bridge logic: local NED from geodetic, body velocity, distance travelled, ordering,
+// staleness while the INS is silent, and the SSS_NAV translation.
+#include "drivers/ins/ins_bridge.hpp"
+
+#include <gtest/gtest.h>
+
+#include "drivers/ins/nav_message.hpp"
+#include "ins_test_states.hpp"
+
+namespace sss::ins {
+namespace {
+
+InsBridgeOptions testOptions() {
+  InsBridgeOptions options;
+  options.origin_latitude_deg = test::kOriginLatitudeDeg;
+  options.origin_longitude_deg = test::kOriginLongitudeDeg;
+  return options;
+}
+
+std::vector<NavSample> feedAll(InsBridge& bridge, const std::string& stream, int64_t host_us = 0) {
+  std::vector<NavSample> samples;
+  bridge.onBytes(reinterpret_cast<const uint8_t*>(stream.data()), stream.size(), host_us, samples);
+  return samples;
+}
+
+TEST(InsBridge, GivesLocalNedBodyVelocityAndDistanceTravelled) {
+  InsBridge bridge(testOptions());
+  const std::vector<NavSample> samples = feedAll(bridge, test::eastboundStream(51));
+  ASSERT_EQ(samples.size(), 51u);  // every burst ends with STATUS: no epoch waits
+  const NavSample& last = samples.back();
+  // 5 s east at 2 m/s from (10, 0, 40): lat/lon at 1e-8 deg (~1 mm), depth at 1 mm.
+  EXPECT_NEAR(last.position_ned_m.x(), 10.0, 0.005);
+  EXPECT_NEAR(last.position_ned_m.y(), 10.0, 0.005);
+  EXPECT_NEAR(last.position_ned_m.z(), 40.0, 0.002);
+  EXPECT_NEAR(last.distance_travelled_m, 10.0, 0.02);
+  // Heading east with 2 m/s east: forward speed 2, small cross terms from roll/pitch only.
+  EXPECT_NEAR(last.velocity_body_m_s.x(), 2.0 * std::cos(0.02), 1e-3);
+  EXPECT_NEAR(last.velocity_body_m_s.y(), 0.0, 1e-3);
+  EXPECT_EQ(last.ins.utime_us, test::kStartUtime + 5'000'000);
+}
+
+TEST(InsBridge, OlderOrRepeatedEpochIsDroppedAndCounted) {
+  InsBridge bridge(testOptions());
+  std::string stream = encodeInsState(test::eastboundState(0)) + encodeInsState(test::eastboundState(2)) +
+                       encodeInsState(test::eastboundState(1)) + encodeInsState(test::eastboundState(3));
+  const std::vector<NavSample> samples = feedAll(bridge, stream);
+  ASSERT_EQ(samples.size(), 3u);
+  EXPECT_EQ(bridge.epochsOutOfOrder(), 1u);
+  EXPECT_EQ(samples[2].ins.utime_us, test::kStartUtime + 300'000);
+}
+
+TEST(InsBridge, SilentInsBecomesStaleAndRecovers) {
+  InsBridge bridge(testOptions());
+  feedAll(bridge, test::eastboundStream(10), 0);
+  EXPECT_EQ(bridge.staleFlagsAt(500'000), 0u);
+  // 1.5 s without data: heading (1 s timeout) is stale, position (5 s) not yet.
+  const uint32_t stale = bridge.staleFlagsAt(1'500'000);
+  EXPECT_TRUE(stale & kStaleHeading);
+  EXPECT_FALSE(stale & kStalePosition);
+  EXPECT_NE(bridge.describeStale(1'500'000).find("heading"), std::string::npos);
+  EXPECT_TRUE(bridge.staleFlagsAt(7'000'000) & kStalePosition);
+  // Data returns: clear again.
+  std::string more;
+  for (int e = 70; e < 72; ++e) more += encodeInsState(test::eastboundState(e));
+  feedAll(bridge, more, 7'000'000);
+  EXPECT_EQ(bridge.staleFlagsAt(7'050'000), 0u);
+  EXPECT_TRUE(bridge.describeStale(7'050'000).empty());
+}
+
+TEST(InsBridge, CorruptSentencesAreCountedAndReportedOnce) {
+  InsBridge bridge(testOptions());
+  std::string stream = test::eastboundStream(5);
+  stream[stream.find("ATITUD") + 8] ^= 0x01;  // checksum no longer matches
+  stream.insert(stream.find("$PIXSE,POSITI"), "\x01\x02garbage");
+  const std::vector<NavSample> samples = feedAll(bridge, stream);
+  EXPECT_EQ(samples.size(), 5u);  // the epoch keeps the other quantities
+  EXPECT_EQ(bridge.streamCounters().bad_checksum, 1);
+  const auto faults = bridge.takeNewFaultMessages();
+  EXPECT_GE(faults.size(), 2u);
+  EXPECT_TRUE(bridge.takeNewFaultMessages().empty());
+}
+
+TEST(NavMessage, CopiesFieldsAndMapsValidityBits) {
+  InsBridge bridge(testOptions());
+  const std::vector<NavSample> samples = feedAll(bridge, test::eastboundStream(3));
+  const sss_msgs::nav_t nav = toNavMessage(samples[2], kStaleAltitude);
+  EXPECT_EQ(nav.utime, test::kStartUtime + 200'000);
+  EXPECT_NEAR(nav.heading_rad, M_PI / 2, 1e-4);
+  EXPECT_NEAR(nav.altitude_m, 18.0, 1e-3);
+  EXPECT_DOUBLE_EQ(nav.position_std_ned_m[0], samples[2].ins.latitude_std_m);
+  const int32_t expected_valid = sss_msgs::nav_t::VALID_POSITION | sss_msgs::nav_t::VALID_ATTITUDE |
+                                 sss_msgs::nav_t::VALID_HEADING | sss_msgs::nav_t::VALID_VELOCITY |
+                                 sss_msgs::nav_t::VALID_DEPTH | sss_msgs::nav_t::VALID_ALTITUDE;
+  EXPECT_EQ(nav.validity, expected_valid | sss_msgs::nav_t::STALE_ALTITUDE);
+}
+
+}  // namespace
+}  // namespace sss::ins
