@@ -1,0 +1,106 @@
+// Dead reckoning: starts at the truth, drifts 0.1-0.5 % of distance by default, scales with
+// drift_scale, and the paper's heading noise grows the error in proportion to its std.
+#include "tools/sim/dead_reckoning.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace sss::sim {
+namespace {
+
+struct StraightLine {
+  Seabed bed;
+  Trajectory trajectory;
+  StraightLine()
+      : bed([] {
+          SeabedOptions options;
+          options.enable_texture = false;
+          options.north_min_m = -50.0;
+          options.east_min_m = -50.0;
+          options.size_north_m = 1100.0;
+          options.size_east_m = 100.0;
+          options.resolution_m = 1.0;
+          return options;
+        }()),
+        trajectory(
+            [] {
+              TrajectoryOptions options;
+              options.lines = 1;
+              options.line_length_m = 1000.0;
+              return options;
+            }(),
+            &bed) {}
+};
+
+double finalError(const DeadReckoning& dr, const Trajectory& trajectory, double time_s) {
+  return (dr.poseAt(time_s).translation - trajectory.sample(time_s).T_world_body.translation).head<2>().norm();
+}
+
+TEST(DeadReckoning, StartsAtTheTruePose) {
+  const StraightLine line;
+  DeadReckoningOptions options;
+  const DeadReckoning dr(options, line.trajectory, 10.0);
+  const sss::core::Pose truth = line.trajectory.sample(0.0).T_world_body;
+  EXPECT_LT((dr.poseAt(0.0).translation - truth.translation).norm(), 1e-12);
+  EXPECT_LT(dr.poseAt(0.0).rotation.angularDistance(truth.rotation), 1e-12);
+}
+
+TEST(DeadReckoning, DefaultDriftIsTenthToHalfPercentOfDistanceOverSeeds) {
+  const StraightLine line;
+  const double duration = line.trajectory.durationS();
+  for (uint64_t seed = 1; seed <= 8; ++seed) {
+    DeadReckoningOptions options;
+    options.seed = seed;
+    const DeadReckoning dr(options, line.trajectory, duration);
+    const double ratio = finalError(dr, line.trajectory, duration) / dr.distanceTravelledM();
+    // Straight line: error ~ hypot(scale factor, heading bias), each drawn in [0.1, 0.3] %.
+    EXPECT_GT(ratio, 0.001) << "seed " << seed;
+    EXPECT_LT(ratio, 0.005) << "seed " << seed;
+    EXPECT_NEAR(ratio, std::hypot(dr.velocityScaleFactor(), dr.headingBiasRad()), 0.0006) << "seed " << seed;
+  }
+}
+
+TEST(DeadReckoning, DriftScaleMultipliesTheError) {
+  const StraightLine line;
+  const double duration = line.trajectory.durationS();
+  DeadReckoningOptions options;
+  options.seed = 4;
+  const DeadReckoning base(options, line.trajectory, duration);
+  options.drift_scale = 3.0;
+  const DeadReckoning scaled(options, line.trajectory, duration);
+  const double ratio = finalError(scaled, line.trajectory, duration) / finalError(base, line.trajectory, duration);
+  // Linear in the error constants; the random walk and white noise add a few percent.
+  EXPECT_NEAR(ratio, 3.0, 0.3);
+}
+
+TEST(DeadReckoning, HeadingNoiseErrorGrowsWithItsStd) {
+  const StraightLine line;
+  const double duration = line.trajectory.durationS();  // 500 s: 2000 increments of 0.25 s
+  double sum_sq[2] = {0.0, 0.0};
+  const double stds[2] = {0.02, 0.04};
+  const int seeds = 12;
+  for (int k = 0; k < 2; ++k) {
+    for (int seed = 1; seed <= seeds; ++seed) {
+      DeadReckoningOptions options;
+      options.seed = static_cast<uint64_t>(seed);
+      options.drift_scale = 0.0;  // isolate the study noise
+      options.heading_noise_rad = stds[k];
+      const DeadReckoning dr(options, line.trajectory, duration);
+      // Cross-track (east) error: linear in the noise; along-track loses only ~S^2/2 per step.
+      const double e = dr.poseAt(duration).translation.y() - line.trajectory.sample(duration).T_world_body.translation.y();
+      sum_sq[k] += e * e;
+    }
+  }
+  const double rms_low = std::sqrt(sum_sq[0] / seeds);
+  const double rms_high = std::sqrt(sum_sq[1] / seeds);
+  // White heading noise per 0.5 m increment: cross-track random walk of std 0.5 * S * sqrt(2000).
+  const double predicted_low = 0.5 * 0.02 * std::sqrt(2000.0);
+  EXPECT_GT(rms_low, 0.5 * predicted_low);
+  EXPECT_LT(rms_low, 1.6 * predicted_low);
+  // Same noise stream, twice the std: twice the error (small-angle linearity).
+  EXPECT_NEAR(rms_high / rms_low, 2.0, 0.05);
+}
+
+}  // namespace
+}  // namespace sss::sim

@@ -1,0 +1,630 @@
+// Mission assembly and outputs: options from YAML, the seabed sized to the survey, parallel ping
+// rendering in chunks (JSF streamed to disk), TUM trajectories, seabed rasters, PNG previews.
+#include "tools/sim/mission.hpp"
+
+#include "drivers/edgetech/jsf_format.hpp"
+#include "drivers/ins/ixblue_nmea.hpp"
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace sss::sim {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+using sss::core::inRange;
+using sss::core::greaterThan;
+using sss::core::atLeast;
+
+// ConfigSection::section throws yaml-cpp's InvalidNode when the key is absent (it assigns to the
+// zombie node a const lookup returns), so an absent sub-section reads as an empty map here.
+sss::core::ConfigSection subsection(sss::core::ConfigSection& parent, const std::string& key) {
+  if (parent.has(key)) return parent.section(key);
+  return sss::core::ConfigSection(YAML::Node(YAML::NodeType::Map), parent.keyPath(key),
+                                  std::make_shared<std::vector<sss::core::ConfigProblem>>());
+}
+
+}  // namespace
+
+void readSimOptions(sss::core::ConfigSection section, SimOptions& o) {
+  section.optional("seed", o.seed, {atLeast<int64_t>(0)});
+  section.optional("origin_latitude_deg", o.origin_latitude_deg, {inRange(-89.0, 89.0)});
+  section.optional("origin_longitude_deg", o.origin_longitude_deg, {inRange(-180.0, 180.0)});
+  section.optional("start_utime_us", o.start_utime_us, {inRange<int64_t>(946684800000000, 4102444800000000)});
+  section.optional("duration_s", o.duration_s, {atLeast(0.0)});
+  section.optional("seabed_margin_m", o.seabed_margin_m, {atLeast(0.0)});
+  section.optional("auto_seabed_extent", o.auto_seabed_extent);
+  section.optional("waterfall_bins_per_side", o.waterfall_bins_per_side, {inRange(16, 20000)});
+  section.optional("mosaic_resolution_m", o.mosaic_resolution_m, {inRange(0.05, 10.0)});
+
+  sss::core::ConfigSection seabed = subsection(section, "seabed");
+  SeabedOptions& s = o.seabed;
+  seabed.optional("north_min_m", s.north_min_m);
+  seabed.optional("east_min_m", s.east_min_m);
+  seabed.optional("size_north_m", s.size_north_m, {inRange(10.0, 5000.0)});
+  seabed.optional("size_east_m", s.size_east_m, {inRange(10.0, 5000.0)});
+  seabed.optional("resolution_m", s.resolution_m, {inRange(0.02, 2.0)});
+  seabed.optional("mean_depth_m", s.mean_depth_m, {inRange(5.0, 6000.0)});
+  seabed.optional("slope_deg", s.slope_deg, {inRange(0.0, 10.0)});
+  seabed.optional("undulation_amplitude_m", s.undulation_amplitude_m, {inRange(0.0, 20.0)});
+  seabed.optional("undulation_wavelength_m", s.undulation_wavelength_m, {inRange(5.0, 2000.0)});
+  seabed.optional("ripple_amplitude_m", s.ripple_amplitude_m, {inRange(0.0, 1.0)});
+  seabed.optional("ripple_wavelength_m", s.ripple_wavelength_m, {inRange(0.3, 20.0)});
+  seabed.optional("ripple_fraction", s.ripple_fraction, {inRange(0.0, 1.0)});
+  seabed.optional("trawl_mark_count", s.trawl_mark_count, {inRange(0, 1000)});
+  seabed.optional("trawl_mark_depth_m", s.trawl_mark_depth_m, {inRange(0.0, 2.0)});
+  seabed.optional("trawl_mark_width_m", s.trawl_mark_width_m, {inRange(0.1, 10.0)});
+  seabed.optional("boulders_per_hectare", s.boulders_per_hectare, {inRange(0.0, 500.0)});
+  seabed.optional("boulder_min_radius_m", s.boulder_min_radius_m, {inRange(0.05, 20.0)});
+  seabed.optional("boulder_max_radius_m", s.boulder_max_radius_m, {inRange(0.05, 20.0)});
+  seabed.optional("sediment_patch_scale_m", s.sediment_patch_scale_m, {inRange(1.0, 1000.0)});
+  seabed.optional("enable_texture", s.enable_texture);
+  seabed.rejectUnknownKeys();
+
+  sss::core::ConfigSection vehicle = subsection(section, "vehicle");
+  TrajectoryOptions& t = o.trajectory;
+  vehicle.optional("pattern", t.pattern, {sss::core::oneOf({"lawnmower", "loop"})});
+  vehicle.optional("lines", t.lines, {inRange(1, 200)});
+  vehicle.optional("line_length_m", t.line_length_m, {inRange(10.0, 20000.0)});
+  vehicle.optional("line_spacing_m", t.line_spacing_m, {inRange(5.0, 2000.0)});
+  vehicle.optional("line_heading_deg", t.line_heading_deg, {inRange(-360.0, 360.0)});
+  vehicle.optional("speed_m_s", t.speed_m_s, {inRange(0.2, 10.0)});
+  vehicle.optional("altitude_m", t.altitude_m, {inRange(1.0, 500.0)});
+  vehicle.optional("roll_amplitude_rad", t.roll_amplitude_rad, {inRange(0.0, 0.5)});
+  vehicle.optional("roll_period_s", t.roll_period_s, {greaterThan(0.0)});
+  vehicle.optional("pitch_amplitude_rad", t.pitch_amplitude_rad, {inRange(0.0, 0.5)});
+  vehicle.optional("pitch_period_s", t.pitch_period_s, {greaterThan(0.0)});
+  vehicle.optional("yaw_amplitude_rad", t.yaw_amplitude_rad, {inRange(0.0, 0.5)});
+  vehicle.optional("yaw_period_s", t.yaw_period_s, {greaterThan(0.0)});
+  vehicle.optional("altitude_wobble_m", t.altitude_wobble_m, {inRange(0.0, 10.0)});
+  vehicle.optional("max_turn_bank_rad", t.max_turn_bank_rad, {inRange(0.0, 0.5)});
+  vehicle.rejectUnknownKeys();
+
+  sss::core::ConfigSection dr = subsection(section, "dead_reckoning");
+  DeadReckoningOptions& d = o.dead_reckoning;
+  dr.optional("rate_hz", d.rate_hz, {inRange(1.0, 200.0)});
+  dr.optional("drift_scale", d.drift_scale, {inRange(0.0, 100.0)});
+  dr.optional("velocity_scale_factor_min", d.velocity_scale_factor_min, {inRange(0.0, 0.1)});
+  dr.optional("velocity_scale_factor_max", d.velocity_scale_factor_max, {inRange(0.0, 0.1)});
+  dr.optional("heading_bias_min_rad", d.heading_bias_min_rad, {inRange(0.0, 0.1)});
+  dr.optional("heading_bias_max_rad", d.heading_bias_max_rad, {inRange(0.0, 0.1)});
+  dr.optional("heading_random_walk_rad_per_sqrt_s", d.heading_random_walk_rad_per_sqrt_s, {inRange(0.0, 0.01)});
+  dr.optional("velocity_white_noise_m_s", d.velocity_white_noise_m_s, {inRange(0.0, 1.0)});
+  dr.optional("attitude_noise_rad", d.attitude_noise_rad, {inRange(0.0, 0.1)});
+  dr.optional("attitude_bias_rad", d.attitude_bias_rad, {inRange(0.0, 0.1)});
+  dr.optional("depth_noise_m", d.depth_noise_m, {inRange(0.0, 10.0)});
+  dr.optional("heading_noise_rad", d.heading_noise_rad, {inRange(0.0, 1.0)});
+  dr.optional("heading_noise_interval_s", d.heading_noise_interval_s, {inRange(0.01, 100.0)});
+  dr.rejectUnknownKeys();
+
+  sss::core::ConfigSection sonar = subsection(section, "sonar");
+  SonarOptions& n = o.sonar;
+  sonar.optional("frequency_hz", n.frequency_hz, {inRange(10e3, 2e6)});
+  sonar.optional("bandwidth_hz", n.bandwidth_hz, {inRange(0.0, 500e3)});
+  sonar.optional("range_m", n.range_m, {inRange(5.0, 1000.0)});
+  sonar.optional("samples_per_side", n.samples_per_side, {inRange(16, 65535)});
+  sonar.optional("sound_speed_m_s", n.sound_speed_m_s, {inRange(1400.0, 1600.0)});
+  sonar.optional("ping_rate_hz", n.ping_rate_hz, {inRange(0.1, 100.0)});
+  sonar.optional("horizontal_beam_width_rad", n.horizontal_beam_width_rad, {inRange(0.0, 0.2)});
+  sonar.optional("vertical_beam_width_rad", n.vertical_beam_width_rad, {inRange(0.05, 3.0)});
+  sonar.optional("depression_rad", n.depression_rad, {inRange(0.0, 1.5)});
+  sonar.optional("sidelobe_level", n.sidelobe_level, {inRange(0.0, 1.0)});
+  sonar.optional("absorption_db_per_km", n.absorption_db_per_km, {inRange(0.0, 1000.0)});
+  sonar.optional("noise_intensity_at_max_range", n.noise_intensity_at_max_range, {inRange(0.0, 10.0)});
+  sonar.optional("tvg_spreading_db_per_decade", n.tvg_spreading_db_per_decade, {inRange(0.0, 40.0)});
+  sonar.optional("ground_step_m", n.ground_step_m, {inRange(0.005, 1.0)});
+  sonar.optional("output_scale", n.output_scale, {greaterThan(0.0)});
+  sonar.rejectUnknownKeys();
+  section.rejectUnknownKeys();
+}
+
+std::vector<std::string> validateSimOptions(const SimOptions& o) {
+  std::vector<std::string> problems;
+  const auto add = [&](const std::string& key, double value, const std::string& reason) {
+    std::ostringstream text;
+    text << "sim." << key << ": " << value << " " << reason;
+    problems.push_back(text.str());
+  };
+  const double max_ping_rate = o.sonar.sound_speed_m_s / (2.0 * o.sonar.range_m);
+  if (o.sonar.ping_rate_hz > max_ping_rate + 1e-9) {
+    add("sonar.ping_rate_hz", o.sonar.ping_rate_hz,
+        "exceeds sound_speed / (2 range) = " + std::to_string(max_ping_rate) + " Hz; lower the rate or the range");
+  }
+  if (o.sonar.range_m <= o.trajectory.altitude_m) add("sonar.range_m", o.sonar.range_m, "must exceed vehicle.altitude_m");
+  const double interval_ns = o.sonar.sampleIntervalS() * 1e9;
+  if (interval_ns < 1.0) add("sonar.samples_per_side", o.sonar.samples_per_side, "gives a sample interval below 1 ns");
+  if (o.dead_reckoning.velocity_scale_factor_min > o.dead_reckoning.velocity_scale_factor_max)
+    add("dead_reckoning.velocity_scale_factor_min", o.dead_reckoning.velocity_scale_factor_min, "exceeds the max");
+  if (o.dead_reckoning.heading_bias_min_rad > o.dead_reckoning.heading_bias_max_rad)
+    add("dead_reckoning.heading_bias_min_rad", o.dead_reckoning.heading_bias_min_rad, "exceeds the max");
+  if (o.seabed.boulder_min_radius_m > o.seabed.boulder_max_radius_m)
+    add("seabed.boulder_min_radius_m", o.seabed.boulder_min_radius_m, "exceeds boulder_max_radius_m");
+  if (o.trajectory.pattern != "lawnmower" && o.trajectory.pattern != "loop")
+    problems.push_back("sim.vehicle.pattern: " + o.trajectory.pattern + " is not lawnmower or loop");
+  if (o.trajectory.pattern == "lawnmower" && o.trajectory.lines > 1 && o.trajectory.line_spacing_m < 20.0)
+    add("vehicle.line_spacing_m", o.trajectory.line_spacing_m, "is below 20 m: the 10 m turn radius minimum");
+  if (o.trajectory.pattern == "loop" && o.trajectory.lines < 3)
+    add("vehicle.lines", o.trajectory.lines, "is too few for a loop; use at least 3");
+  // Memory guard: two float rasters.
+  const double cells = (o.seabed.size_north_m / o.seabed.resolution_m) * (o.seabed.size_east_m / o.seabed.resolution_m);
+  if (!o.auto_seabed_extent && cells > 2.0e8) add("seabed.resolution_m", o.seabed.resolution_m, "gives more than 2e8 cells");
+  return problems;
+}
+
+std::string simOptionsYaml(const SimOptions& o) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(10);
+  out << YAML::BeginMap;
+  out << YAML::Key << "seed" << YAML::Value << o.seed;
+  out << YAML::Key << "origin_latitude_deg" << YAML::Value << o.origin_latitude_deg;
+  out << YAML::Key << "origin_longitude_deg" << YAML::Value << o.origin_longitude_deg;
+  out << YAML::Key << "start_utime_us" << YAML::Value << o.start_utime_us;
+  out << YAML::Key << "duration_s" << YAML::Value << o.duration_s;
+  out << YAML::Key << "seabed_margin_m" << YAML::Value << o.seabed_margin_m;
+  out << YAML::Key << "auto_seabed_extent" << YAML::Value << o.auto_seabed_extent;
+  out << YAML::Key << "waterfall_bins_per_side" << YAML::Value << o.waterfall_bins_per_side;
+  out << YAML::Key << "mosaic_resolution_m" << YAML::Value << o.mosaic_resolution_m;
+  const SeabedOptions& s = o.seabed;
+  out << YAML::Key << "seabed" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "north_min_m" << YAML::Value << s.north_min_m << YAML::Key << "east_min_m" << YAML::Value << s.east_min_m
+      << YAML::Key << "size_north_m" << YAML::Value << s.size_north_m << YAML::Key << "size_east_m" << YAML::Value << s.size_east_m
+      << YAML::Key << "resolution_m" << YAML::Value << s.resolution_m << YAML::Key << "mean_depth_m" << YAML::Value << s.mean_depth_m
+      << YAML::Key << "slope_deg" << YAML::Value << s.slope_deg << YAML::Key << "undulation_amplitude_m" << YAML::Value
+      << s.undulation_amplitude_m << YAML::Key << "undulation_wavelength_m" << YAML::Value << s.undulation_wavelength_m
+      << YAML::Key << "ripple_amplitude_m" << YAML::Value << s.ripple_amplitude_m << YAML::Key << "ripple_wavelength_m"
+      << YAML::Value << s.ripple_wavelength_m << YAML::Key << "ripple_fraction" << YAML::Value << s.ripple_fraction
+      << YAML::Key << "trawl_mark_count" << YAML::Value << s.trawl_mark_count << YAML::Key << "trawl_mark_depth_m"
+      << YAML::Value << s.trawl_mark_depth_m << YAML::Key << "trawl_mark_width_m" << YAML::Value << s.trawl_mark_width_m
+      << YAML::Key << "boulders_per_hectare" << YAML::Value << s.boulders_per_hectare << YAML::Key << "boulder_min_radius_m"
+      << YAML::Value << s.boulder_min_radius_m << YAML::Key << "boulder_max_radius_m" << YAML::Value << s.boulder_max_radius_m
+      << YAML::Key << "sediment_patch_scale_m" << YAML::Value << s.sediment_patch_scale_m << YAML::Key << "enable_texture"
+      << YAML::Value << s.enable_texture;
+  out << YAML::EndMap;
+  const TrajectoryOptions& t = o.trajectory;
+  out << YAML::Key << "vehicle" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "pattern" << YAML::Value << t.pattern << YAML::Key << "lines" << YAML::Value << t.lines << YAML::Key
+      << "line_length_m" << YAML::Value << t.line_length_m << YAML::Key << "line_spacing_m" << YAML::Value << t.line_spacing_m
+      << YAML::Key << "line_heading_deg" << YAML::Value << t.line_heading_deg << YAML::Key << "speed_m_s" << YAML::Value
+      << t.speed_m_s << YAML::Key << "altitude_m" << YAML::Value << t.altitude_m << YAML::Key << "roll_amplitude_rad"
+      << YAML::Value << t.roll_amplitude_rad << YAML::Key << "roll_period_s" << YAML::Value << t.roll_period_s << YAML::Key
+      << "pitch_amplitude_rad" << YAML::Value << t.pitch_amplitude_rad << YAML::Key << "pitch_period_s" << YAML::Value
+      << t.pitch_period_s << YAML::Key << "yaw_amplitude_rad" << YAML::Value << t.yaw_amplitude_rad << YAML::Key
+      << "yaw_period_s" << YAML::Value << t.yaw_period_s << YAML::Key << "altitude_wobble_m" << YAML::Value
+      << t.altitude_wobble_m << YAML::Key << "max_turn_bank_rad" << YAML::Value << t.max_turn_bank_rad;
+  out << YAML::EndMap;
+  const DeadReckoningOptions& d = o.dead_reckoning;
+  out << YAML::Key << "dead_reckoning" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "rate_hz" << YAML::Value << d.rate_hz << YAML::Key << "drift_scale" << YAML::Value << d.drift_scale
+      << YAML::Key << "velocity_scale_factor_min" << YAML::Value << d.velocity_scale_factor_min << YAML::Key
+      << "velocity_scale_factor_max" << YAML::Value << d.velocity_scale_factor_max << YAML::Key << "heading_bias_min_rad"
+      << YAML::Value << d.heading_bias_min_rad << YAML::Key << "heading_bias_max_rad" << YAML::Value << d.heading_bias_max_rad
+      << YAML::Key << "heading_random_walk_rad_per_sqrt_s" << YAML::Value << d.heading_random_walk_rad_per_sqrt_s
+      << YAML::Key << "velocity_white_noise_m_s" << YAML::Value << d.velocity_white_noise_m_s << YAML::Key
+      << "attitude_noise_rad" << YAML::Value << d.attitude_noise_rad << YAML::Key << "attitude_bias_rad" << YAML::Value
+      << d.attitude_bias_rad << YAML::Key << "depth_noise_m" << YAML::Value << d.depth_noise_m << YAML::Key
+      << "heading_noise_rad" << YAML::Value << d.heading_noise_rad << YAML::Key << "heading_noise_interval_s" << YAML::Value
+      << d.heading_noise_interval_s;
+  out << YAML::EndMap;
+  const SonarOptions& n = o.sonar;
+  out << YAML::Key << "sonar" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "frequency_hz" << YAML::Value << n.frequency_hz << YAML::Key << "bandwidth_hz" << YAML::Value
+      << n.bandwidth_hz << YAML::Key << "range_m" << YAML::Value << n.range_m << YAML::Key << "samples_per_side" << YAML::Value
+      << n.samples_per_side << YAML::Key << "sound_speed_m_s" << YAML::Value << n.sound_speed_m_s << YAML::Key
+      << "ping_rate_hz" << YAML::Value << n.ping_rate_hz << YAML::Key << "horizontal_beam_width_rad" << YAML::Value
+      << n.horizontal_beam_width_rad << YAML::Key << "vertical_beam_width_rad" << YAML::Value << n.vertical_beam_width_rad
+      << YAML::Key << "depression_rad" << YAML::Value << n.depression_rad << YAML::Key << "sidelobe_level" << YAML::Value
+      << n.sidelobe_level << YAML::Key << "absorption_db_per_km" << YAML::Value << n.absorption_db_per_km << YAML::Key
+      << "noise_intensity_at_max_range" << YAML::Value << n.noise_intensity_at_max_range << YAML::Key
+      << "tvg_spreading_db_per_decade" << YAML::Value << n.tvg_spreading_db_per_decade << YAML::Key << "ground_step_m"
+      << YAML::Value << n.ground_step_m << YAML::Key << "output_scale" << YAML::Value << n.output_scale;
+  out << YAML::EndMap;
+  out << YAML::EndMap;
+  return out.c_str();
+}
+
+// ---- Mission ------------------------------------------------------------------------------------
+
+Mission::Mission(const SimOptions& options)
+    : options_(options), plane_(options.origin_latitude_deg, options.origin_longitude_deg) {
+  const auto seed = static_cast<uint64_t>(options_.seed);
+  options_.seabed.seed = mixSeed(seed, 1);
+  options_.trajectory.seed = mixSeed(seed, 2);
+  options_.dead_reckoning.seed = mixSeed(seed, 3);
+  options_.sonar.seed = mixSeed(seed, 4);
+  if (options_.auto_seabed_extent) {
+    // The seabed covers the path plus the swath and a margin on every side.
+    const Eigen::Vector4d extent = Trajectory::planExtent(options_.trajectory);
+    const double pad = options_.sonar.range_m + options_.seabed_margin_m;
+    options_.seabed.north_min_m = std::floor(extent[0] - pad);
+    options_.seabed.east_min_m = std::floor(extent[1] - pad);
+    options_.seabed.size_north_m = std::ceil(extent[2] + pad) - options_.seabed.north_min_m;
+    options_.seabed.size_east_m = std::ceil(extent[3] + pad) - options_.seabed.east_min_m;
+  }
+  seabed_ = std::make_unique<Seabed>(options_.seabed);
+  trajectory_ = std::make_unique<Trajectory>(options_.trajectory, seabed_.get());
+  duration_s_ = trajectory_->durationS();
+  if (options_.duration_s > 0.0) duration_s_ = std::min(duration_s_, options_.duration_s);
+  dead_reckoning_ = std::make_unique<DeadReckoning>(options_.dead_reckoning, *trajectory_, duration_s_);
+  sonar_ = std::make_unique<SonarModel>(options_.sonar, seabed_.get());
+  ping_count_ = static_cast<size_t>(std::floor(duration_s_ * options_.sonar.ping_rate_hz + 1e-9)) + 1;
+}
+
+int64_t Mission::pingUtimeUs(size_t ping) const {
+  return options_.start_utime_us + static_cast<int64_t>(std::llround(pingTimeS(ping) * 1e6));
+}
+
+std::vector<size_t> Mission::pingsOfLine(int line_index) const {
+  std::vector<size_t> pings;
+  for (size_t i = 0; i < ping_count_; ++i) {
+    if (truthAtPing(i).line_index == line_index) pings.push_back(i);
+  }
+  return pings;
+}
+
+PingSamples Mission::renderPing(size_t ping) const {
+  return sonar_->render(truthAtPing(ping).T_world_body, static_cast<uint32_t>(ping));
+}
+
+std::vector<uint8_t> Mission::encodePingJsf(size_t ping, const PingSamples& samples, uint8_t& sequence) const {
+  namespace jsf = sss::edgetech;
+  const NavSample nav = dead_reckoning_->sampleAt(pingTimeS(ping));
+  const sss::core::GeodeticPosition geo = plane_.toGeodetic(nav.T_world_body.translation);
+  jsf::SonarChannelRecord record;
+  record.subsystem = options_.sonar.frequency_hz < 600e3 ? jsf::kSubsystemSideScanLow : jsf::kSubsystemSideScanHigh;
+  record.ping_time_us = pingUtimeUs(ping);
+  record.ping_number = static_cast<uint32_t>(ping);
+  record.start_depth_samples = 0;
+  record.sample_interval_s = options_.sonar.sampleIntervalS();
+  record.sound_speed_m_s = static_cast<float>(options_.sonar.sound_speed_m_s);
+  record.start_frequency_hz = static_cast<float>(options_.sonar.frequency_hz - 0.5 * options_.sonar.bandwidth_hz);
+  record.end_frequency_hz = static_cast<float>(options_.sonar.frequency_hz + 0.5 * options_.sonar.bandwidth_hz);
+  record.data_format = 0;
+  // The sonar processor stamps the vehicle's (DR) navigation into every ping header.
+  record.validity = jsf::kValidLatLon | jsf::kValidHeading | jsf::kValidPitchRoll | jsf::kValidAltitude |
+                    jsf::kValidDepth | jsf::kValidSoundSpeed;
+  record.latitude_deg = geo.latitude_deg;
+  record.longitude_deg = geo.longitude_deg;
+  record.depth_m = geo.depth_m;
+  record.altitude_m = nav.altitude_m;
+  record.heading_rad = nav.heading_rad < 0.0 ? nav.heading_rad + 2.0 * kPi : nav.heading_rad;
+  record.pitch_rad = nav.pitch_rad;
+  record.roll_rad = nav.roll_rad;
+  std::vector<uint8_t> bytes;
+  for (uint8_t channel : {jsf::kChannelPort, jsf::kChannelStarboard}) {
+    record.channel = channel;
+    const std::vector<float>& magnitudes = channel == jsf::kChannelPort ? samples.port : samples.starboard;
+    int16_t weighting = 0;
+    const std::vector<uint16_t> codes = jsf::quantiseEnvelope(magnitudes, weighting);
+    record.weighting_factor = weighting;
+    const std::vector<uint8_t> message = jsf::encodeSonarData(record, codes, sequence++);
+    bytes.insert(bytes.end(), message.begin(), message.end());
+  }
+  return bytes;
+}
+
+std::string insNmeaStream(const Mission& mission) {
+  std::string stream;
+  const sss::core::LocalTangentPlane& plane = mission.tangentPlane();
+  for (const NavSample& nav : mission.deadReckoning().samples()) {
+    sss::ins::InsState state;
+    state.utime_us = mission.options().start_utime_us + static_cast<int64_t>(std::llround(nav.time_s * 1e6));
+    const sss::core::GeodeticPosition geo = plane.toGeodetic(nav.T_world_body.translation);
+    state.latitude_deg = geo.latitude_deg;
+    state.longitude_deg = geo.longitude_deg;
+    state.depth_m = geo.depth_m;
+    state.altitude_m = nav.altitude_m;
+    state.roll_rad = nav.roll_rad;
+    state.pitch_rad = nav.pitch_rad;
+    state.heading_rad = nav.heading_rad;
+    state.velocity_north_m_s = nav.velocity_world_m_s.x();
+    state.velocity_east_m_s = nav.velocity_world_m_s.y();
+    state.velocity_down_m_s = nav.velocity_world_m_s.z();
+    state.latitude_std_m = nav.position_std_m;
+    state.longitude_std_m = nav.position_std_m;
+    state.depth_std_m = 0.05;
+    state.roll_std_rad = 0.0003;
+    state.pitch_std_rad = 0.0003;
+    state.heading_std_rad = 0.002;
+    state.velocity_north_std_m_s = 0.01;
+    state.velocity_east_std_m_s = 0.01;
+    state.velocity_down_std_m_s = 0.01;
+    state.validity = sss::ins::kValidAll;
+    stream += sss::ins::encodeInsState(state);
+  }
+  return stream;
+}
+
+// ---- outputs ------------------------------------------------------------------------------------
+
+namespace {
+
+bool writeBinary(const std::string& path, const void* data, size_t bytes, std::string& error) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(static_cast<const char*>(data), static_cast<std::streamsize>(bytes));
+  if (!out) {
+    error = "cannot write " + path + "; check the output directory is writable and has space";
+    return false;
+  }
+  return true;
+}
+
+bool writeText(const std::string& path, const std::string& text, std::string& error) {
+  return writeBinary(path, text.data(), text.size(), error);
+}
+
+std::string tumLine(int64_t utime_us, const sss::core::Pose& pose) {
+  char line[256];
+  const Eigen::Quaterniond& q = pose.rotation;
+  std::snprintf(line, sizeof line, "%lld.%06lld %.4f %.4f %.4f %.9f %.9f %.9f %.9f\n",
+                static_cast<long long>(utime_us / 1000000), static_cast<long long>(utime_us % 1000000),
+                pose.translation.x(), pose.translation.y(), pose.translation.z(), q.x(), q.y(), q.z(), q.w());
+  return line;
+}
+
+// The value below which `fraction` of the positive samples lie: a robust display white level.
+float percentile(std::vector<float> values, double fraction) {
+  values.erase(std::remove_if(values.begin(), values.end(), [](float v) { return !(v > 0.0f); }), values.end());
+  if (values.empty()) return 1.0f;
+  const size_t k = std::min(values.size() - 1, static_cast<size_t>(fraction * values.size()));
+  std::nth_element(values.begin(), values.begin() + k, values.end());
+  return std::max(values[k], 1e-6f);
+}
+
+cv::Mat toImage8(const std::vector<float>& values, int rows, int cols, float white) {
+  cv::Mat image(rows, cols, CV_8UC1);
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      const float v = values[static_cast<size_t>(r) * cols + c] / white;
+      image.at<uint8_t>(r, c) = static_cast<uint8_t>(std::clamp(v * 255.0f, 0.0f, 255.0f));
+    }
+  }
+  return image;
+}
+
+bool writePng(const std::string& path, const cv::Mat& image, std::string& error) {
+  try {
+    if (cv::imwrite(path, image)) return true;
+  } catch (const cv::Exception& e) {
+    error = "cannot write " + path + ": " + e.what();
+    return false;
+  }
+  error = "cannot write " + path;
+  return false;
+}
+
+bool writeSeabed(const Mission& mission, const std::string& dir, MissionReport& report, std::string& error) {
+  const Seabed& seabed = mission.seabed();
+  const SeabedOptions& o = seabed.options();
+  const auto& depth = seabed.depthGrid();
+  const auto& reflect = seabed.reflectivityGrid();
+  // Raw float32 in the host byte order; every supported target (x86-64, aarch64) is little-endian.
+  if (!writeBinary(dir + "/seabed_depth.f32", depth.data(), depth.size() * sizeof(float), error)) return false;
+  if (!writeBinary(dir + "/seabed_reflectivity.f32", reflect.data(), reflect.size() * sizeof(float), error)) return false;
+  std::ostringstream yaml;
+  yaml.precision(12);
+  yaml << "# True seabed of the simulated mission: two raw little-endian float32 rasters, row-major.\n"
+       << "# Cell (row, col) lies at north = north_min_m + row * resolution_m, east = east_min_m + col *\n"
+       << "# resolution_m in the local NED plane of the origin; rows grow northwards.\n"
+       << "rows: " << seabed.rows() << "\ncols: " << seabed.cols() << "\nresolution_m: " << o.resolution_m
+       << "\nnorth_min_m: " << o.north_min_m << "\neast_min_m: " << o.east_min_m
+       << "\norigin_latitude_deg: " << mission.options().origin_latitude_deg
+       << "\norigin_longitude_deg: " << mission.options().origin_longitude_deg
+       << "\ndepth_file: seabed_depth.f32\ndepth_units: metres below the origin (NED z, positive down)"
+       << "\nreflectivity_file: seabed_reflectivity.f32\nreflectivity_units: backscatter coefficient (dimensionless)\n";
+  if (!writeText(dir + "/seabed.yaml", yaml.str(), error)) return false;
+
+  // Previews at 4 cells per pixel, north up: hill-shaded depth and reflectivity.
+  const int step = 4;
+  const int rows = seabed.rows() / step;
+  const int cols = seabed.cols() / step;
+  cv::Mat shade(rows, cols, CV_8UC1);
+  cv::Mat refl(rows, cols, CV_8UC1);
+  double min_depth = 1e18, max_depth = -1e18;
+  for (float d : depth) {
+    min_depth = std::min(min_depth, static_cast<double>(d));
+    max_depth = std::max(max_depth, static_cast<double>(d));
+  }
+  const Eigen::Vector3d light = Eigen::Vector3d(-1.0, -1.0, -1.0).normalized();  // from the north-west, above
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      const double north = o.north_min_m + r * step * o.resolution_m;
+      const double east = o.east_min_m + c * step * o.resolution_m;
+      const double relief = (seabed.depthM(north, east) - min_depth) / std::max(1e-6, max_depth - min_depth);
+      const double lambert = std::max(0.0, seabed.normal(north, east).dot(-light) * -1.0 + 0.0);
+      const double value = 0.55 * std::clamp(lambert, 0.0, 1.0) + 0.45 * (1.0 - relief);
+      shade.at<uint8_t>(rows - 1 - r, c) = static_cast<uint8_t>(std::clamp(value * 255.0, 0.0, 255.0));
+      refl.at<uint8_t>(rows - 1 - r, c) =
+          static_cast<uint8_t>(std::clamp(seabed.reflectivity(north, east) / 1.2 * 255.0, 0.0, 255.0));
+    }
+  }
+  if (!writePng(dir + "/seabed_depth.png", shade, error)) return false;
+  if (!writePng(dir + "/seabed_reflectivity.png", refl, error)) return false;
+  for (const char* name : {"seabed_depth.f32", "seabed_reflectivity.f32", "seabed.yaml", "seabed_depth.png",
+                           "seabed_reflectivity.png"}) {
+    report.files.push_back(name);
+  }
+  return true;
+}
+
+}  // namespace
+
+bool writeMission(const Mission& mission, const std::string& out_dir, MissionReport& report, std::string& error) {
+  const auto start = std::chrono::steady_clock::now();
+  std::error_code ec;
+  std::filesystem::create_directories(out_dir, ec);
+  if (ec) {
+    error = "cannot create " + out_dir + ": " + ec.message();
+    return false;
+  }
+  const std::string dir = out_dir;
+  const SimOptions& options = mission.options();
+  const SonarOptions& sonar = mission.sonar().options();
+  const size_t pings = mission.pingCount();
+  report = MissionReport();
+  report.pings = pings;
+  report.duration_s = mission.durationS();
+  report.distance_m = mission.deadReckoning().distanceTravelledM();
+
+  if (!writeSeabed(mission, dir, report, error)) return false;
+
+  // Trajectories, one line per ping.
+  std::string truth_text, dr_text;
+  for (size_t i = 0; i < pings; ++i) {
+    const int64_t utime = mission.pingUtimeUs(i);
+    const sss::core::Pose truth = mission.truthAtPing(i).T_world_body;
+    const sss::core::Pose dr = mission.deadReckoning().poseAt(mission.pingTimeS(i));
+    truth_text += tumLine(utime, truth);
+    dr_text += tumLine(utime, dr);
+    const double err = (truth.translation - dr.translation).head<2>().norm();
+    report.max_dr_error_m = std::max(report.max_dr_error_m, err);
+    if (i + 1 == pings) report.final_dr_error_m = err;
+  }
+  if (!writeText(dir + "/ground_truth.tum", truth_text, error)) return false;
+  if (!writeText(dir + "/dead_reckoning.tum", dr_text, error)) return false;
+  report.files.push_back("ground_truth.tum");
+  report.files.push_back("dead_reckoning.tum");
+
+  // INS stream: iXblue NMEA ($PIXSE family) at the DR rate.
+  if (!writeText(dir + "/ins.nmea", insNmeaStream(mission), error)) return false;
+  report.files.push_back("ins.nmea");
+
+  // Pings: rendered in parallel chunks, written in order.
+  const int bins = options.waterfall_bins_per_side;
+  const int samples = sonar.samples_per_side;
+  const double spacing = sonar.sampleSpacingM();
+  std::vector<std::vector<float>> line_rows;  // per ping: 2 * bins, port mirrored on the left
+  std::vector<int> ping_line(pings, -1);
+  line_rows.resize(pings);
+  const SeabedOptions& bed = mission.seabed().options();
+  const double along_track_step = options.trajectory.speed_m_s / sonar.ping_rate_hz;
+  const double mres = options.mosaic_resolution_m;
+  const int mosaic_rows = static_cast<int>(std::ceil(bed.size_north_m / mres));
+  const int mosaic_cols = static_cast<int>(std::ceil(bed.size_east_m / mres));
+  std::vector<float> mosaic_sum(static_cast<size_t>(mosaic_rows) * mosaic_cols, 0.0f);
+  std::vector<uint16_t> mosaic_count(mosaic_sum.size(), 0);
+
+  std::ofstream jsf_out(dir + "/sonar.jsf", std::ios::binary);
+  if (!jsf_out) {
+    error = "cannot write " + dir + "/sonar.jsf";
+    return false;
+  }
+  const auto render_start = std::chrono::steady_clock::now();
+  uint8_t sequence = 0;
+  const size_t chunk = 64;
+  std::vector<PingSamples> rendered(chunk);
+  for (size_t first = 0; first < pings; first += chunk) {
+    const size_t count = std::min(chunk, pings - first);
+#pragma omp parallel for schedule(dynamic, 1)
+    for (long k = 0; k < static_cast<long>(count); ++k) rendered[k] = mission.renderPing(first + k);
+    for (size_t k = 0; k < count; ++k) {
+      const size_t ping = first + k;
+      const std::vector<uint8_t> bytes = mission.encodePingJsf(ping, rendered[k], sequence);
+      jsf_out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+      const TrajectorySample truth = mission.truthAtPing(ping);
+      ping_line[ping] = truth.line_index;
+      if (truth.line_index < 0) continue;
+      std::vector<float>& row = line_rows[ping];
+      row.assign(2 * bins, 0.0f);
+      for (Side side : {Side::kPort, Side::kStarboard}) {
+        const std::vector<float>& values = side == Side::kPort ? rendered[k].port : rendered[k].starboard;
+        const FanPlane plane = fanPlane(truth.T_world_body, side);
+        for (int j = 0; j < bins; ++j) {
+          const int s0 = static_cast<int>(static_cast<int64_t>(j) * samples / bins);
+          const int s1 = std::max(s0 + 1, static_cast<int>(static_cast<int64_t>(j + 1) * samples / bins));
+          double sum = 0.0;
+          for (int s = s0; s < s1; ++s) sum += values[s];
+          const float mean = static_cast<float>(sum / (s1 - s0));
+          row[side == Side::kPort ? bins - 1 - j : bins + j] = mean;
+          // Mosaic: flat-seabed ground range at the true altitude, from the true position.
+          const double range = 0.5 * (s0 + s1) * spacing;
+          if (range <= truth.altitude_m) continue;
+          const double ground = std::sqrt(range * range - truth.altitude_m * truth.altitude_m);
+          // Each sample stands for one ping spacing of track: splatting it at two along-track taps
+          // keeps every line's contribution in every cell it covers (else cells alias between
+          // lines and the overlap average stripes).
+          for (const double tap : {-0.25, 0.25}) {
+            const Eigen::Vector3d p = plane.origin + ground * plane.outward + tap * along_track_step * plane.normal;
+            const int mr = static_cast<int>(std::floor((p.x() - bed.north_min_m) / mres));
+            const int mc = static_cast<int>(std::floor((p.y() - bed.east_min_m) / mres));
+            if (mr < 0 || mc < 0 || mr >= mosaic_rows || mc >= mosaic_cols) continue;
+            const size_t index = static_cast<size_t>(mosaic_rows - 1 - mr) * mosaic_cols + mc;
+            mosaic_sum[index] += mean;
+            if (mosaic_count[index] < 65535) ++mosaic_count[index];
+          }
+        }
+      }
+    }
+  }
+  jsf_out.close();
+  if (!jsf_out) {
+    error = "cannot write " + dir + "/sonar.jsf (disk full?)";
+    return false;
+  }
+  report.render_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - render_start).count();
+  report.files.push_back("sonar.jsf");
+
+  // Waterfalls: one PNG per survey line, first ping at the top.
+  for (int line = 0; line < options.trajectory.lines; ++line) {
+    std::vector<float> image;
+    int rows = 0;
+    for (size_t i = 0; i < pings; ++i) {
+      if (ping_line[i] != line) continue;
+      image.insert(image.end(), line_rows[i].begin(), line_rows[i].end());
+      ++rows;
+    }
+    if (rows == 0) continue;
+    char name[64];
+    std::snprintf(name, sizeof name, "waterfall_line_%02d.png", line);
+    if (!writePng(dir + "/" + name, toImage8(image, rows, 2 * bins, percentile(image, 0.99)), error)) return false;
+    report.files.push_back(name);
+  }
+  // Mosaic, north up, on the seabed raster's extent.
+  std::vector<float> mosaic(mosaic_sum.size(), 0.0f);
+  for (size_t i = 0; i < mosaic.size(); ++i) {
+    if (mosaic_count[i] > 0) mosaic[i] = mosaic_sum[i] / mosaic_count[i];
+  }
+  if (!writePng(dir + "/mosaic.png", toImage8(mosaic, mosaic_rows, mosaic_cols, percentile(mosaic, 0.99)), error)) {
+    return false;
+  }
+  std::ostringstream mosaic_yaml;
+  mosaic_yaml.precision(12);
+  mosaic_yaml << "# mosaic.png: mean envelope per cell from the true poses (flat seabed at the true altitude).\n"
+              << "# Pixel (row, col): north = north_max_m - (row + 0.5) * resolution_m, east = east_min_m + (col + 0.5)"
+              << " * resolution_m.\nresolution_m: " << mres << "\nnorth_max_m: " << bed.north_min_m + mosaic_rows * mres
+              << "\neast_min_m: " << bed.east_min_m << "\nrows: " << mosaic_rows << "\ncols: " << mosaic_cols << "\n";
+  if (!writeText(dir + "/mosaic.yaml", mosaic_yaml.str(), error)) return false;
+  report.files.push_back("mosaic.png");
+  report.files.push_back("mosaic.yaml");
+
+  report.total_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::ostringstream yaml;
+  yaml.precision(12);
+  yaml << "# sss-sim mission: the `sim` section is the full configuration used (reusable with --config);\n"
+       << "# `mission` describes what came out.\nsim:\n";
+  std::istringstream sim_yaml(simOptionsYaml(options));
+  for (std::string line; std::getline(sim_yaml, line);) yaml << "  " << line << "\n";
+  const DeadReckoning& dr = mission.deadReckoning();
+  yaml << "mission:\n  pings: " << pings << "\n  duration_s: " << mission.durationS()
+       << "\n  start_utime_us: " << options.start_utime_us << "\n  distance_m: " << report.distance_m
+       << "\n  sample_interval_s: " << sonar.sampleIntervalS() << "\n  sample_spacing_m: " << spacing
+       << "\n  dr_velocity_scale_factor: " << dr.velocityScaleFactor() << "\n  dr_heading_bias_rad: " << dr.headingBiasRad()
+       << "\n  dr_final_error_m: " << report.final_dr_error_m << "\n  dr_max_error_m: " << report.max_dr_error_m
+       << "\n  frames: local NED at the origin (x north, y east, z down), body FRD, TUM t x y z qx qy qz qw"
+       << "\n  ins_protocol: iXblue NMEA 0183 ($HEHDT, $PIXSE ATITUD/POSITI/SPEED_/TIME__/STD*, $SDDPT, $INZDA)"
+       << "\n  jsf: type 80 envelope, port (channel 0) then starboard (1) per ping, DR navigation in the headers\n";
+  if (!writeText(dir + "/mission.yaml", yaml.str(), error)) return false;
+  report.files.push_back("mission.yaml");
+  return true;
+}
+
+}  // namespace sss::sim

@@ -1,0 +1,181 @@
+// Survey path planning (straight lines joined by semicircular turns) and the vehicle's true
+// motion along it: terrain following on the smooth seabed, autopilot wobble, bank in turns.
+#include "tools/sim/trajectory.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+namespace sss::sim {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+Eigen::Vector2d headingVector(double heading_rad) { return {std::cos(heading_rad), std::sin(heading_rad)}; }
+Eigen::Vector2d starboardVector(double heading_rad) { return {-std::sin(heading_rad), std::cos(heading_rad)}; }
+
+}  // namespace
+
+std::vector<PathSegment> planSurvey(const TrajectoryOptions& options) {
+  if (options.lines < 1) throw std::invalid_argument("planSurvey: lines must be >= 1");
+  const double h0 = options.line_heading_deg * kPi / 180.0;
+  const Eigen::Vector2d along = headingVector(h0);
+  const Eigen::Vector2d lateral = starboardVector(h0);
+  const double s = options.line_spacing_m;
+  const double length = options.line_length_m;
+
+  // Each line: lateral offset (in spacings) and direction (+1 along h0, -1 against).
+  std::vector<std::pair<double, double>> lines;
+  if (options.pattern == "lawnmower") {
+    for (int k = 0; k < options.lines; ++k) lines.emplace_back(k * s, k % 2 == 0 ? 1.0 : -1.0);
+  } else if (options.pattern == "loop") {
+    // Racetrack loops that step sideways by one spacing per loop: the outbound lines lie side by
+    // side, the return lines too, ceil(lines/2) spacings further out. Every turn is to starboard.
+    const int outbound = (options.lines + 1) / 2;
+    for (int k = 0; k < options.lines; ++k) {
+      const int loop = k / 2;
+      lines.emplace_back(k % 2 == 0 ? loop * s : (loop + outbound) * s, k % 2 == 0 ? 1.0 : -1.0);
+    }
+  } else {
+    throw std::invalid_argument("planSurvey: unknown pattern " + options.pattern);
+  }
+
+  std::vector<PathSegment> segments;
+  double distance = 0.0;
+  for (size_t k = 0; k < lines.size(); ++k) {
+    const auto [offset, direction] = lines[k];
+    PathSegment line;
+    line.is_line = true;
+    line.line_index = static_cast<int>(k);
+    line.start_distance_m = distance;
+    line.length_m = length;
+    line.start = lateral * offset + (direction > 0 ? Eigen::Vector2d::Zero() : Eigen::Vector2d(along * length));
+    line.start_heading_rad = direction > 0 ? h0 : sss::core::wrapAngle(h0 + kPi);
+    segments.push_back(line);
+    distance += length;
+    if (k + 1 == lines.size()) break;
+    // Semicircle to the next line's start: the lateral gap is the turn's diameter.
+    const Eigen::Vector2d end = line.start + headingVector(line.start_heading_rad) * length;
+    const double next_offset = lines[k + 1].first;
+    const Eigen::Vector2d next_start =
+        lateral * next_offset + (lines[k + 1].second > 0 ? Eigen::Vector2d::Zero() : Eigen::Vector2d(along * length));
+    const Eigen::Vector2d gap = next_start - end;
+    const double diameter = gap.norm();
+    if (diameter < 10.0) throw std::invalid_argument("planSurvey: turn diameter below 10 m; increase line spacing");
+    PathSegment turn;
+    turn.is_line = false;
+    turn.start_distance_m = distance;
+    turn.start = end;
+    turn.start_heading_rad = line.start_heading_rad;
+    turn.turn_radius_m = 0.5 * diameter;
+    turn.turn_sign = gap.dot(starboardVector(line.start_heading_rad)) > 0 ? 1.0 : -1.0;
+    turn.length_m = kPi * turn.turn_radius_m;
+    segments.push_back(turn);
+    distance += turn.length_m;
+  }
+  return segments;
+}
+
+Eigen::Vector4d Trajectory::planExtent(const TrajectoryOptions& options) {
+  const std::vector<PathSegment> segments = planSurvey(options);
+  Eigen::Vector4d extent(1e18, 1e18, -1e18, -1e18);  // north min, east min, north max, east max
+  for (const PathSegment& segment : segments) {
+    const int steps = 64;
+    for (int i = 0; i <= steps; ++i) {
+      const double a = segment.length_m * i / steps;
+      Eigen::Vector2d p;
+      if (segment.is_line) {
+        p = segment.start + headingVector(segment.start_heading_rad) * a;
+      } else {
+        const double r = segment.turn_radius_m;
+        const Eigen::Vector2d centre = segment.start + segment.turn_sign * r * starboardVector(segment.start_heading_rad);
+        p = centre - segment.turn_sign * r * starboardVector(segment.start_heading_rad + segment.turn_sign * a / r);
+      }
+      extent[0] = std::min(extent[0], p.x());
+      extent[1] = std::min(extent[1], p.y());
+      extent[2] = std::max(extent[2], p.x());
+      extent[3] = std::max(extent[3], p.y());
+    }
+  }
+  return extent;
+}
+
+Trajectory::Trajectory(const TrajectoryOptions& options, const Seabed* seabed)
+    : options_(options), seabed_(seabed), segments_(planSurvey(options)) {
+  if (options.speed_m_s <= 0.0) throw std::invalid_argument("Trajectory: speed must be positive");
+  total_length_m_ = segments_.back().start_distance_m + segments_.back().length_m;
+  std::mt19937_64 rng(mixSeed(options.seed, 2001));
+  std::uniform_real_distribution<double> phase(0.0, 2.0 * kPi);
+  phase_roll_ = phase(rng);
+  phase_pitch_ = phase(rng);
+  phase_yaw_ = phase(rng);
+  phase_altitude_ = phase(rng);
+}
+
+void Trajectory::planarState(double distance_m, Eigen::Vector2d& position, double& heading_rad, double& curvature,
+                             int& line) const {
+  distance_m = std::clamp(distance_m, 0.0, total_length_m_);
+  auto it = std::upper_bound(segments_.begin(), segments_.end(), distance_m,
+                             [](double d, const PathSegment& s) { return d < s.start_distance_m; });
+  const PathSegment& segment = *(it == segments_.begin() ? it : it - 1);
+  const double a = std::min(distance_m - segment.start_distance_m, segment.length_m);
+  if (segment.is_line) {
+    position = segment.start + headingVector(segment.start_heading_rad) * a;
+    heading_rad = segment.start_heading_rad;
+    curvature = 0.0;
+    line = segment.line_index;
+    return;
+  }
+  const double r = segment.turn_radius_m;
+  const Eigen::Vector2d centre = segment.start + segment.turn_sign * r * starboardVector(segment.start_heading_rad);
+  heading_rad = segment.start_heading_rad + segment.turn_sign * a / r;
+  position = centre - segment.turn_sign * r * starboardVector(heading_rad);
+  // Bank builds up over the first and last 10 m of the turn rather than jumping.
+  const double ramp = std::clamp(std::min(a, segment.length_m - a) / 10.0, 0.0, 1.0);
+  curvature = segment.turn_sign * ramp / r;
+  line = -1;
+}
+
+TrajectorySample Trajectory::sample(double time_s) const {
+  const double distance = time_s * options_.speed_m_s;
+  Eigen::Vector2d planar;
+  double path_heading = 0.0;
+  double curvature = 0.0;
+  int line = -1;
+  planarState(distance, planar, path_heading, curvature, line);
+
+  const double t = time_s;
+  const auto depthAt = [&](const Eigen::Vector2d& p, double time) {
+    return seabed_->smoothDepthM(p.x(), p.y()) - options_.altitude_m +
+           options_.altitude_wobble_m * std::sin(2.0 * kPi * time / 31.0 + phase_altitude_);
+  };
+  const double depth = depthAt(planar, t);
+  // Slope of the flown depth along track gives the mean pitch (bow up when climbing).
+  const double ds = 1.0;
+  const Eigen::Vector2d ahead = planar + headingVector(path_heading) * ds;
+  const Eigen::Vector2d behind = planar - headingVector(path_heading) * ds;
+  const double dz_ds = (depthAt(ahead, t) - depthAt(behind, t)) / (2.0 * ds);
+
+  const double roll = options_.roll_amplitude_rad * std::sin(2.0 * kPi * t / options_.roll_period_s + phase_roll_) +
+                      std::clamp(curvature * 35.0, -1.0, 1.0) * options_.max_turn_bank_rad;
+  const double pitch = -std::atan(dz_ds) +
+                       options_.pitch_amplitude_rad * std::sin(2.0 * kPi * t / options_.pitch_period_s + phase_pitch_);
+  const double heading = sss::core::wrapAngle(
+      path_heading + options_.yaw_amplitude_rad * std::sin(2.0 * kPi * t / options_.yaw_period_s + phase_yaw_));
+
+  TrajectorySample sample;
+  sample.time_s = time_s;
+  sample.T_world_body = sss::core::Pose(sss::core::quaternionFromEuler(roll, pitch, heading),
+                                        Eigen::Vector3d(planar.x(), planar.y(), depth));
+  const Eigen::Vector2d velocity_planar = headingVector(path_heading) * options_.speed_m_s;
+  // Vertical speed: terrain following along the path plus the altitude wobble's own rate.
+  const double wobble_rate = options_.altitude_wobble_m * (2.0 * kPi / 31.0) * std::cos(2.0 * kPi * t / 31.0 + phase_altitude_);
+  sample.velocity_world_m_s =
+      Eigen::Vector3d(velocity_planar.x(), velocity_planar.y(), dz_ds * options_.speed_m_s + wobble_rate);
+  sample.altitude_m = seabed_->depthM(planar.x(), planar.y()) - depth;
+  sample.line_index = line;
+  return sample;
+}
+
+}  // namespace sss::sim

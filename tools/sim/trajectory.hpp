@@ -1,0 +1,83 @@
+// Simulated AUV path: lawnmower or loop survey lines joined by turns, flown at constant speed and
+// altitude over the seabed with small roll/pitch motion; the ground-truth pose at any time.
+#pragma once
+
+#include "pipeline/core/pose.hpp"
+#include "tools/sim/seabed.hpp"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace sss::sim {
+
+struct TrajectoryOptions {
+  std::string pattern = "lawnmower";  // "lawnmower" or "loop"
+  int lines = 5;
+  double line_length_m = 400.0;
+  double line_spacing_m = 70.0;  // 75 m range: adjacent lines overlap ~50% of a 150 m swath pair
+  double line_heading_deg = 0.0; // heading of the first line, clockwise from north
+  double speed_m_s = 2.0;
+  double altitude_m = 18.0;
+  double roll_amplitude_rad = 0.012;   // ~0.7 deg wave/control wobble
+  double roll_period_s = 14.0;
+  double pitch_amplitude_rad = 0.008;
+  double pitch_period_s = 22.0;
+  double yaw_amplitude_rad = 0.004;    // heading hunting of the autopilot around the line
+  double yaw_period_s = 40.0;
+  double altitude_wobble_m = 0.3;      // terrain following is not perfect
+  double max_turn_bank_rad = 0.08;     // roll into turns
+  uint64_t seed = 1;
+};
+
+// One straight line or one turn of the path, parameterised by distance along the path.
+struct PathSegment {
+  bool is_line = true;
+  int line_index = -1;          // survey line number for lines, -1 for turns
+  double start_distance_m = 0.0;
+  double length_m = 0.0;
+  Eigen::Vector2d start = Eigen::Vector2d::Zero();  // north, east
+  double start_heading_rad = 0.0;
+  double turn_radius_m = 0.0;   // turns only
+  double turn_sign = 1.0;       // +1 clockwise (starboard turn), -1 anticlockwise
+};
+
+struct TrajectorySample {
+  double time_s = 0.0;
+  sss::core::Pose T_world_body;
+  Eigen::Vector3d velocity_world_m_s = Eigen::Vector3d::Zero();
+  double altitude_m = 0.0;  // true altitude above the seabed directly below
+  int line_index = -1;      // -1 while turning
+};
+
+class Trajectory {
+ public:
+  Trajectory(const TrajectoryOptions& options, const Seabed* seabed);
+
+  double durationS() const { return total_length_m_ / options_.speed_m_s; }
+  double lengthM() const { return total_length_m_; }
+  TrajectorySample sample(double time_s) const;
+  const std::vector<PathSegment>& segments() const { return segments_; }
+  const TrajectoryOptions& options() const { return options_; }
+
+  // The horizontal footprint of the path (north/east min and max) before any swath margin.
+  static Eigen::Vector4d planExtent(const TrajectoryOptions& options);
+
+ private:
+  void planarState(double distance_m, Eigen::Vector2d& position, double& heading_rad, double& curvature, int& line) const;
+
+  TrajectoryOptions options_;
+  const Seabed* seabed_;
+  std::vector<PathSegment> segments_;
+  double total_length_m_ = 0.0;
+  double phase_roll_ = 0.0;
+  double phase_pitch_ = 0.0;
+  double phase_yaw_ = 0.0;
+  double phase_altitude_ = 0.0;
+};
+
+std::vector<PathSegment> planSurvey(const TrajectoryOptions& options);
+
+}  // namespace sss::sim
