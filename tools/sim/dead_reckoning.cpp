@@ -24,6 +24,9 @@ DeadReckoning::DeadReckoning(const DeadReckoningOptions& options, const Trajecto
   heading_bias_rad_ = k * signedMagnitude(options.heading_bias_min_rad, options.heading_bias_max_rad);
   const double roll_bias = k * signedMagnitude(0.0, options.attitude_bias_rad);
   const double pitch_bias = k * signedMagnitude(0.0, options.attitude_bias_rad);
+  // Drawn after the others so adding it left the earlier constants of a seed unchanged.
+  heading_deviation_rad_ = k * std::abs(signedMagnitude(options.heading_deviation_min_rad, options.heading_deviation_max_rad));
+  heading_deviation_phase_rad_ = 2.0 * M_PI * uniform(rng);
   // A separate stream for the study noise, so switching it on leaves the base errors unchanged.
   std::mt19937_64 study_rng(mixSeed(options.seed, 3002));
 
@@ -45,7 +48,7 @@ DeadReckoning::DeadReckoning(const DeadReckoningOptions& options, const Trajecto
       study_heading_noise = options.heading_noise_rad * gauss(study_rng);
       next_study_draw_s += options.heading_noise_interval_s;
     }
-    const double heading = sss::core::wrapAngle(true_euler.heading_rad + heading_bias_rad_ + heading_walk);
+    const double heading = sss::core::wrapAngle(true_euler.heading_rad + headingErrorRad(true_euler.heading_rad) + heading_walk);
     const double roll = true_euler.roll_rad + roll_bias + k * options.attitude_noise_rad * gauss(rng);
     const double pitch = true_euler.pitch_rad + pitch_bias + k * options.attitude_noise_rad * gauss(rng);
 
@@ -102,5 +105,9 @@ NavSample DeadReckoning::sampleAt(double time_s) const {
 }
 
 sss::core::Pose DeadReckoning::poseAt(double time_s) const { return sampleAt(time_s).T_world_body; }
+
+double DeadReckoning::headingErrorRad(double true_heading_rad) const {
+  return heading_bias_rad_ + heading_deviation_rad_ * std::cos(true_heading_rad - heading_deviation_phase_rad_);
+}
 
 }  // namespace sss::sim

@@ -18,8 +18,14 @@ struct DeadReckoningOptions {
   // straight-line drift ~ hypot(scale factor, heading bias) = 0.14-0.42 % of distance.
   double velocity_scale_factor_min = 0.001;
   double velocity_scale_factor_max = 0.003;
-  double heading_bias_min_rad = 0.001;         // 0.06-0.17 deg, a good INS after alignment
-  double heading_bias_max_rad = 0.003;
+  double heading_bias_min_rad = 0.0005;        // 0.03-0.09 deg, a good INS after alignment
+  double heading_bias_max_rad = 0.0015;
+  // Heading error that depends on the heading, one cycle per revolution (residual gyrocompass
+  // speed/latitude error, alignment residuals): amplitude drawn in [min, max], random phase.
+  // Unlike a constant bias it does not cancel on the reversed lines of a lawnmower survey, which
+  // is what makes real DR drift on such surveys.
+  double heading_deviation_min_rad = 0.001;
+  double heading_deviation_max_rad = 0.002;
   double heading_random_walk_rad_per_sqrt_s = 2e-5;
   double velocity_white_noise_m_s = 0.005;     // DVL bottom-track noise per sample
   double attitude_noise_rad = 0.0002;          // roll/pitch output noise (white)
@@ -56,6 +62,10 @@ class DeadReckoning {
   // The drawn per-mission error constants (for mission.yaml and tests).
   double velocityScaleFactor() const { return scale_factor_; }
   double headingBiasRad() const { return heading_bias_rad_; }
+  double headingDeviationRad() const { return heading_deviation_rad_; }
+  double headingDeviationPhaseRad() const { return heading_deviation_phase_rad_; }
+  // The heading error (without random walk and study noise) at a true heading.
+  double headingErrorRad(double true_heading_rad) const;
   double distanceTravelledM() const { return distance_m_; }
 
  private:
@@ -63,6 +73,8 @@ class DeadReckoning {
   std::vector<NavSample> samples_;
   double scale_factor_ = 0.0;
   double heading_bias_rad_ = 0.0;
+  double heading_deviation_rad_ = 0.0;
+  double heading_deviation_phase_rad_ = 0.0;
   double distance_m_ = 0.0;
 };
 

@@ -98,6 +98,8 @@ void readSimOptions(sss::core::ConfigSection section, SimOptions& o) {
   dr.optional("velocity_scale_factor_max", d.velocity_scale_factor_max, {inRange(0.0, 0.1)});
   dr.optional("heading_bias_min_rad", d.heading_bias_min_rad, {inRange(0.0, 0.1)});
   dr.optional("heading_bias_max_rad", d.heading_bias_max_rad, {inRange(0.0, 0.1)});
+  dr.optional("heading_deviation_min_rad", d.heading_deviation_min_rad, {inRange(0.0, 0.1)});
+  dr.optional("heading_deviation_max_rad", d.heading_deviation_max_rad, {inRange(0.0, 0.1)});
   dr.optional("heading_random_walk_rad_per_sqrt_s", d.heading_random_walk_rad_per_sqrt_s, {inRange(0.0, 0.01)});
   dr.optional("velocity_white_noise_m_s", d.velocity_white_noise_m_s, {inRange(0.0, 1.0)});
   dr.optional("attitude_noise_rad", d.attitude_noise_rad, {inRange(0.0, 0.1)});
@@ -147,6 +149,8 @@ std::vector<std::string> validateSimOptions(const SimOptions& o) {
     add("dead_reckoning.velocity_scale_factor_min", o.dead_reckoning.velocity_scale_factor_min, "exceeds the max");
   if (o.dead_reckoning.heading_bias_min_rad > o.dead_reckoning.heading_bias_max_rad)
     add("dead_reckoning.heading_bias_min_rad", o.dead_reckoning.heading_bias_min_rad, "exceeds the max");
+  if (o.dead_reckoning.heading_deviation_min_rad > o.dead_reckoning.heading_deviation_max_rad)
+    add("dead_reckoning.heading_deviation_min_rad", o.dead_reckoning.heading_deviation_min_rad, "exceeds the max");
   if (o.seabed.boulder_min_radius_m > o.seabed.boulder_max_radius_m)
     add("seabed.boulder_min_radius_m", o.seabed.boulder_min_radius_m, "exceeds boulder_max_radius_m");
   if (o.trajectory.pattern != "lawnmower" && o.trajectory.pattern != "loop")
@@ -208,6 +212,8 @@ std::string simOptionsYaml(const SimOptions& o) {
       << YAML::Key << "velocity_scale_factor_min" << YAML::Value << d.velocity_scale_factor_min << YAML::Key
       << "velocity_scale_factor_max" << YAML::Value << d.velocity_scale_factor_max << YAML::Key << "heading_bias_min_rad"
       << YAML::Value << d.heading_bias_min_rad << YAML::Key << "heading_bias_max_rad" << YAML::Value << d.heading_bias_max_rad
+      << YAML::Key << "heading_deviation_min_rad" << YAML::Value << d.heading_deviation_min_rad << YAML::Key
+      << "heading_deviation_max_rad" << YAML::Value << d.heading_deviation_max_rad
       << YAML::Key << "heading_random_walk_rad_per_sqrt_s" << YAML::Value << d.heading_random_walk_rad_per_sqrt_s
       << YAML::Key << "velocity_white_noise_m_s" << YAML::Value << d.velocity_white_noise_m_s << YAML::Key
       << "attitude_noise_rad" << YAML::Value << d.attitude_noise_rad << YAML::Key << "attitude_bias_rad" << YAML::Value
@@ -618,6 +624,8 @@ bool writeMission(const Mission& mission, const std::string& out_dir, MissionRep
        << "\n  start_utime_us: " << options.start_utime_us << "\n  distance_m: " << report.distance_m
        << "\n  sample_interval_s: " << sonar.sampleIntervalS() << "\n  sample_spacing_m: " << spacing
        << "\n  dr_velocity_scale_factor: " << dr.velocityScaleFactor() << "\n  dr_heading_bias_rad: " << dr.headingBiasRad()
+       << "\n  dr_heading_deviation_rad: " << dr.headingDeviationRad()
+       << "\n  dr_heading_deviation_phase_rad: " << dr.headingDeviationPhaseRad()
        << "\n  dr_final_error_m: " << report.final_dr_error_m << "\n  dr_max_error_m: " << report.max_dr_error_m
        << "\n  frames: local NED at the origin (x north, y east, z down), body FRD, TUM t x y z qx qy qz qw"
        << "\n  ins_protocol: iXblue NMEA 0183 ($HEHDT, $PIXSE ATITUD/POSITI/SPEED_/TIME__/STD*, $SDDPT, $INZDA)"
