@@ -147,6 +147,7 @@ void TcpStreamServer::run(const std::atomic<bool>& stop) {
       continue;
     }
     damaged ? ++stats_.chunks_faulted : ++stats_.chunks_sent;
+    if (on_chunk_sent_) on_chunk_sent_(i, sss::core::monotonicUtime());
     if (every(options_.faults.pause_every, i)) {
       ++stats_.pauses;
       pacer.pause(options_.faults.pause_s, stop);

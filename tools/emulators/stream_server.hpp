@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,10 @@ class TcpStreamServer {
   // Binds and listens; false with error set when the port is taken or the address is wrong.
   bool listen(std::string& error);
   int port() const { return port_; }
+  // Called after the last byte of chunk `index` was handed to the kernel (benchmarks).
+  void setChunkSentCallback(std::function<void(size_t index, int64_t monotonic_us)> callback) {
+    on_chunk_sent_ = std::move(callback);
+  }
   // Waits for a client, sends every chunk (continuing after a drop once a client reconnects),
   // returns when all are sent or stop becomes true. Closes the connection at the end.
   void run(const std::atomic<bool>& stop);
@@ -62,6 +67,7 @@ class TcpStreamServer {
   int listen_fd_ = -1;
   int port_ = 0;
   StreamStats stats_;
+  std::function<void(size_t, int64_t)> on_chunk_sent_;
 };
 
 // Sends each chunk as one UDP datagram to host:port (an INS's usual output), paced and faulted
