@@ -22,7 +22,25 @@ void SonarDriver::onBytes(const uint8_t* data, size_t size, int64_t host_utime_u
 
 void SonarDriver::handleMessages(int64_t host_utime_us, int64_t monotonic_us) {
   for (const JsfMessage& message : messages_) {
-    if (message.header.message_type != kJsfSonarData) continue;  // nav types: not used by this driver yet
+    if (isNavigationType(message.header.message_type)) {
+      JsfNavigationDecodeResult nav = decodeNavigation(message.header, message.body.data(), message.body.size());
+      if (nav.record) {
+        ++navigation_messages_;
+        latest_navigation_ = std::move(nav.record);
+      } else {
+        ++sonar_decode_errors_;
+        if (!decode_error_reported_) {
+          decode_error_reported_ = true;
+          new_faults_.push_back("JSF message at byte " + std::to_string(message.stream_offset) + ": " + nav.error +
+                                "; skipped");
+        }
+      }
+      continue;
+    }
+    if (message.header.message_type != kJsfSonarData) {
+      ++other_messages_;  // system info, bathymetry, ...: skipped by their byte count
+      continue;
+    }
     SonarDecodeResult decoded = decodeSonarData(message.header, message.body.data(), message.body.size());
     if (!decoded.record) {
       ++sonar_decode_errors_;

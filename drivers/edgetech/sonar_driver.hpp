@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "drivers/edgetech/clock_offset.hpp"
+#include "drivers/edgetech/jsf_navigation.hpp"
 #include "drivers/edgetech/jsf_stream_parser.hpp"
 #include "drivers/edgetech/ping_assembler.hpp"
 #include "drivers/edgetech/raw_recorder.hpp"
@@ -56,6 +57,10 @@ class SonarDriver {
   const PingAssemblerCounters& assemblerCounters() const { return assembler_.counters(); }
   const RawRecorder& recorder() const { return recorder_; }
   uint64_t sonarDecodeErrors() const { return sonar_decode_errors_; }
+  uint64_t navigationMessages() const { return navigation_messages_; }
+  uint64_t otherMessages() const { return other_messages_; }
+  // The newest navigation message of the sonar's own sensors (2020/2080/2090/2091/2002).
+  const std::optional<JsfNavigationRecord>& latestNavigation() const { return latest_navigation_; }
   uint64_t pingsWithoutOffset() const { return pings_without_offset_; }
   // host = sonar + offset; empty before enough pings.
   std::optional<int64_t> clockOffsetUs() const { return clock_.offsetUs(); }
@@ -73,6 +78,9 @@ class SonarDriver {
   std::vector<JsfMessage> messages_;      // reused between calls
   std::vector<AssembledPing> assembled_;  // reused between calls
   uint64_t sonar_decode_errors_ = 0;
+  uint64_t navigation_messages_ = 0;
+  uint64_t other_messages_ = 0;
+  std::optional<JsfNavigationRecord> latest_navigation_;
   uint64_t pings_without_offset_ = 0;
   std::vector<std::string> new_faults_;
   bool decode_error_reported_ = false;

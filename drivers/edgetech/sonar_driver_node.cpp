@@ -1,6 +1,9 @@
-// sss-sonar-driver: EdgeTech 2205 JSF from the sonar processor's TCP data port (or a .jsf file
-// for replay) -> SSS_PING on LCM. Translation only; the logic is in SonarDriver.
-//   sss-sonar-driver [--config FILE] [--file FILE.jsf [--speed X]] [--lcm-url URL]
+// sss-sonar-driver: EdgeTech 2205 JSF from the sonar processor's TCP data port (or a .jsf or
+// .xtf file for replay) -> SSS_PING on LCM. Translation only; the logic is in SonarDriver and
+// XtfReader.
+//   sss-sonar-driver [--config FILE] [--file FILE.jsf|FILE.xtf [--speed X]] [--lcm-url URL]
+#include <strings.h>
+
 #include <cstdio>
 #include <cstdlib>
 #include <deque>
@@ -9,6 +12,7 @@
 
 #include "drivers/edgetech/ping_message.hpp"
 #include "drivers/edgetech/sonar_driver.hpp"
+#include "drivers/xtf/xtf_reader.hpp"
 #include "pipeline/core/time.hpp"
 #include "pipeline/transport/logging.hpp"
 #include "pipeline/transport/process_loop.hpp"
@@ -27,10 +31,11 @@ struct NodeOptions {
   std::string ping_channel = "SSS_PING";
   std::string replay_file;      // non-empty: read this file instead of TCP
   double replay_speed = 1.0;    // 0: as fast as possible
+  int xtf_pair_index = 0;       // XTF with several side-scan pairs: 0 = lowest frequency
 };
 
 void usage(const char* program) {
-  std::fprintf(stderr, "usage: %s [--config FILE] [--file FILE.jsf [--speed X]] [--lcm-url URL]\n", program);
+  std::fprintf(stderr, "usage: %s [--config FILE] [--file FILE.jsf|FILE.xtf [--speed X]] [--lcm-url URL]\n", program);
 }
 
 // Replays a file through the same byte path as TCP, publishing each ping at its sonar time
@@ -74,6 +79,46 @@ class FileReplay {
   std::deque<sss::edgetech::DriverPing> queue_;
 };
 
+// Replays an XTF file: its packets already join both sides, so they bypass the JSF assembler.
+class XtfReplay {
+ public:
+  XtfReplay(const std::string& path, double speed, sss::xtf::XtfReaderOptions options)
+      : reader_(path, options), pacer_(speed) {}
+  bool isOpen() const { return reader_.isOpen(); }
+  bool done() const { return eof_ && queue_.empty(); }
+  sss::xtf::XtfReader& reader() { return reader_; }
+
+  template <typename Publish>
+  void step(Publish publish) {
+    while (!eof_ && queue_.size() < 64) {
+      sss::edgetech::DriverPing ping;
+      if (!reader_.next(ping)) {
+        eof_ = true;
+        break;
+      }
+      queue_.push_back(std::move(ping));
+    }
+    const int64_t now = monotonicUtime();
+    for (int budget = 200; budget > 0 && !queue_.empty(); --budget) {
+      sss::edgetech::DriverPing& next = queue_.front();
+      if (!pacer_.due(next.sonar_utime_us, now)) break;
+      next.ping.last_arrival_us = now;
+      publish(next);
+      queue_.pop_front();
+    }
+  }
+
+ private:
+  sss::xtf::XtfReader reader_;
+  sss::transport::ReplayPacer pacer_;
+  bool eof_ = false;
+  std::deque<sss::edgetech::DriverPing> queue_;
+};
+
+bool hasXtfExtension(const std::string& path) {
+  return path.size() > 4 && strcasecmp(path.c_str() + path.size() - 4, ".xtf") == 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -112,6 +157,7 @@ int main(int argc, char** argv) {
     section.optional("ping_channel", options.ping_channel, {sss::core::nonEmpty()});
     section.optional("replay_file", options.replay_file);
     if (!speed_given) section.optional("replay_speed", options.replay_speed, {sss::core::inRange(0.0, 1000.0)});
+    section.optional("xtf_pair_index", options.xtf_pair_index, {sss::core::inRange(0, 7)});
     section.rejectUnknownKeys();
     if (!config.ok()) {
       std::fprintf(stderr, "sss-sonar-driver: invalid configuration:\n%s", config.problemReport().c_str());
@@ -144,6 +190,8 @@ int main(int argc, char** argv) {
     health.setCounter("jsf_bad_headers", static_cast<double>(parser.bad_headers));
     health.setCounter("jsf_truncated_messages", static_cast<double>(parser.truncated_messages));
     health.setCounter("jsf_sonar_decode_errors", static_cast<double>(driver.sonarDecodeErrors()));
+    health.setCounter("jsf_navigation_messages", static_cast<double>(driver.navigationMessages()));
+    health.setCounter("jsf_other_messages", static_cast<double>(driver.otherMessages()));
     health.setCounter("pings_complete", static_cast<double>(assembler.complete_pings));
     health.setCounter("pings_one_side_missing", static_cast<double>(assembler.incomplete_pings));
     health.setCounter("pings_before_clock_estimate", static_cast<double>(driver.pingsWithoutOffset()));
@@ -158,10 +206,42 @@ int main(int argc, char** argv) {
   loop.addTimer(1.0, updateCounters);
 
   std::unique_ptr<FileReplay> replay;
+  std::unique_ptr<XtfReplay> xtf_replay;
   std::unique_ptr<sss::transport::TcpClient> tcp;
   int registered_fd = -1;
   std::vector<sss::edgetech::DriverPing> pings;  // reused by the TCP callbacks below
-  if (!options.replay_file.empty()) {
+  if (!options.replay_file.empty() && hasXtfExtension(options.replay_file)) {
+    sss::xtf::XtfReaderOptions xtf_options;
+    xtf_options.pair_index = options.xtf_pair_index;
+    xtf_replay = std::make_unique<XtfReplay>(options.replay_file, options.replay_speed, xtf_options);
+    if (!xtf_replay->isOpen()) {
+      spdlog::critical("{}", xtf_replay->reader().error());
+      return 1;
+    }
+    spdlog::info("{}", xtf_replay->reader().summary());
+    uint64_t xtf_pings_published = 0;
+    loop.addTimer(0.002, [&] {
+      xtf_replay->step([&](const sss::edgetech::DriverPing& ping) {
+        publish(ping);
+        ++xtf_pings_published;
+      });
+      sss::xtf::XtfReader& reader = xtf_replay->reader();
+      for (const std::string& fault : reader.takeNewFaultMessages()) {
+        health.recordError("sonar_input", fault, nowUtime());
+        spdlog::warn("{} (further faults of this kind are counted in SSS_STATUS)", fault);
+      }
+      health.setCounter("xtf_pings", static_cast<double>(reader.counters().pings));
+      health.setCounter("xtf_packets_skipped", static_cast<double>(reader.counters().packets_skipped));
+      health.setCounter("xtf_corrupt_records", static_cast<double>(reader.counters().corruptRecords()));
+      health.setCounter("xtf_bytes_skipped", static_cast<double>(reader.counters().bytes_skipped));
+      health.setCounter("xtf_truncated_packets", static_cast<double>(reader.counters().truncated_packets));
+      if (xtf_replay->done()) {
+        spdlog::info("{}", reader.summary());
+        spdlog::info("replay of '{}' finished: {} pings", options.replay_file, xtf_pings_published);
+        loop.stop();
+      }
+    });
+  } else if (!options.replay_file.empty()) {
     replay = std::make_unique<FileReplay>(options.replay_file, options.replay_speed);
     if (!replay->isOpen()) {
       spdlog::critical("cannot open sonar file '{}'", options.replay_file);

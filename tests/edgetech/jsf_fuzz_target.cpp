@@ -3,6 +3,7 @@
 
 #include <cstdlib>
 
+#include "drivers/edgetech/jsf_navigation.hpp"
 #include "drivers/edgetech/jsf_stream_parser.hpp"
 
 namespace sss::test {
@@ -25,6 +26,8 @@ int fuzzJsf(const uint8_t* data, size_t size) {
     if (message.header.message_type == kJsfSonarData) {
       const SonarDecodeResult result = decodeSonarData(message.header, message.body.data(), message.body.size());
       if (result.record) ++decoded;
+    } else if (isNavigationType(message.header.message_type)) {
+      decodeNavigation(message.header, message.body.data(), message.body.size());
     }
   }
   if (parser.counters().messages != messages.size()) std::abort();

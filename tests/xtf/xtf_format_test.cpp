@@ -1,0 +1,123 @@
+// XTF file header parsing, side-scan pair selection, ping time and sonar packet decoding.
+#include "drivers/xtf/xtf_format.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "tests/xtf/xtf_test_data.hpp"
+
+namespace sss {
+namespace {
+
+TEST(XtfFormat, ParsesFileHeaderChannels) {
+  const xtf::XtfWriterOptions options = test::makeXtfOptions({100.0f, 400.0f}, 1, xtf::kNavUnitsMetres);
+  const std::vector<uint8_t> bytes = xtf::encodeFileHeader(options);
+  std::string error;
+  const xtf::XtfFileInfo info = xtf::parseFileHeader(bytes.data(), bytes.size(), error);
+  ASSERT_TRUE(error.empty()) << error;
+  EXPECT_EQ(info.nav_units, xtf::kNavUnitsMetres);
+  ASSERT_EQ(info.channels.size(), 4u);
+  EXPECT_EQ(info.channels[2].type_of_channel, xtf::kChannelPort);
+  EXPECT_EQ(info.channels[2].bytes_per_sample, 1);
+  EXPECT_EQ(info.channels[2].sample_type, xtf::SampleType::kUnsigned8);
+  EXPECT_EQ(info.channels[3].name, "Stbd");
+  EXPECT_EQ(info.recording_program, "sss-slam");
+}
+
+TEST(XtfFormat, RejectsWhatIsNoXtfHeader) {
+  std::vector<uint8_t> bytes(1024, 0);
+  std::string error;
+  xtf::parseFileHeader(bytes.data(), bytes.size(), error);
+  EXPECT_NE(error.find("0x7B"), std::string::npos);
+  xtf::parseFileHeader(bytes.data(), 100, error);
+  EXPECT_FALSE(error.empty());
+  bytes[0] = 0x7B;
+  bytes[166] = 0xFF;  // 255 sonar channels
+  xtf::parseFileHeader(bytes.data(), bytes.size(), error);
+  EXPECT_NE(error.find("corrupt"), std::string::npos);
+}
+
+TEST(XtfFormat, EightChannelHeaderNeedsTwoBlocks) {
+  const xtf::XtfWriterOptions options = test::makeXtfOptions({100.0f, 200.0f, 300.0f, 400.0f}, 2);
+  const std::vector<uint8_t> bytes = xtf::encodeFileHeader(options);
+  EXPECT_EQ(xtf::requiredHeaderBytes(bytes.data(), 1024), 2048u);
+  std::string error;
+  xtf::parseFileHeader(bytes.data(), 1024, error);
+  EXPECT_NE(error.find("2048"), std::string::npos);
+  const xtf::XtfFileInfo info = xtf::parseFileHeader(bytes.data(), bytes.size(), error);
+  ASSERT_TRUE(error.empty()) << error;
+  ASSERT_EQ(info.channels.size(), 8u);
+  EXPECT_FLOAT_EQ(info.channels[7].frequency, 400.0f);
+}
+
+TEST(XtfFormat, PairsOrderedByFrequency) {
+  // High-frequency pair first in the file: pair 0 must still be the low one.
+  const xtf::XtfWriterOptions options = test::makeXtfOptions({410.0f, 120.0f}, 1);
+  std::string error;
+  const std::vector<uint8_t> bytes = xtf::encodeFileHeader(options);
+  const std::vector<xtf::ChannelPair> pairs = xtf::sideScanPairs(xtf::parseFileHeader(bytes.data(), bytes.size(), error));
+  ASSERT_EQ(pairs.size(), 2u);
+  EXPECT_EQ(pairs[0].port, 2);
+  EXPECT_EQ(pairs[0].starboard, 3);
+  EXPECT_EQ(pairs[1].port, 0);
+  EXPECT_EQ(pairs[1].starboard, 1);
+  EXPECT_FLOAT_EQ(xtf::frequencyHz(120.0f), 120000.0f);
+  EXPECT_FLOAT_EQ(xtf::frequencyHz(455000.0f), 455000.0f);
+}
+
+TEST(XtfFormat, CalendarToUtc) {
+  EXPECT_EQ(*xtf::utcFromCalendar(1970, 1, 1, 0, 0, 0, 0), 0);
+  EXPECT_EQ(*xtf::utcFromCalendar(2023, 11, 14, 22, 13, 20, 25), 1700000000250000);
+  EXPECT_EQ(*xtf::utcFromCalendar(2024, 2, 29, 0, 0, 0, 0), 1709164800000000);
+  EXPECT_FALSE(xtf::utcFromCalendar(2023, 13, 1, 0, 0, 0, 0));
+  EXPECT_FALSE(xtf::utcFromCalendar(2023, 1, 1, 0, 0, 0, 100));
+  EXPECT_FALSE(xtf::utcFromCalendar(0, 1, 1, 0, 0, 0, 0));
+}
+
+xtf::SonarDecodeResult decodeOne(float sound_velocity, float slant_range_m, float duration_s) {
+  const xtf::XtfWriterOptions options = test::makeXtfOptions({100.0f}, 2);
+  xtf::XtfPingInput input = test::makeXtfPing(options, 1, 100);
+  input.sound_velocity = sound_velocity;
+  for (auto& channel : input.channels) {
+    channel.slant_range_m = slant_range_m;
+    channel.time_duration_s = duration_s;
+  }
+  const std::vector<uint8_t> header = xtf::encodeFileHeader(options);
+  const std::vector<uint8_t> packet = xtf::encodeSonarPacket(options, input);
+  std::string error;
+  const xtf::XtfFileInfo info = xtf::parseFileHeader(header.data(), header.size(), error);
+  xtf::SonarDecodeOptions decode;
+  decode.port_channel = 0;
+  decode.starboard_channel = 1;
+  return xtf::decodeSonarPacket(info, decode, packet.data(), packet.size());
+}
+
+TEST(XtfFormat, SoundVelocityHalfOrFullGivesTheSameRanges) {
+  // 750 (Isis, half speed) and 1500 must both give c = 1500 and the last sample at 99/100 of 75 m.
+  for (const float stored : {750.0f, 1500.0f}) {
+    const xtf::SonarDecodeResult result = decodeOne(stored, 75.0f, 0.0f);
+    ASSERT_TRUE(result.ping) << result.error;
+    const edgetech::SonarChannelRecord& port = *result.ping->ping.port;
+    EXPECT_FLOAT_EQ(port.sound_speed_m_s, 1500.0f);
+    EXPECT_NEAR(port.slantRangeM(99), 75.0 * 99 / 100, 1e-9);
+    EXPECT_TRUE(port.validity & edgetech::kValidSoundSpeed);
+  }
+  const xtf::SonarDecodeResult odd = decodeOne(0.0f, 75.0f, 0.0f);
+  ASSERT_TRUE(odd.ping);
+  EXPECT_TRUE(odd.sound_speed_fallback);
+  EXPECT_NEAR(odd.ping->ping.port->slantRangeM(50), 37.5, 1e-9);  // range still from SlantRange
+}
+
+TEST(XtfFormat, RangeFromTimeDurationWithoutSlantRange) {
+  // TimeDuration is two-way: 0.1 s at 1500 m/s is 75 m.
+  const xtf::SonarDecodeResult result = decodeOne(750.0f, 0.0f, 0.1f);
+  ASSERT_TRUE(result.ping) << result.error;
+  EXPECT_NEAR(result.ping->ping.starboard->slantRangeM(100), 75.0, 1e-4);
+  const xtf::SonarDecodeResult none = decodeOne(750.0f, 0.0f, -1.0f);
+  EXPECT_FALSE(none.ping);
+  EXPECT_NE(none.error.find("slant range"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace sss
