@@ -35,7 +35,7 @@ struct NodeOptions {
 };
 
 void usage(const char* program) {
-  std::fprintf(stderr, "usage: %s [--config FILE] [--file FILE.jsf|FILE.xtf [--speed X]] [--lcm-url URL]\n", program);
+  std::fprintf(stderr, "usage: %s [--config FILE [--check-config]] [--file FILE.jsf|FILE.xtf [--speed X]] [--lcm-url URL]\n", program);
 }
 
 // Replays a file through the same byte path as TCP, publishing each ping at its sonar time
@@ -126,6 +126,7 @@ int main(int argc, char** argv) {
   std::string lcm_url_override;
   NodeOptions options;
   bool speed_given = false;
+  bool check_config_only = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--config" && i + 1 < argc) {
@@ -135,6 +136,8 @@ int main(int argc, char** argv) {
     } else if (arg == "--speed" && i + 1 < argc) {
       options.replay_speed = std::atof(argv[++i]);
       speed_given = true;
+    } else if (arg == "--check-config") {
+      check_config_only = true;
     } else if (arg == "--lcm-url" && i + 1 < argc) {
       lcm_url_override = argv[++i];
     } else {
@@ -163,6 +166,10 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "sss-sonar-driver: invalid configuration:\n%s", config.problemReport().c_str());
       return 2;
     }
+  }
+  if (check_config_only) {
+    std::printf("%s: configuration '%s' is valid\n", "sss-sonar-driver", config_path.c_str());
+    return 0;
   }
   if (!lcm_url_override.empty()) options.process.lcm_url = lcm_url_override;
   // A file carries the sonar's own clock; there is no arrival time to compare it with.

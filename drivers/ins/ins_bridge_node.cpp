@@ -90,6 +90,7 @@ int main(int argc, char** argv) {
   std::string config_path, lcm_url_override;
   NodeOptions options;
   bool speed_given = false;
+  bool check_config_only = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--config" && i + 1 < argc) {
@@ -100,10 +101,12 @@ int main(int argc, char** argv) {
     } else if (arg == "--speed" && i + 1 < argc) {
       options.replay_speed = std::atof(argv[++i]);
       speed_given = true;
+    } else if (arg == "--check-config") {
+      check_config_only = true;
     } else if (arg == "--lcm-url" && i + 1 < argc) {
       lcm_url_override = argv[++i];
     } else {
-      std::fprintf(stderr, "usage: %s [--config FILE] [--file ins.nmea [--speed X]] [--lcm-url URL]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--config FILE [--check-config]] [--file ins.nmea [--speed X]] [--lcm-url URL]\n", argv[0]);
       return arg == "--help" ? 0 : 2;
     }
   }
@@ -137,6 +140,10 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "sss-ins-bridge: invalid configuration:\n%s", config.problemReport().c_str());
       return 2;
     }
+  }
+  if (check_config_only) {
+    std::printf("%s: configuration '%s' is valid\n", "sss-ins-bridge", config_path.c_str());
+    return 0;
   }
   if (!lcm_url_override.empty()) options.process.lcm_url = lcm_url_override;
 
