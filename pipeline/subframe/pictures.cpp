@@ -1,0 +1,131 @@
+// Waterfall and mosaic PNGs of canonical subframes. See pictures.hpp.
+#include "pipeline/subframe/pictures.hpp"
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "pipeline/subframe/georeference.hpp"
+
+namespace sss::subframe {
+
+std::vector<std::string> writeWaterfalls(const std::vector<Subframe>& subframes, const std::string& dir,
+                                         const PictureOptions& options, std::string& error) {
+  std::map<int, std::vector<const Subframe*>> lines;
+  for (const Subframe& s : subframes) lines[s.line_id].push_back(&s);
+  std::vector<std::string> files;
+  for (const auto& [line_id, list] : lines) {
+    int rows = 0;
+    for (const Subframe* s : list) rows += s->rows();
+    const int cols = list.front()->cols();
+    const int factor = std::max(1, (cols + options.waterfall_max_width_px - 1) / options.waterfall_max_width_px);
+    const int width = cols / factor;
+    cv::Mat image(rows, width, CV_8UC3, cv::Scalar(0, 0, 0));
+    int row0 = 0;
+    for (const Subframe* s : list) {
+      for (int r = 0; r < s->rows(); ++r) {
+        for (int x = 0; x < width; ++x) {
+          double sum = 0.0;
+          int valid = 0;
+          for (int k = 0; k < factor; ++k) {
+            const size_t i = static_cast<size_t>(r) * cols + x * factor + k;
+            if (s->mask[i] == kMaskValid) {
+              sum += s->image[i];
+              ++valid;
+            }
+          }
+          cv::Vec3b& pixel = image.at<cv::Vec3b>(row0 + r, x);
+          if (valid == 0) {
+            pixel = cv::Vec3b(60, 0, 0);  // BGR: dark blue for masked
+          } else {
+            const double v = std::clamp(sum / valid / options.display_max_intensity, 0.0, 1.0) * 255.0;
+            pixel = cv::Vec3b(static_cast<uint8_t>(v), static_cast<uint8_t>(v), static_cast<uint8_t>(v));
+          }
+        }
+      }
+      for (int x = 0; x < std::min(8, width); ++x) image.at<cv::Vec3b>(row0, x) = cv::Vec3b(0, 0, 255);
+      row0 += s->rows();
+    }
+    const std::string path = dir + "/waterfall_line_" + std::to_string(line_id) + ".png";
+    if (!cv::imwrite(path, image)) {
+      error = "cannot write " + path;
+      return files;
+    }
+    files.push_back(path);
+  }
+  return files;
+}
+
+bool writeMosaic(const std::vector<Subframe>& subframes,
+                 const std::map<int64_t, std::vector<sss::core::Pose>>& poses_by_subframe, const std::string& path,
+                 const PictureOptions& options, std::string& error) {
+  if (subframes.empty()) {
+    error = "no subframes for the mosaic " + path;
+    return false;
+  }
+  struct Point {
+    double north, east;
+    float value;
+  };
+  std::vector<Point> points;
+  double n_min = std::numeric_limits<double>::max(), n_max = -n_min, e_min = n_min, e_max = -n_min;
+  for (const Subframe& s : subframes) {
+    auto found = poses_by_subframe.find(s.id);
+    const std::vector<sss::core::Pose> poses = found != poses_by_subframe.end() ? found->second : drPoses(s);
+    // Every other column: the mosaic cell (0.5 m) is far coarser than a bin.
+    // Half-row steps (interpolated poses) so 0.5 m pings leave no empty cells between rows.
+    for (int half = 0; half < 2 * s.rows() - 1; ++half) {
+      const int r = half / 2;
+      const sss::core::Pose pose =
+          half % 2 == 0 ? poses[r] : sss::core::interpolate(poses[r], poses[r + 1], 0.5);
+      const double altitude_m = half % 2 == 0 ? s.pings[r].altitude_m
+                                              : 0.5 * (s.pings[r].altitude_m + s.pings[r + 1].altitude_m);
+      for (int c = 0; c < s.cols(); c += 2) {
+        const size_t i = static_cast<size_t>(r) * s.cols() + c;
+        if (s.mask[i] != kMaskValid) continue;
+        const auto p = georeferencePixel(s.geometry, pose, altitude_m, c);
+        if (!p) continue;
+        points.push_back({p->x(), p->y(), s.image[i]});
+        n_min = std::min(n_min, p->x());
+        n_max = std::max(n_max, p->x());
+        e_min = std::min(e_min, p->y());
+        e_max = std::max(e_max, p->y());
+      }
+    }
+  }
+  if (points.empty()) {
+    error = "no valid pixels for the mosaic " + path;
+    return false;
+  }
+  const double res = options.mosaic_resolution_m;
+  const int rows = static_cast<int>(std::ceil((n_max - n_min) / res)) + 1;
+  const int cols = static_cast<int>(std::ceil((e_max - e_min) / res)) + 1;
+  cv::Mat sum(rows, cols, CV_64F, cv::Scalar(0.0));
+  cv::Mat count(rows, cols, CV_32S, cv::Scalar(0));
+  for (const Point& p : points) {
+    // North up: image row 0 is the northernmost cell.
+    const int row = rows - 1 - static_cast<int>((p.north - n_min) / res);
+    const int col = static_cast<int>((p.east - e_min) / res);
+    sum.at<double>(row, col) += p.value;
+    count.at<int>(row, col) += 1;
+  }
+  cv::Mat image(rows, cols, CV_8UC3, cv::Scalar(60, 0, 0));
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      const int n = count.at<int>(r, c);
+      if (n == 0) continue;
+      const double v = std::clamp(sum.at<double>(r, c) / n / options.display_max_intensity, 0.0, 1.0) * 255.0;
+      image.at<cv::Vec3b>(r, c) = cv::Vec3b(static_cast<uint8_t>(v), static_cast<uint8_t>(v), static_cast<uint8_t>(v));
+    }
+  }
+  if (!cv::imwrite(path, image)) {
+    error = "cannot write " + path;
+    return false;
+  }
+  return true;
+}
+
+}  // namespace sss::subframe

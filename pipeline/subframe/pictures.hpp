@@ -1,0 +1,32 @@
+// Pictures of canonical subframes: a waterfall PNG per survey line and a geo-referenced mosaic
+// PNG of a whole mission (OpenCV), for eyes and reports, not for the matcher.
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "pipeline/core/pose.hpp"
+#include "pipeline/subframe/subframe_builder.hpp"
+
+namespace sss::subframe {
+
+struct PictureOptions {
+  double display_max_intensity = 3.0;  // normalised intensity shown white
+  double mosaic_resolution_m = 0.5;
+  int waterfall_max_width_px = 1250;   // columns averaged down to at most this width
+};
+
+// Writes <dir>/waterfall_line_<id>.png for every line (subframes stacked in time order, oldest row
+// at the top; masked pixels dark blue, subframe boundaries as a red tick at the left edge).
+// Returns the files written; error says why when one could not be written.
+std::vector<std::string> writeWaterfalls(const std::vector<Subframe>& subframes, const std::string& dir,
+                                         const PictureOptions& options, std::string& error);
+
+// Writes a north-up mosaic: mean normalised intensity per cell of every valid pixel geo-referenced
+// with the given poses per subframe id (DR when a subframe has none there).
+bool writeMosaic(const std::vector<Subframe>& subframes,
+                 const std::map<int64_t, std::vector<sss::core::Pose>>& poses_by_subframe, const std::string& path,
+                 const PictureOptions& options, std::string& error);
+
+}  // namespace sss::subframe

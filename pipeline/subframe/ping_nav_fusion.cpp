@@ -1,0 +1,172 @@
+// Ping-navigation fusion: interpolation of DR nav at ping times (slerp for attitude), bounded
+// waiting, altitude fallback, and counted drops. See ping_nav_fusion.hpp.
+#include "pipeline/subframe/ping_nav_fusion.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sss::subframe {
+
+using sss::core::Pose;
+
+sss::core::Pose PingNavFusionOptions::T_body_sonar() const {
+  return Pose(sss::core::quaternionFromEuler(sonar_rpy_body_rad.x(), sonar_rpy_body_rad.y(), sonar_rpy_body_rad.z()),
+              sonar_position_body_m);
+}
+
+void readPingNavFusionOptions(sss::core::ConfigSection& section, PingNavFusionOptions& options) {
+  using namespace sss::core;
+  std::vector<double> lever{options.sonar_position_body_m.x(), options.sonar_position_body_m.y(),
+                            options.sonar_position_body_m.z()};
+  std::vector<double> rpy{options.sonar_rpy_body_rad.x(), options.sonar_rpy_body_rad.y(),
+                          options.sonar_rpy_body_rad.z()};
+  const Rule<std::vector<double>> three = satisfies<std::vector<double>>(
+      [](const std::vector<double>& v) { return v.size() == 3; }, "a list of 3 numbers");
+  section.optional("sonar_position_body_m", lever, {three});
+  section.optional("sonar_rpy_body_rad", rpy, {three});
+  if (lever.size() == 3) options.sonar_position_body_m = Eigen::Vector3d(lever[0], lever[1], lever[2]);
+  if (rpy.size() == 3) options.sonar_rpy_body_rad = Eigen::Vector3d(rpy[0], rpy[1], rpy[2]);
+  section.optional("nav_history_s", options.nav_history_s, {inRange(1.0, 3600.0)});
+  section.optional("max_nav_gap_s", options.max_nav_gap_s, {inRange(0.001, 60.0)});
+  section.optional("max_ping_wait_s", options.max_ping_wait_s, {inRange(0.0, 60.0)});
+  section.optional("max_pending_pings", options.max_pending_pings, {inRange(1, 100000)});
+  section.optional("heading_rate_window_s", options.heading_rate_window_s, {inRange(0.0, 30.0)});
+  section.optional("min_altitude_m", options.min_altitude_m, {inRange(0.0, 1000.0)});
+  section.optional("duplicate_memory_pings", options.duplicate_memory_pings, {inRange(1, 100000)});
+}
+
+PingNavFusion::PingNavFusion(const PingNavFusionOptions& options)
+    : options_(options), T_body_sonar_(options.T_body_sonar()) {}
+
+void PingNavFusion::addNav(const NavInput& nav, std::vector<FusedPing>& out) {
+  ++counters_.nav_in;
+  if (!history_.empty() && nav.utime_us <= history_.back().utime_us) {
+    ++counters_.nav_out_of_order;
+    return;
+  }
+  history_.push_back(nav);
+  const int64_t keep_us = static_cast<int64_t>(options_.nav_history_s * 1e6);
+  while (history_.size() > 2 && history_.front().utime_us < nav.utime_us - keep_us) history_.pop_front();
+  release(out, false);
+}
+
+bool PingNavFusion::seenRecently(int64_t ping_number) const {
+  return std::find(recent_numbers_.begin(), recent_numbers_.end(), ping_number) != recent_numbers_.end();
+}
+
+void PingNavFusion::addPing(PingInput ping, std::vector<FusedPing>& out) {
+  ++counters_.pings_in;
+  if (seenRecently(ping.ping_number)) {
+    ++counters_.pings_duplicate;
+    return;
+  }
+  recent_numbers_.push_back(ping.ping_number);
+  while (static_cast<int>(recent_numbers_.size()) > options_.duplicate_memory_pings) recent_numbers_.pop_front();
+  if (ping.utime_us <= last_released_utime_us_) {
+    ++counters_.pings_out_of_order;
+    return;
+  }
+  auto position = std::upper_bound(pending_.begin(), pending_.end(), ping.utime_us,
+                                   [](int64_t t, const PingInput& p) { return t < p.utime_us; });
+  if (position != pending_.end()) ++counters_.pings_reordered;
+  pending_.insert(position, std::move(ping));
+  release(out, false);
+}
+
+void PingNavFusion::finish(std::vector<FusedPing>& out) { release(out, true); }
+
+void PingNavFusion::release(std::vector<FusedPing>& out, bool flush) {
+  const int64_t wait_us = static_cast<int64_t>(options_.max_ping_wait_s * 1e6);
+  while (!pending_.empty()) {
+    PingInput& front = pending_.front();
+    // The heading rate is centred on the ping, so a ping waits for nav half a window past it
+    // (0.5 s by default); at the end of input whatever nav brackets it is enough.
+    const int64_t lookahead_us = static_cast<int64_t>(0.5 * options_.heading_rate_window_s * 1e6);
+    const bool nav_arrived = !history_.empty() && (history_.back().utime_us >= front.utime_us + lookahead_us ||
+                                                   (flush && history_.back().utime_us >= front.utime_us));
+    if (!nav_arrived) {
+      const bool waited_too_long = pending_.back().utime_us - front.utime_us > wait_us;
+      const bool overflow = static_cast<int>(pending_.size()) > options_.max_pending_pings;
+      if (!(flush || waited_too_long || overflow)) break;
+      ++counters_.dropped_no_nav;
+      last_released_utime_us_ = front.utime_us;
+      pending_.pop_front();
+      continue;
+    }
+    PingInput ping = std::move(front);
+    pending_.pop_front();
+    last_released_utime_us_ = ping.utime_us;
+    if (resolve(std::move(ping), out)) ++counters_.pings_out;
+  }
+}
+
+bool PingNavFusion::resolve(PingInput&& ping, std::vector<FusedPing>& out) {
+  const int64_t t = ping.utime_us;
+  // b: first nav at or after t; a: the one before it.
+  auto b = std::lower_bound(history_.begin(), history_.end(), t,
+                            [](const NavInput& n, int64_t time) { return n.utime_us < time; });
+  if (b == history_.end()) return false;  // cannot happen: release() checked the newest nav
+  if (b->utime_us != t && b == history_.begin()) {
+    ++counters_.dropped_too_old;
+    return false;
+  }
+  auto a = b->utime_us == t ? b : std::prev(b);
+  if (static_cast<double>(b->utime_us - a->utime_us) * 1e-6 > options_.max_nav_gap_s) {
+    ++counters_.dropped_nav_gap;
+    return false;
+  }
+  const double alpha = b == a ? 0.0 : static_cast<double>(t - a->utime_us) / static_cast<double>(b->utime_us - a->utime_us);
+  const Pose pose_a(sss::core::quaternionFromEuler(a->roll_rad, a->pitch_rad, a->heading_rad), a->position_ned_m);
+  const Pose pose_b(sss::core::quaternionFromEuler(b->roll_rad, b->pitch_rad, b->heading_rad), b->position_ned_m);
+
+  FusedPing fused;
+  fused.T_world_body = sss::core::interpolate(pose_a, pose_b, alpha);  // slerp for attitude
+  fused.heading_rad = sss::core::wrapAngle(a->heading_rad + alpha * sss::core::wrapAngle(b->heading_rad - a->heading_rad));
+  fused.roll_rad = a->roll_rad + alpha * (b->roll_rad - a->roll_rad);
+  fused.distance_travelled_m = a->distance_travelled_m + alpha * (b->distance_travelled_m - a->distance_travelled_m);
+
+  // Heading rate over heading_rate_window_s centred on the ping (a one-sided window would lag
+  // the start of a turn by half a window and put its first pings into the line).
+  const int64_t half_window_us = static_cast<int64_t>(0.5 * options_.heading_rate_window_s * 1e6);
+  auto w0 = std::lower_bound(history_.begin(), a, t - half_window_us,
+                             [](const NavInput& n, int64_t time) { return n.utime_us < time; });
+  auto w1 = std::lower_bound(b, history_.end(), t + half_window_us,
+                             [](const NavInput& n, int64_t time) { return n.utime_us < time; });
+  if (w1 == history_.end()) w1 = std::prev(history_.end());
+  if (w1->utime_us > w0->utime_us) {
+    fused.heading_rate_rad_s = sss::core::wrapAngle(w1->heading_rad - w0->heading_rad) /
+                               (static_cast<double>(w1->utime_us - w0->utime_us) * 1e-6);
+  }
+
+  // Altitude of the sonar: DVL altitude of the body, shifted by the lever arm's vertical
+  // component in the world (a sonar mounted below the body origin is closer to the seabed).
+  const double sonar_down_offset_m = (fused.T_world_body.rotation * T_body_sonar_.translation).z();
+  const bool nav_altitude_ok = a->altitude_valid && b->altitude_valid && a->altitude_m >= options_.min_altitude_m &&
+                               b->altitude_m >= options_.min_altitude_m;
+  if (nav_altitude_ok) {
+    fused.altitude_m = a->altitude_m + alpha * (b->altitude_m - a->altitude_m) - sonar_down_offset_m;
+  } else if (ping.altitude_m >= options_.min_altitude_m) {
+    // The sonar's own altitude is measured at the sonar.
+    fused.altitude_m = ping.altitude_m;
+    fused.altitude_from_ping = true;
+    ++counters_.altitude_from_ping;
+  } else {
+    ++counters_.dropped_no_altitude;
+    return false;
+  }
+  if (fused.altitude_m < options_.min_altitude_m) {
+    ++counters_.dropped_no_altitude;
+    return false;
+  }
+  fused.ping = std::move(ping);
+  out.push_back(std::move(fused));
+  return true;
+}
+
+size_t PingNavFusion::memoryBytes() const {
+  size_t bytes = history_.size() * sizeof(NavInput) + recent_numbers_.size() * sizeof(int64_t);
+  for (const PingInput& p : pending_) bytes += sizeof(PingInput) + (p.port.capacity() + p.starboard.capacity()) * sizeof(float);
+  return bytes;
+}
+
+}  // namespace sss::subframe

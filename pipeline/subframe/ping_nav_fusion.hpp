@@ -1,0 +1,121 @@
+// Ping-navigation fusion: keeps a bounded navigation history and pings waiting (bounded) for the
+// nav samples that bracket them, and gives each ping its interpolated DR pose and altitude.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <deque>
+#include <vector>
+
+#include "pipeline/core/config.hpp"
+#include "pipeline/core/pose.hpp"
+
+namespace sss::subframe {
+
+// One DR navigation sample (SSS_NAV without the middleware).
+struct NavInput {
+  int64_t utime_us = 0;
+  Eigen::Vector3d position_ned_m = Eigen::Vector3d::Zero();  // body origin, local NED
+  double roll_rad = 0.0;
+  double pitch_rad = 0.0;
+  double heading_rad = 0.0;
+  double altitude_m = -1.0;        // body above seabed (DVL)
+  bool altitude_valid = false;     // valid and not stale
+  double distance_travelled_m = 0.0;
+};
+
+// One side-scan ping (SSS_PING without the middleware).
+struct PingInput {
+  int64_t utime_us = 0;
+  int64_t ping_number = 0;
+  double sound_speed_m_s = 1500.0;
+  double sample_interval_s = 0.0;  // two-way travel time between samples
+  double start_range_m = 0.0;      // slant range of sample 0
+  double altitude_m = -1.0;        // the sonar's own altitude; < 0 when unknown
+  std::vector<float> port;
+  std::vector<float> starboard;
+  int64_t arrival_monotonic_us = 0;  // when the ping reached this process (latency figures)
+
+  double sampleSpacingM() const { return 0.5 * sound_speed_m_s * sample_interval_s; }
+};
+
+// A ping with its DR pose at the ping time.
+struct FusedPing {
+  PingInput ping;
+  sss::core::Pose T_world_body;
+  double altitude_m = 0.0;           // the sonar's height above the seabed (canonical h)
+  bool altitude_from_ping = false;   // nav altitude was invalid or stale
+  double heading_rad = 0.0;
+  double roll_rad = 0.0;
+  double heading_rate_rad_s = 0.0;   // over heading_rate_window_s centred on the ping
+  double distance_travelled_m = 0.0;
+};
+
+struct PingNavFusionOptions {
+  // Sonar mounting T_body_sonar: lever arm (FRD, m) and rotation (roll, pitch, yaw, rad).
+  Eigen::Vector3d sonar_position_body_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d sonar_rpy_body_rad = Eigen::Vector3d::Zero();
+  double nav_history_s = 60.0;        // nav kept behind the newest sample
+  double max_nav_gap_s = 0.5;         // bracketing nav samples further apart: the ping is dropped
+  double max_ping_wait_s = 3.0;       // a ping waits this long (in ping time) for its nav, then drops
+  int max_pending_pings = 64;         // waiting pings beyond this: the oldest is dropped
+  double heading_rate_window_s = 1.0; // heading rate over this span centred on the ping; pings wait
+                                      // for nav half of it past them (latency)
+  double min_altitude_m = 0.5;        // altitudes below this are treated as invalid
+  int duplicate_memory_pings = 256;   // recent ping numbers remembered to catch duplicates
+
+  sss::core::Pose T_body_sonar() const;
+};
+
+void readPingNavFusionOptions(sss::core::ConfigSection& section, PingNavFusionOptions& options);
+
+struct PingNavFusionCounters {
+  uint64_t nav_in = 0;
+  uint64_t nav_out_of_order = 0;     // not newer than the newest nav: ignored
+  uint64_t pings_in = 0;
+  uint64_t pings_out = 0;
+  uint64_t pings_reordered = 0;      // arrived late but within the waiting window: put in order
+  uint64_t pings_out_of_order = 0;   // older than a ping already released: dropped
+  uint64_t pings_duplicate = 0;      // ping number seen recently: dropped
+  uint64_t dropped_no_nav = 0;       // waited max_ping_wait_s / overflow without bracketing nav
+  uint64_t dropped_too_old = 0;      // older than the nav history
+  uint64_t dropped_nav_gap = 0;      // bracketing nav samples more than max_nav_gap_s apart
+  uint64_t dropped_no_altitude = 0;  // neither nav nor ping altitude usable
+  uint64_t altitude_from_ping = 0;   // nav altitude invalid/stale, the ping's own altitude used
+
+  uint64_t droppedWithoutNav() const { return dropped_no_nav + dropped_too_old + dropped_nav_gap; }
+};
+
+// Pings are released in time order, each once its bracketing nav has arrived (nav is assumed to
+// arrive in time order; older nav is counted and ignored). Out-of-order pings: a ping older than
+// one already waiting is put in order (counted as reordered); older than one already released
+// it is dropped (counted). Nothing is extrapolated: no bracketing nav, no ping.
+class PingNavFusion {
+ public:
+  explicit PingNavFusion(const PingNavFusionOptions& options);
+
+  void addNav(const NavInput& nav, std::vector<FusedPing>& out);
+  void addPing(PingInput ping, std::vector<FusedPing>& out);
+  // End of input: pings still waiting are dropped (counted as no nav).
+  void finish(std::vector<FusedPing>& out);
+
+  const PingNavFusionCounters& counters() const { return counters_; }
+  size_t pendingPings() const { return pending_.size(); }
+  size_t navHistorySize() const { return history_.size(); }
+  size_t memoryBytes() const;
+
+ private:
+  void release(std::vector<FusedPing>& out, bool flush);
+  bool resolve(PingInput&& ping, std::vector<FusedPing>& out);
+  bool seenRecently(int64_t ping_number) const;
+
+  PingNavFusionOptions options_;
+  sss::core::Pose T_body_sonar_;
+  std::deque<NavInput> history_;
+  std::deque<PingInput> pending_;   // sorted by utime
+  std::deque<int64_t> recent_numbers_;
+  int64_t last_released_utime_us_ = INT64_MIN;
+  PingNavFusionCounters counters_;
+};
+
+}  // namespace sss::subframe

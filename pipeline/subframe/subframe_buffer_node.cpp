@@ -1,0 +1,147 @@
+// sss-subframe-buffer: SSS_PING + SSS_NAV -> SSS_SUBFRAME (canonical, geo-referenced subframes),
+// with drops and latency in SSS_STATUS. Translation only; the logic is in SubframeBuffer.
+//   sss-subframe-buffer [--config FILE] [--lcm-url URL]
+#include <algorithm>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "pipeline/core/time.hpp"
+#include "pipeline/subframe/subframe_buffer.hpp"
+#include "pipeline/subframe/subframe_message.hpp"
+#include "pipeline/transport/logging.hpp"
+#include "pipeline/transport/process_loop.hpp"
+
+namespace {
+
+struct NodeOptions {
+  sss::transport::ProcessOptions process;
+  sss::subframe::SubframeBufferOptions buffer;
+  std::string ping_channel = "SSS_PING";
+  std::string nav_channel = "SSS_NAV";
+  std::string subframe_channel = "SSS_SUBFRAME";
+  double horizontal_beam_width_rad = 0.0087;  // carried in the message for the matcher
+  double vertical_beam_width_rad = 0.87;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string config_path, lcm_url_override;
+  bool check_config_only = false;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--config" && i + 1 < argc) {
+      config_path = argv[++i];
+    } else if (arg == "--check-config") {
+      check_config_only = true;
+    } else if (arg == "--lcm-url" && i + 1 < argc) {
+      lcm_url_override = argv[++i];
+    } else {
+      std::fprintf(stderr, "usage: %s [--config FILE [--check-config]] [--lcm-url URL]\n", argv[0]);
+      return arg == "--help" ? 0 : 2;
+    }
+  }
+  NodeOptions options;
+  options.process.process_name = "sss-subframe-buffer";
+  if (!config_path.empty()) {
+    using namespace sss::core;
+    Config config = Config::fromFile(config_path);
+    // The mission origin is the NED origin of SSS_NAV already (the INS bridge converts); it is
+    // read here only so the shared mission section is validated the same way everywhere.
+    ConfigSection mission = config.section("mission");
+    double origin_latitude_deg = 0.0, origin_longitude_deg = 0.0;
+    mission.optional("origin_latitude_deg", origin_latitude_deg, {inRange(-90.0, 90.0)});
+    mission.optional("origin_longitude_deg", origin_longitude_deg, {inRange(-180.0, 180.0)});
+    ConfigSection section = config.section("subframe_buffer");
+    sss::transport::readProcessOptions(section, options.process);
+    sss::subframe::readSubframeBufferOptions(section, options.buffer);
+    section.optional("ping_channel", options.ping_channel, {nonEmpty()});
+    section.optional("nav_channel", options.nav_channel, {nonEmpty()});
+    section.optional("subframe_channel", options.subframe_channel, {nonEmpty()});
+    section.optional("horizontal_beam_width_rad", options.horizontal_beam_width_rad, {inRange(0.0, 1.0)});
+    section.optional("vertical_beam_width_rad", options.vertical_beam_width_rad, {inRange(0.0, 3.2)});
+    section.rejectUnknownKeys();
+    if (!config.ok()) {
+      std::fprintf(stderr, "sss-subframe-buffer: invalid configuration:\n%s", config.problemReport().c_str());
+      return 2;
+    }
+  }
+  if (check_config_only) {
+    std::printf("sss-subframe-buffer: configuration '%s' is valid\n", config_path.c_str());
+    return 0;
+  }
+  if (!lcm_url_override.empty()) options.process.lcm_url = lcm_url_override;
+
+  sss::transport::initLogging(options.process.process_name, options.process.log_level);
+  sss::transport::ProcessLoop loop(options.process);
+  sss::core::HealthMonitor& health = loop.health();
+  sss::subframe::SubframeBuffer buffer(options.buffer);
+  std::vector<sss::subframe::Subframe> subframes;
+
+  auto publishAll = [&] {
+    for (const sss::subframe::Subframe& subframe : subframes) {
+      const sss_msgs::subframe_t message = sss::subframe::toSubframeMessage(
+          subframe, options.buffer.subframes.intensity_bits, options.buffer.subframes.max_intensity,
+          static_cast<float>(options.horizontal_beam_width_rad), static_cast<float>(options.vertical_beam_width_rad));
+      // Latency in SSS_STATUS: from the arrival of the subframe's last ping to the end of the publish.
+      loop.bus().publish(options.subframe_channel, message, subframe.last_ping_arrival_monotonic_us);
+    }
+    subframes.clear();
+  };
+  loop.bus().subscribe<sss_msgs::nav_t>(options.nav_channel, [&](const sss_msgs::nav_t& message) {
+    buffer.addNav(sss::subframe::fromNavMessage(message), subframes);
+    publishAll();
+  });
+  loop.bus().subscribe<sss_msgs::ping_t>(options.ping_channel, [&](const sss_msgs::ping_t& message) {
+    buffer.addPing(sss::subframe::fromPingMessage(message, sss::core::monotonicUtime()), subframes);
+    publishAll();
+  });
+
+  // Counters and faults (logged once per kind, counted always).
+  uint64_t reported_no_nav = 0, reported_out_of_order = 0, reported_no_altitude = 0;
+  loop.addTimer(1.0, [&] {
+    const sss::subframe::SubframeBufferCounters c = buffer.counters();
+    const auto set = [&](const char* name, uint64_t value) { health.setCounter(name, static_cast<double>(value)); };
+    set("pings_in", c.fusion.pings_in);
+    set("pings_fused", c.fusion.pings_out);
+    set("pings_dropped_without_nav", c.fusion.droppedWithoutNav());
+    set("pings_dropped_no_nav", c.fusion.dropped_no_nav);
+    set("pings_dropped_too_old", c.fusion.dropped_too_old);
+    set("pings_dropped_nav_gap", c.fusion.dropped_nav_gap);
+    set("pings_out_of_order", c.fusion.pings_out_of_order);
+    set("pings_reordered", c.fusion.pings_reordered);
+    set("pings_duplicate", c.fusion.pings_duplicate);
+    set("pings_dropped_no_altitude", c.fusion.dropped_no_altitude);
+    set("altitude_from_ping", c.fusion.altitude_from_ping);
+    set("nav_in", c.fusion.nav_in);
+    set("nav_out_of_order", c.fusion.nav_out_of_order);
+    set("turn_rows", c.turn_rows);
+    set("lines", c.builder.lines);
+    set("subframes_out", c.builder.subframes);
+    set("partial_subframes", c.builder.partial_subframes);
+    set("dropped_short_tails", c.builder.dropped_short_tails);
+    set("memory_bytes", buffer.memoryBytes());
+    health.setQueueDepth(options.ping_channel, false, 0);
+    const int64_t now = sss::core::nowUtime();
+    if (c.fusion.droppedWithoutNav() > reported_no_nav) {
+      if (health.recordError("ping_without_nav", "pings dropped without bracketing navigation (check SSS_NAV)", now))
+        spdlog::warn("pings dropped without bracketing navigation; further drops are counted in SSS_STATUS");
+      reported_no_nav = c.fusion.droppedWithoutNav();
+    }
+    if (c.fusion.pings_out_of_order > reported_out_of_order) {
+      if (health.recordError("ping_out_of_order", "pings older than one already processed were dropped", now))
+        spdlog::warn("out-of-order pings dropped; further ones are counted in SSS_STATUS");
+      reported_out_of_order = c.fusion.pings_out_of_order;
+    }
+    if (c.fusion.dropped_no_altitude > reported_no_altitude) {
+      if (health.recordError("ping_without_altitude", "pings dropped: no valid nav or sonar altitude", now))
+        spdlog::warn("pings dropped without a valid altitude; further ones are counted in SSS_STATUS");
+      reported_no_altitude = c.fusion.dropped_no_altitude;
+    }
+  });
+  const int code = loop.run();
+  buffer.finish(subframes);
+  publishAll();
+  return code;
+}

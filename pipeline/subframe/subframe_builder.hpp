@@ -1,0 +1,113 @@
+// Survey-line segmentation from the heading history and cutting of each line into subframes of
+// N pings (paper Sec. "Subframe Pose Estimation": images evenly divided into subframes).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "pipeline/core/config.hpp"
+#include "pipeline/core/pose.hpp"
+#include "pipeline/subframe/canonical_transform.hpp"
+
+namespace sss::subframe {
+
+struct LineSegmenterOptions {
+  // A line is a stretch of steady pings (not turn rows: see CanonicalTransformOptions) whose
+  // heading stays within max_heading_deviation_rad of the line's mean heading.
+  double max_heading_deviation_rad = 0.1;  // ~6 deg: DR heading hunting is < 0.3 deg
+  int min_steady_pings = 8;                // steady pings in a row before a line opens (2 s)
+  double max_ping_gap_s = 5.0;             // a longer gap between pings ends the line
+};
+
+struct SubframeOptions {
+  int pings_per_subframe = 200;  // paper: 200 pings per subframe
+  int min_pings = 50;            // a line's last, partial subframe is emitted from this many pings (25 m)
+  int intensity_bits = 16;       // quantisation of the published image: 8 or 16
+  double max_intensity = 16.0;   // full scale of the quantised image (normalised mean = 1)
+};
+
+void readLineSegmenterOptions(sss::core::ConfigSection& section, LineSegmenterOptions& options);
+void readSubframeOptions(sss::core::ConfigSection& section, SubframeOptions& options);
+
+// The ground-range axis and the sonar mounting of a subframe's image.
+struct SubframeGeometry {
+  int bins_per_side = 0;
+  double bin_size_m = 0.0;
+  double first_bin_range_m = 0.0;
+  sss::core::Pose T_body_sonar;
+
+  int columns() const { return 2 * bins_per_side; }
+  // Signed across-track ground range of a (fractional) column: port negative, starboard positive.
+  double signedGroundRangeM(double column) const;
+};
+
+struct SubframePing {
+  int64_t utime_us = 0;
+  int64_t ping_number = 0;
+  sss::core::Pose T_world_body;  // DR
+  double altitude_m = 0.0;       // the sonar's height above the seabed (the h of the transform)
+  double distance_travelled_m = 0.0;
+};
+
+struct Subframe {
+  int64_t id = 0;
+  int line_id = 0;
+  int centre_ping_index = 0;     // row of the centre ping
+  std::vector<SubframePing> pings;
+  SubframeGeometry geometry;
+  std::vector<float> image;      // rows = pings, columns = geometry.columns(), normalised intensity
+  std::vector<uint8_t> mask;     // MaskCode per pixel
+  int64_t last_ping_arrival_monotonic_us = 0;
+
+  int rows() const { return static_cast<int>(pings.size()); }
+  int cols() const { return geometry.columns(); }
+  const SubframePing& centre() const { return pings[centre_ping_index]; }
+};
+
+struct SubframeBuilderCounters {
+  uint64_t pings_in = 0;
+  uint64_t turn_pings = 0;            // not in any line
+  uint64_t lines = 0;                 // lines opened
+  uint64_t subframes = 0;
+  uint64_t partial_subframes = 0;     // a line's last subframe with min_pings..N-1 pings
+  uint64_t dropped_short_tails = 0;   // a line's last pings, fewer than min_pings: dropped
+  uint64_t dropped_tail_pings = 0;
+};
+
+// Pings must come in time order (PingNavFusion releases them so). A subframe is emitted as soon
+// as its N-th ping arrives; when a line ends (turn, heading change, gap, finish()), its remaining
+// pings form a last subframe if there are at least min_pings of them (centre = middle of those
+// pings), else they are dropped and counted: a short tail would give a weakly constrained centre.
+class SubframeBuilder {
+ public:
+  SubframeBuilder(const LineSegmenterOptions& line_options, const SubframeOptions& options,
+                  const SubframeGeometry& geometry);
+
+  void addPing(CanonicalPing ping, std::vector<Subframe>& out);
+  void finish(std::vector<Subframe>& out);
+
+  // Line of the newest ping; -1 while turning or before a line opened.
+  int currentLineId() const { return line_open_ ? line_id_ : -1; }
+  const SubframeBuilderCounters& counters() const { return counters_; }
+  size_t memoryBytes() const;
+
+ private:
+  void closeLine(std::vector<Subframe>& out);
+  void appendToLine(CanonicalPing&& ping, std::vector<Subframe>& out);
+  void emit(std::vector<Subframe>& out);
+  bool deviates(double heading_rad) const;
+
+  LineSegmenterOptions line_options_;
+  SubframeOptions options_;
+  SubframeGeometry geometry_;
+  bool line_open_ = false;
+  int line_id_ = -1;
+  double line_sin_sum_ = 0.0, line_cos_sum_ = 0.0;  // circular mean heading of the line
+  std::vector<CanonicalPing> candidate_;            // steady pings before the line opens
+  std::vector<CanonicalPing> current_;              // pings of the subframe being filled
+  int64_t last_utime_us_ = 0;
+  int64_t next_subframe_id_ = 0;
+  SubframeBuilderCounters counters_;
+};
+
+}  // namespace sss::subframe

@@ -1,0 +1,181 @@
+// Ping-nav fusion: interpolation, bounded waiting, drops that are counted and never guessed,
+// reordering, duplicates, altitude fallback and the lever arm; hand-built nav and pings.
+#include "pipeline/subframe/ping_nav_fusion.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace sss::subframe {
+namespace {
+
+constexpr int64_t kT0 = 1780300800000000;
+
+NavInput nav(double t_s, double north_m, double heading_rad, double altitude_m = 18.0, bool altitude_valid = true) {
+  NavInput n;
+  n.utime_us = kT0 + static_cast<int64_t>(std::llround(t_s * 1e6));
+  n.position_ned_m = Eigen::Vector3d(north_m, 0.0, 22.0);
+  n.heading_rad = heading_rad;
+  n.altitude_m = altitude_m;
+  n.altitude_valid = altitude_valid;
+  n.distance_travelled_m = north_m;
+  return n;
+}
+
+PingInput ping(double t_s, int64_t number, double altitude_m = -1.0) {
+  PingInput p;
+  p.utime_us = kT0 + static_cast<int64_t>(std::llround(t_s * 1e6));
+  p.ping_number = number;
+  p.sample_interval_s = 2e-5;
+  p.altitude_m = altitude_m;
+  p.port.assign(10, 1.0f);
+  p.starboard.assign(10, 1.0f);
+  return p;
+}
+
+// Pings released as soon as one nav sample lies past them (no look-ahead for the heading rate).
+PingNavFusionOptions immediate() {
+  PingNavFusionOptions options;
+  options.heading_rate_window_s = 0.0;
+  return options;
+}
+
+TEST(PingNavFusion, WaitsHalfAHeadingRateWindowPastThePingForACentredRate) {
+  PingNavFusion fusion({});  // 1 s window
+  std::vector<FusedPing> out;
+  for (int i = 0; i <= 10; ++i) {
+    fusion.addNav(nav(0.1 * i, 0.2 * i, 0.02 * i * i), out);  // heading accelerating
+    if (i == 3) fusion.addPing(ping(0.3, 1), out);
+    if (i < 8) {
+      EXPECT_TRUE(out.empty()) << i;
+    }
+  }
+  ASSERT_EQ(out.size(), 1u);
+  // Rate over [0.0, 0.8] s: (0.02 * 64 - 0) / 0.8.
+  EXPECT_NEAR(out[0].heading_rate_rad_s, 1.6, 1e-9);
+}
+
+TEST(PingNavFusion, InterpolatesPositionAndSlerpsAttitudeAtThePingTime) {
+  PingNavFusion fusion(immediate());
+  std::vector<FusedPing> out;
+  fusion.addNav(nav(0.0, 0.0, 0.2), out);
+  fusion.addPing(ping(0.25, 1), out);
+  EXPECT_TRUE(out.empty());  // waits for the nav sample after it
+  fusion.addNav(nav(0.5, 1.0, 0.4, 20.0), out);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_NEAR(out[0].T_world_body.translation.x(), 0.5, 1e-9);
+  EXPECT_NEAR(out[0].heading_rad, 0.3, 1e-9);
+  EXPECT_NEAR(sss::core::eulerFromQuaternion(out[0].T_world_body.rotation).heading_rad, 0.3, 1e-9);
+  EXPECT_NEAR(out[0].altitude_m, 19.0, 1e-9);
+  EXPECT_NEAR(out[0].distance_travelled_m, 0.5, 1e-9);
+  EXPECT_NEAR(out[0].heading_rate_rad_s, 0.4, 1e-9);  // 0.2 rad in 0.5 s
+  EXPECT_EQ(fusion.counters().pings_out, 1u);
+}
+
+TEST(PingNavFusion, InterpolatesHeadingAcrossNorth) {
+  PingNavFusion fusion(immediate());
+  std::vector<FusedPing> out;
+  fusion.addNav(nav(0.0, 0.0, 3.1), out);
+  fusion.addNav(nav(0.5, 1.0, -3.1), out);
+  fusion.addPing(ping(0.25, 1), out);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_NEAR(std::abs(out[0].heading_rad), M_PI, 1e-9);
+}
+
+TEST(PingNavFusion, DropsAPingWhoseNavNeverComes) {
+  PingNavFusionOptions options = immediate();
+  options.max_ping_wait_s = 1.0;
+  PingNavFusion fusion(options);
+  std::vector<FusedPing> out;
+  fusion.addNav(nav(0.0, 0.0, 0.0), out);
+  for (int i = 1; i <= 8; ++i) fusion.addPing(ping(0.25 * i, i), out);  // nav silent for 2 s
+  EXPECT_TRUE(out.empty());
+  EXPECT_EQ(fusion.counters().dropped_no_nav, 3u);  // pings more than 1 s behind the newest one
+  fusion.finish(out);
+  EXPECT_TRUE(out.empty());
+  EXPECT_EQ(fusion.counters().dropped_no_nav, 8u);
+  EXPECT_EQ(fusion.pendingPings(), 0u);
+}
+
+TEST(PingNavFusion, DropsPingsInsideANavGapAndBeforeTheHistory) {
+  PingNavFusionOptions options = immediate();
+  options.max_nav_gap_s = 0.5;
+  PingNavFusion fusion(options);
+  std::vector<FusedPing> out;
+  fusion.addNav(nav(1.0, 0.0, 0.0), out);
+  fusion.addPing(ping(0.5, 1), out);  // before any nav: too old once nav is there
+  fusion.addNav(nav(3.0, 4.0, 0.0), out);
+  fusion.addPing(ping(2.0, 2), out);  // bracketed by nav 2 s apart
+  fusion.addNav(nav(3.2, 4.4, 0.0), out);
+  fusion.addPing(ping(3.1, 3), out);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].ping.ping_number, 3);
+  EXPECT_EQ(fusion.counters().dropped_too_old, 1u);
+  EXPECT_EQ(fusion.counters().dropped_nav_gap, 1u);
+  EXPECT_EQ(fusion.counters().droppedWithoutNav(), 2u);
+}
+
+TEST(PingNavFusion, ReordersWaitingPingsAndDropsLateOnesAndDuplicates) {
+  PingNavFusion fusion(immediate());
+  std::vector<FusedPing> out;
+  fusion.addNav(nav(0.0, 0.0, 0.0), out);
+  fusion.addPing(ping(0.50, 3), out);
+  fusion.addPing(ping(0.25, 2), out);  // late but the other one still waits: reordered
+  fusion.addPing(ping(0.50, 3), out);  // duplicate ping number
+  fusion.addNav(nav(0.5, 1.0, 0.0), out);
+  ASSERT_EQ(out.size(), 2u);
+  EXPECT_EQ(out[0].ping.ping_number, 2);
+  EXPECT_EQ(out[1].ping.ping_number, 3);
+  fusion.addPing(ping(0.4, 4), out);  // older than one released: dropped
+  EXPECT_EQ(out.size(), 2u);
+  const auto& c = fusion.counters();
+  EXPECT_EQ(c.pings_reordered, 1u);
+  EXPECT_EQ(c.pings_duplicate, 1u);
+  EXPECT_EQ(c.pings_out_of_order, 1u);
+  EXPECT_EQ(c.pings_in, 4u);
+}
+
+TEST(PingNavFusion, FallsBackToThePingAltitudeAndDropsWithoutAny) {
+  PingNavFusion fusion(immediate());
+  std::vector<FusedPing> out;
+  fusion.addNav(nav(0.0, 0.0, 0.0, 18.0, false), out);
+  fusion.addNav(nav(0.5, 1.0, 0.0, 18.0, false), out);
+  fusion.addPing(ping(0.25, 1, 17.5), out);
+  fusion.addPing(ping(0.4, 2, -1.0), out);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_TRUE(out[0].altitude_from_ping);
+  EXPECT_NEAR(out[0].altitude_m, 17.5, 1e-6);
+  EXPECT_EQ(fusion.counters().altitude_from_ping, 1u);
+  EXPECT_EQ(fusion.counters().dropped_no_altitude, 1u);
+}
+
+TEST(PingNavFusion, LeverArmBelowTheBodyShortensTheAltitude) {
+  PingNavFusionOptions options = immediate();
+  options.sonar_position_body_m = Eigen::Vector3d(1.0, 0.0, 0.5);
+  PingNavFusion fusion(options);
+  std::vector<FusedPing> out;
+  fusion.addNav(nav(0.0, 0.0, 0.0), out);
+  fusion.addNav(nav(0.5, 0.0, 0.0), out);
+  fusion.addPing(ping(0.25, 1), out);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_NEAR(out[0].altitude_m, 17.5, 1e-9);
+}
+
+TEST(PingNavFusion, ABurstOfPingsWithoutNavStaysBoundedAndCounted) {
+  PingNavFusionOptions options = immediate();
+  options.max_pending_pings = 64;
+  options.max_ping_wait_s = 1000.0;
+  PingNavFusion fusion(options);
+  std::vector<FusedPing> out;
+  fusion.addNav(nav(0.0, 0.0, 0.0), out);
+  for (int i = 1; i <= 5000; ++i) fusion.addPing(ping(0.001 * i, i), out);
+  EXPECT_LE(fusion.pendingPings(), 64u);
+  EXPECT_EQ(fusion.counters().dropped_no_nav, 5000u - 64u);
+  fusion.addNav(nav(10.0, 0.0, 0.0), out);  // 10 s gap: the survivors are dropped as nav gap
+  EXPECT_EQ(fusion.pendingPings(), 0u);
+  EXPECT_EQ(fusion.counters().dropped_nav_gap, 64u);
+  EXPECT_TRUE(out.empty());
+}
+
+}  // namespace
+}  // namespace sss::subframe

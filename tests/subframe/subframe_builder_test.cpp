@@ -1,0 +1,147 @@
+// Line segmentation and subframe cutting on synthetic rows: subframe boundaries and centre
+// pings at line ends, lines shorter than N, turns and heading changes.
+#include "pipeline/subframe/subframe_builder.hpp"
+
+#include <gtest/gtest.h>
+
+namespace sss::subframe {
+namespace {
+
+struct Rows {
+  int64_t next_number = 0;
+  int64_t utime_us = 1780300800000000;
+  std::vector<Subframe> out;
+  SubframeBuilder builder;
+
+  explicit Rows(const SubframeOptions& options = {})
+      : builder(LineSegmenterOptions{}, options, SubframeGeometry{4, 0.1, 0.0, {}}) {}
+
+  void add(int count, double heading_rad, bool turn = false) {
+    for (int i = 0; i < count; ++i) {
+      CanonicalPing row;
+      row.fused.ping.ping_number = next_number++;
+      row.fused.ping.utime_us = utime_us;
+      utime_us += 250000;
+      row.fused.heading_rad = heading_rad;
+      row.turn = turn;
+      row.intensity.assign(8, static_cast<float>(row.fused.ping.ping_number));
+      row.mask.assign(8, turn ? kMaskTurn : kMaskValid);
+      builder.addPing(std::move(row), out);
+    }
+  }
+};
+
+TEST(SubframeBuilder, CutsFullSubframesAndEmitsALongEnoughTailWithItsOwnCentre) {
+  Rows rows;
+  rows.add(530, 0.0);  // 200 + 200 + 130
+  ASSERT_EQ(rows.out.size(), 2u);  // emitted as soon as the 200th ping arrives
+  rows.add(60, 0.0, true);         // turn: the line ends
+  ASSERT_EQ(rows.out.size(), 3u);
+  const Subframe& a = rows.out[0];
+  const Subframe& b = rows.out[1];
+  const Subframe& tail = rows.out[2];
+  EXPECT_EQ(a.pings.front().ping_number, 0);
+  EXPECT_EQ(a.pings.back().ping_number, 199);
+  EXPECT_EQ(a.centre_ping_index, 100);
+  EXPECT_EQ(b.pings.front().ping_number, 200);
+  EXPECT_EQ(tail.rows(), 130);
+  EXPECT_EQ(tail.pings.front().ping_number, 400);
+  EXPECT_EQ(tail.centre_ping_index, 65);
+  EXPECT_EQ(tail.centre().ping_number, 465);
+  EXPECT_EQ(tail.image[static_cast<size_t>(65) * 8], 465.0f);  // rows carry their own pings
+  EXPECT_EQ(a.id, 0);
+  EXPECT_EQ(tail.id, 2);
+  EXPECT_EQ(a.line_id, tail.line_id);
+  EXPECT_EQ(rows.builder.counters().partial_subframes, 1u);
+}
+
+TEST(SubframeBuilder, ShortLinesGiveOnePartialSubframeOrAreDroppedAndCounted) {
+  Rows rows;
+  rows.add(150, 0.0);        // line 0: shorter than N but >= min_pings
+  rows.add(40, 0.0, true);
+  rows.add(45, M_PI);        // line 1: < min_pings (50)
+  rows.add(40, 0.0, true);
+  rows.add(210, 0.0);        // line 2: 200 + 10
+  rows.builder.finish(rows.out);
+  ASSERT_EQ(rows.out.size(), 2u);
+  EXPECT_EQ(rows.out[0].line_id, 0);
+  EXPECT_EQ(rows.out[0].rows(), 150);
+  EXPECT_EQ(rows.out[0].centre().ping_number, 75);
+  EXPECT_EQ(rows.out[1].line_id, 2);
+  EXPECT_EQ(rows.out[1].rows(), 200);
+  EXPECT_EQ(rows.out[1].pings.front().ping_number, 275);  // 150 + 40 + 45 + 40
+  const auto& c = rows.builder.counters();
+  EXPECT_EQ(c.lines, 3u);
+  EXPECT_EQ(c.dropped_short_tails, 2u);
+  EXPECT_EQ(c.dropped_tail_pings, 55u);
+  EXPECT_EQ(c.turn_pings, 80u);
+}
+
+TEST(SubframeBuilder, AHeadingChangeOrAPingGapEndsTheLine) {
+  Rows rows;
+  rows.add(120, 0.0);
+  rows.add(120, 0.5);  // > 0.1 rad off the line's heading without a turn signature
+  rows.utime_us += 10000000;  // 10 s without pings
+  rows.add(120, 0.5);
+  rows.builder.finish(rows.out);
+  ASSERT_EQ(rows.out.size(), 3u);
+  EXPECT_EQ(rows.out[0].line_id, 0);
+  EXPECT_EQ(rows.out[1].line_id, 1);
+  EXPECT_EQ(rows.out[2].line_id, 2);
+  EXPECT_EQ(rows.out[1].pings.front().ping_number, 120);
+}
+
+TEST(SubframeBuilder, ASteadyBlipInsideATurnDoesNotOpenALine) {
+  Rows rows;
+  rows.add(30, 0.0, true);
+  rows.add(5, 1.0);  // fewer than min_steady_pings (8)
+  rows.add(30, 0.0, true);
+  rows.builder.finish(rows.out);
+  EXPECT_TRUE(rows.out.empty());
+  EXPECT_EQ(rows.builder.counters().lines, 0u);
+  EXPECT_EQ(rows.builder.counters().turn_pings, 65u);
+}
+
+}  // namespace
+}  // namespace sss::subframe
+
+#include "pipeline/subframe/subframe_buffer.hpp"
+
+namespace sss::subframe {
+namespace {
+
+TEST(SubframeBufferOptions, ReadsEverySubSectionAndRejectsTyposAndBadValues) {
+  sss::core::Config config = sss::core::Config::fromString(R"(
+subframe_buffer:
+  fusion: {sonar_position_body_m: [1.2, 0.0, 0.4], max_nav_gap_s: 0.3}
+  canonical: {bins_per_side: 1500, bin_size_m: 0.05}
+  lines: {min_steady_pings: 12}
+  subframes: {pings_per_subframe: 100, min_pings: 40, intensity_bits: 8}
+)");
+  sss::core::ConfigSection section = config.section("subframe_buffer");
+  SubframeBufferOptions options;
+  readSubframeBufferOptions(section, options);
+  ASSERT_TRUE(config.ok()) << config.problemReport();
+  EXPECT_DOUBLE_EQ(options.fusion.sonar_position_body_m.x(), 1.2);
+  EXPECT_DOUBLE_EQ(options.fusion.max_nav_gap_s, 0.3);
+  EXPECT_EQ(options.canonical.bins_per_side, 1500);
+  EXPECT_EQ(options.lines.min_steady_pings, 12);
+  EXPECT_EQ(options.subframes.pings_per_subframe, 100);
+  EXPECT_EQ(options.subframes.intensity_bits, 8);
+
+  sss::core::Config bad = sss::core::Config::fromString(R"(
+subframe_buffer:
+  canonical: {bin_size: 0.05}
+  subframes: {pings_per_subframe: 100, min_pings: 150, intensity_bits: 12}
+)");
+  sss::core::ConfigSection bad_section = bad.section("subframe_buffer");
+  SubframeBufferOptions bad_options;
+  readSubframeBufferOptions(bad_section, bad_options);
+  const std::string report = bad.problemReport();
+  EXPECT_NE(report.find("subframe_buffer.canonical.bin_size"), std::string::npos) << report;
+  EXPECT_NE(report.find("subframe_buffer.subframes.intensity_bits"), std::string::npos) << report;
+  EXPECT_NE(report.find("subframe_buffer.subframes.min_pings"), std::string::npos) << report;
+}
+
+}  // namespace
+}  // namespace sss::subframe
