@@ -1,0 +1,95 @@
+// Dense matching of two geo-referenced side-scan images: DR-initialised PatchMatch with a masked
+// ZNCC patch distance (paper Sec. "Data Association", Alg. 1), at any relative heading.
+#pragma once
+
+#include <opencv2/core.hpp>
+
+#include <cstdint>
+#include <vector>
+
+#include "pipeline/core/config.hpp"
+
+namespace sss::matcher {
+
+// One canonical side-scan image with its geo-reference: row = ping, column = ground-range bin
+// (port mirrored left of nadir, starboard right). All matrices have the image's size except
+// heading_rad (rows x 1).
+struct GeoImage {
+  cv::Mat1f intensity;      // normalised intensities
+  cv::Mat1b valid;          // 255 where the pixel may be matched (masks: nadir, far range, turns)
+  cv::Mat2f position_ne_m;  // local north/east of every pixel's seabed point (DR or optimised poses)
+  cv::Mat1f heading_rad;    // per-row vehicle heading (rows x 1), clockwise from north; unused here
+  cv::Mat1f side;           // optional, unused
+};
+
+struct DenseMatcherOptions {
+  int patch_size = 13;   // paper: 13 (odd)
+  int iterations = 10;   // paper: 10 rounds of random search + propagation
+  // Stop before `iterations` once fewer than this fraction of the field changed in a round.
+  double min_update_fraction = 0.005;
+  // Search window around the geo-referenced initial guess, per image axis: max_offset_px (the
+  // paper's o_max, 5 px) plus max_dr_error_m converted to pixels with A's own pixel spacing along
+  // that axis. The paper's 5 px assumes DR error below a few pixels; lines of an AUV survey
+  // differ by metres, so the DR term dominates (5 m at 0.13 m bins is ~38 columns).
+  double max_offset_px = 5.0;
+  double max_dr_error_m = 5.0;
+  // A pixel of A whose nearest valid geo-referenced pixel of B is farther than this has no
+  // overlap with B and is not matched.
+  double max_init_distance_m = 1.0;
+  double min_zncc = 0.6;             // matches below are dropped
+  double min_valid_fraction = 0.8;   // of a patch's pixels valid in both images
+  double min_patch_stddev = 1e-3;    // texture-free patches (intensity units) never match
+  bool forward_backward_check = true;
+  double max_fb_error_px = 1.5;
+  // Of a match's 8 lattice neighbours, how many must have an offset within 1 px of its own.
+  int min_coherent_neighbours = 4;
+  bool subpixel = true;              // parabola fit of ZNCC around the integer optimum
+  double random_search_ratio = 0.5;  // Barnes et al.: window shrinks by this factor per sample
+  int stride = 2;                    // match every stride-th row and column of A
+  int threads = 2;
+  std::uint64_t seed = 1;            // random search is seeded per pixel: same output for any threads
+};
+
+// A match from pixel (row_a, col_a) of A to the continuous position (row_b, col_b) of B.
+struct Correspondence {
+  float row_a = 0.0f;
+  float col_a = 0.0f;
+  float row_b = 0.0f;
+  float col_b = 0.0f;
+  float zncc = 0.0f;
+};
+
+// Wall-clock seconds of each stage of one match() call and the pixel counts behind them.
+struct MatchTimings {
+  double kd_tree_s = 0.0;         // building the kd-tree over B's valid geo-referenced pixels
+  double initialisation_s = 0.0;  // kd-tree queries and resampling B onto A's pixel grid
+  double patch_match_s = 0.0;     // random search + propagation, forward (A -> B)
+  double consistency_s = 0.0;     // backward PatchMatch (B -> A), FB check, sub-pixel, thresholds
+  double total_s = 0.0;
+  long overlapping_pixels = 0;    // valid A pixels on the stride grid with a B pixel within reach
+  long matches = 0;
+};
+
+class DenseMatcher {
+ public:
+  // Throws std::invalid_argument for options validateDenseMatcherOptions rejects.
+  explicit DenseMatcher(DenseMatcherOptions options);
+
+  // Correspondences from A to B, at most one per stride-grid pixel of A. Returns none when the
+  // images do not overlap according to their geo-references. Throws std::invalid_argument when
+  // the matrices of an image disagree in size or type (a programming error upstream).
+  std::vector<Correspondence> match(const GeoImage& a, const GeoImage& b, MatchTimings* timings = nullptr) const;
+
+  const DenseMatcherOptions& options() const { return options_; }
+
+ private:
+  DenseMatcherOptions options_;
+};
+
+// Empty when the options are usable; otherwise what is wrong with which field.
+std::vector<std::string> validateDenseMatcherOptions(const DenseMatcherOptions& options);
+
+// Fills options from a YAML section (keys = field names) and records every problem in it.
+void readDenseMatcherOptions(sss::core::ConfigSection& section, DenseMatcherOptions& options);
+
+}  // namespace sss::matcher
