@@ -22,6 +22,7 @@ struct NodeOptions {
   std::string subframe_channel = "SSS_SUBFRAME";
   double horizontal_beam_width_rad = 0.0087;  // carried in the message for the matcher
   double vertical_beam_width_rad = 0.87;
+  double idle_flush_s = 5.0;  // no ping for this long (host time): close the open line
 };
 
 }  // namespace
@@ -61,6 +62,7 @@ int main(int argc, char** argv) {
     section.optional("subframe_channel", options.subframe_channel, {nonEmpty()});
     section.optional("horizontal_beam_width_rad", options.horizontal_beam_width_rad, {inRange(0.0, 1.0)});
     section.optional("vertical_beam_width_rad", options.vertical_beam_width_rad, {inRange(0.0, 3.2)});
+    section.optional("idle_flush_s", options.idle_flush_s, {inRange(0.1, 3600.0)});
     section.rejectUnknownKeys();
     if (!config.ok()) {
       std::fprintf(stderr, "sss-subframe-buffer: invalid configuration:\n%s", config.problemReport().c_str());
@@ -93,9 +95,23 @@ int main(int argc, char** argv) {
     buffer.addNav(sss::subframe::fromNavMessage(message), subframes);
     publishAll();
   });
+  int64_t last_ping_monotonic_us = 0;
+  bool flushed_since_last_ping = true;
   loop.bus().subscribe<sss_msgs::ping_t>(options.ping_channel, [&](const sss_msgs::ping_t& message) {
-    buffer.addPing(sss::subframe::fromPingMessage(message, sss::core::monotonicUtime()), subframes);
+    last_ping_monotonic_us = sss::core::monotonicUtime();
+    flushed_since_last_ping = false;
+    buffer.addPing(sss::subframe::fromPingMessage(message, last_ping_monotonic_us), subframes);
     publishAll();
+  });
+  // When the sonar stops (end of the mission, a stop between surveys) nothing else ends the open
+  // line: after idle_flush_s without pings its tail becomes a subframe instead of waiting forever.
+  loop.addTimer(0.5, [&] {
+    if (flushed_since_last_ping) return;
+    if (sss::core::monotonicUtime() - last_ping_monotonic_us < static_cast<int64_t>(options.idle_flush_s * 1e6)) return;
+    buffer.finish(subframes);
+    publishAll();
+    flushed_since_last_ping = true;
+    spdlog::info("no ping for {} s: closed the open survey line", options.idle_flush_s);
   });
 
   // Counters and faults (logged once per kind, counted always).
