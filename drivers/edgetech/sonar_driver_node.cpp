@@ -183,12 +183,6 @@ int main(int argc, char** argv) {
   auto publish = [&](const sss::edgetech::DriverPing& ping) {
     loop.bus().publish(options.ping_channel, sss::edgetech::toPingMessage(ping), ping.ping.last_arrival_us);
   };
-  auto logFaults = [&] {
-    for (const std::string& fault : driver.takeNewFaultMessages()) {
-      health.recordError("sonar_input", fault, nowUtime());
-      spdlog::warn("{} (further faults of this kind are counted in SSS_STATUS)", fault);
-    }
-  };
   auto updateCounters = [&] {
     const auto& parser = driver.parserCounters();
     const auto& assembler = driver.assemblerCounters();
@@ -208,7 +202,7 @@ int main(int argc, char** argv) {
       health.setCounter("recorded_bytes", static_cast<double>(driver.recorder().bytesWritten()));
       health.setCounter("record_errors", static_cast<double>(driver.recorder().writeErrors()));
     }
-    logFaults();
+    loop.reportFaults("sonar_input", driver.takeNewFaultMessages());
   };
   loop.addTimer(1.0, updateCounters);
 
@@ -233,10 +227,7 @@ int main(int argc, char** argv) {
         ++xtf_pings_published;
       });
       sss::xtf::XtfReader& reader = xtf_replay->reader();
-      for (const std::string& fault : reader.takeNewFaultMessages()) {
-        health.recordError("sonar_input", fault, nowUtime());
-        spdlog::warn("{} (further faults of this kind are counted in SSS_STATUS)", fault);
-      }
+      loop.reportFaults("sonar_input", reader.takeNewFaultMessages());
       health.setCounter("xtf_pings", static_cast<double>(reader.counters().pings));
       health.setCounter("xtf_packets_skipped", static_cast<double>(reader.counters().packets_skipped));
       health.setCounter("xtf_corrupt_records", static_cast<double>(reader.counters().corruptRecords()));

@@ -173,10 +173,7 @@ int main(int argc, char** argv) {
     health.setCounter("nmea_garbage_bytes", static_cast<double>(stream.garbage_bytes));
     health.setCounter("ins_epochs", static_cast<double>(bridge.assemblerCounters().epochs));
     health.setCounter("ins_epochs_out_of_order", static_cast<double>(bridge.epochsOutOfOrder()));
-    for (const std::string& fault : bridge.takeNewFaultMessages()) {
-      health.recordError("ins_input", fault, sss::core::nowUtime());
-      spdlog::warn("{} (further faults of this kind are counted in SSS_STATUS)", fault);
-    }
+    loop.reportFaults("ins_input", bridge.takeNewFaultMessages());
   });
 
   std::string error;

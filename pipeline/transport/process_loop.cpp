@@ -145,6 +145,13 @@ int ProcessLoop::run() {
   return 0;
 }
 
+void ProcessLoop::reportFaults(const std::string& kind, const std::vector<std::string>& faults) {
+  for (const std::string& fault : faults) {
+    health_.recordError(kind, fault, sss::core::nowUtime());
+    spdlog::warn("{} (further faults of this kind are counted in SSS_STATUS)", fault);
+  }
+}
+
 sss_msgs::status_t ProcessLoop::buildStatus() {
   const sss::core::HealthSnapshot snap = health_.snapshot(sss::core::monotonicUtime());
   sss_msgs::status_t status;

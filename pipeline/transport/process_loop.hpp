@@ -42,6 +42,11 @@ class ProcessLoop {
   void stop();
   bool stopRequested() const;
 
+  // Faults a library reports once per kind (its takeNewFaultMessages()): each is counted as an
+  // error of `kind` in SSS_STATUS and logged as a warning, so a bad input stream is visible
+  // without flooding the log.
+  void reportFaults(const std::string& kind, const std::vector<std::string>& faults);
+
   // Builds the status message of this process now (also used by tests).
   sss_msgs::status_t buildStatus();
 

@@ -72,6 +72,18 @@ TEST(ProcessLoop, PublishesStatusWithChannelFigures) {
   EXPECT_DOUBLE_EQ(status.counter_value[0], 2.0);
 }
 
+TEST(ProcessLoop, ReportedFaultsAreCountedInTheStatus) {
+  ProcessLoop loop(testOptions(10.0));
+  loop.reportFaults("jsf_input", {"JSF message at byte 10: bad header", "JSF stream at byte 99: garbage"});
+  loop.reportFaults("jsf_input", {});
+  const sss_msgs::status_t status = loop.buildStatus();
+  EXPECT_EQ(status.errors_total, 2);
+  EXPECT_EQ(status.last_error, "JSF stream at byte 99: garbage");
+  ASSERT_EQ(status.num_counters, 1);
+  EXPECT_EQ(status.counter_name[0], "error.jsf_input");
+  EXPECT_DOUBLE_EQ(status.counter_value[0], 2.0);
+}
+
 TEST(ProcessLoop, ReadableFileDescriptorCallsItsHandler) {
   ProcessLoop loop(testOptions(10.0));
   int fds[2];
