@@ -1,0 +1,229 @@
+// Relative pose of a subframe pair on hand-built geometry: two survey lines over a flat seabed,
+// exact correspondences with pixel noise and outliers, DR error between the lines.
+#include "pipeline/matcher/relative_pose.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+
+namespace sss::matcher {
+namespace {
+
+using sss::core::Pose;
+
+constexpr double kSeabedDepthM = 58.0;
+constexpr double kAltitudeM = 18.0;
+constexpr int kPings = 200;
+constexpr double kPingSpacingM = 0.5;
+constexpr int kBinsPerSide = 700;
+constexpr double kBinSizeM = 0.1;
+constexpr double kLineSpacingM = 60.0;
+constexpr double kReliefSigmaM = 0.3;  // the default seabed_sigma_m
+
+struct SyntheticPair {
+  RelativePoseInput input;
+  Pose T_a_b_true;
+};
+
+Pose linePose(double north_m, double east_m, double heading_rad) {
+  return Pose(sss::core::quaternionFromEuler(0.0, 0.0, heading_rad),
+              Eigen::Vector3d(north_m, east_m, kSeabedDepthM - kAltitudeM));
+}
+
+// Column of a ground range on a side (+1 starboard, -1 port): port is mirrored left of nadir.
+double columnOf(double ground_range_m, int side) {
+  const double bin = ground_range_m / kBinSizeM;
+  return side > 0 ? kBinsPerSide + bin : kBinsPerSide - 1 - bin;
+}
+
+// Line A heads north at east 0; line B runs at east 60 m, heading north (parallel) or south.
+// B's DR poses are its true poses moved rigidly by 3 m along-track, 2 m laterally and 0.005 rad
+// of heading about its centre: the DR error between the lines that the estimator must remove.
+SyntheticPair makePair(bool anti_parallel, std::uint64_t seed, int num_matches = 1000, double outlier_fraction = 0.2,
+                       bool all_random = false) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> pixel_noise(0.0, 0.5);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  std::normal_distribution<double> relief(0.0, kReliefSigmaM);
+  SyntheticPair pair;
+  RelativePoseInput& in = pair.input;
+  const double b_heading = anti_parallel ? M_PI : 0.0;
+  std::vector<Pose> true_b;
+  for (int i = 0; i < kPings; ++i) {
+    const double s = -50.0 + kPingSpacingM * i;
+    in.dr_poses_a.push_back(linePose(s, 0.0, 0.0));
+    true_b.push_back(linePose(anti_parallel ? -s : s, kLineSpacingM, b_heading));
+    in.altitude_a_m.push_back(kAltitudeM);
+    in.altitude_b_m.push_back(kAltitudeM);
+  }
+  in.centre_a = in.centre_b = kPings / 2;
+  const Eigen::Vector3d centre_b = true_b[in.centre_b].translation;
+  const Eigen::Quaterniond heading_error = sss::core::quaternionFromEuler(0.0, 0.0, 0.005);
+  const Pose T_error(heading_error, centre_b + Eigen::Vector3d(3.0, 2.0, 0.0) - heading_error * centre_b);
+  for (const Pose& p : true_b) in.dr_poses_b.push_back(T_error * p);
+  pair.T_a_b_true = in.dr_poses_a[in.centre_a].inverse() * true_b[in.centre_b];
+
+  in.T_body_sonar = Pose::identity();
+  in.bin_size_m = kBinSizeM;
+  in.first_bin_range_m = 0.0;
+  in.bins_per_side = kBinsPerSide;
+  sss::core::Matrix6d cov = sss::core::Matrix6d::Zero();
+  cov.diagonal() << 16.0, 16.0, 0.25, 1e-4, 1e-4, 4e-4;  // 4 m horizontal, 0.5 m depth, 0.02 rad heading
+  in.dr_covariance_ab = cov;
+
+  // Seabed points in the overlap; each is seen by the ping whose fan plane (constant northing)
+  // contains it. A sees it to starboard; B to port (parallel) or to starboard (anti-parallel).
+  for (int k = 0; k < num_matches; ++k) {
+    const double north = -40.0 + 80.0 * uniform(rng);
+    const double east = 20.0 + 20.0 * uniform(rng);
+    // Seabed relief about the flat seabed, what the landmark depth prior allows for.
+    const double height_m = kAltitudeM + relief(rng) * (std::getenv("RELIEF_SCALE") ? std::atof(std::getenv("RELIEF_SCALE")) : 1.0);
+    // The canonical image's column is the flat-seabed ground range of the true slant range.
+    auto canonicalGroundRange = [&](double across_m) {
+      return std::sqrt(across_m * across_m + height_m * height_m - kAltitudeM * kAltitudeM);
+    };
+    Correspondence c;
+    c.row_a = static_cast<float>((north + 50.0) / kPingSpacingM + pixel_noise(rng));
+    c.col_a = static_cast<float>(columnOf(canonicalGroundRange(east), +1) + pixel_noise(rng));
+    c.row_b = static_cast<float>((anti_parallel ? 50.0 - north : north + 50.0) / kPingSpacingM + pixel_noise(rng));
+    c.col_b = static_cast<float>(columnOf(canonicalGroundRange(kLineSpacingM - east), anti_parallel ? +1 : -1) +
+                                 pixel_noise(rng));
+    if (all_random) {
+      c.row_a = static_cast<float>((kPings - 1) * uniform(rng));
+      c.row_b = static_cast<float>((kPings - 1) * uniform(rng));
+      c.col_a = static_cast<float>((2 * kBinsPerSide - 1) * uniform(rng));
+      c.col_b = static_cast<float>((2 * kBinsPerSide - 1) * uniform(rng));
+    } else if (uniform(rng) < outlier_fraction) {
+      c.col_b = static_cast<float>((2 * kBinsPerSide - 1) * uniform(rng));
+    }
+    c.zncc = 0.9f;
+    in.matches.push_back(c);
+  }
+  return pair;
+}
+
+RelativePoseOptions testOptions() {
+  RelativePoseOptions options;
+  options.range_sigma_m = 0.05;  // the simulated column noise: 0.5 bin of 0.1 m
+  options.time_limit_s = 2.0;    // the machine is shared; the timing is reported, not asserted
+  return options;
+}
+
+struct Errors {
+  Eigen::Vector3d translation_m;  // estimate - truth, in A's centre body frame (x along, y lateral)
+  double nees_translation = 0.0;
+  double nees_full = 0.0;
+};
+
+Errors errorsOf(const SyntheticPair& pair, const RelativePoseResult& result) {
+  Errors e;
+  e.translation_m = result.T_a_b.translation - pair.T_a_b_true.translation;
+  // The covariance lives in the tangent at the estimate: delta = boxMinus(truth, estimate).
+  const sss::core::Vector6d delta = sss::core::boxMinus(pair.T_a_b_true, result.T_a_b);
+  e.nees_translation = delta.head<3>().dot(result.covariance.topLeftCorner<3, 3>().ldlt().solve(delta.head<3>()));
+  e.nees_full = delta.dot(result.covariance.ldlt().solve(delta));
+  return e;
+}
+
+void expectRecoversDrError(bool anti_parallel) {
+  const SyntheticPair pair = makePair(anti_parallel, 7);
+  const RelativePoseResult result = estimateRelativePose(pair.input, testOptions());
+  ASSERT_TRUE(result.accepted) << result.reason;
+  const Errors e = errorsOf(pair, result);
+  std::printf("[%s] inliers %d, error along %.3f m lateral %.3f m depth %.3f m, sigma along %.3f lateral %.3f, "
+              "costs range %.2f plane %.2f, %.3f s (%d RANSAC iterations)\n",
+              anti_parallel ? "anti-parallel" : "parallel", result.num_inliers, e.translation_m.x(),
+              e.translation_m.y(), e.translation_m.z(), std::sqrt(result.covariance(0, 0)),
+              std::sqrt(result.covariance(1, 1)), result.range_cost, result.plane_cost, result.seconds,
+              result.ransac_iterations_run);
+  // DR error was 3 m along and 2 m lateral; the issue asks for 0.3 m in both directions.
+  EXPECT_LT(std::abs(e.translation_m.x()), 0.3);
+  EXPECT_LT(std::abs(e.translation_m.y()), 0.3);
+  // 80 % of 1000 matches are true; a few noisy ones fall outside 3 sigma.
+  EXPECT_GT(result.num_inliers, 700);
+  EXPECT_LT(result.num_inliers, 850);
+}
+
+TEST(RelativePose, RecoversAlongTrackAndLateralDrErrorParallel) { expectRecoversDrError(false); }
+
+TEST(RelativePose, RecoversAlongTrackAndLateralDrErrorAntiParallel) { expectRecoversDrError(true); }
+
+// On a flat seabed, range and plane residuals from two parallel lines fix a landmark given the
+// two sonar positions, wherever B is laterally: a lateral shift is absorbed by landmark depth.
+// The seabed prior from altimetry pins the depths and so the lateral offset.
+TEST(RelativePose, SeabedPriorMakesLateralOffsetObservable) {
+  const SyntheticPair pair = makePair(false, 11);
+  const double dr_lateral_sigma_m = std::sqrt(pair.input.dr_covariance_ab(1, 1));
+  RelativePoseOptions with_prior = testOptions();
+  RelativePoseOptions without_prior = testOptions();
+  without_prior.use_seabed_prior = false;
+  const RelativePoseResult a = estimateRelativePose(pair.input, with_prior);
+  const RelativePoseResult b = estimateRelativePose(pair.input, without_prior);
+  ASSERT_TRUE(a.accepted) << a.reason;
+  const Errors ea = errorsOf(pair, a);
+  const Eigen::Vector3d eb = b.T_a_b.translation - pair.T_a_b_true.translation;
+  const double sigma_with = std::sqrt(a.covariance(1, 1));
+  const double sigma_without = std::sqrt(b.covariance(1, 1));
+  std::printf("with seabed prior: lateral error %.3f m sigma %.3f m; without: lateral error %.3f m sigma %.3f m "
+              "(accepted %d: %s); DR lateral sigma %.1f m\n",
+              ea.translation_m.y(), sigma_with, eb.y(), sigma_without, b.accepted, b.reason.c_str(), dr_lateral_sigma_m);
+  EXPECT_LT(std::abs(ea.translation_m.y()), 0.3);
+  EXPECT_LT(sigma_with, 0.1 * dr_lateral_sigma_m);
+  // Without the prior the lateral offset stays at the DR guess, with the DR prior's uncertainty.
+  EXPECT_GT(std::abs(eb.y()), 1.0);
+  EXPECT_GT(sigma_without, 0.5 * dr_lateral_sigma_m);
+}
+
+// Normalised estimation error squared over a batch of noise/outlier/RANSAC seeds: near its
+// dimension when the reported covariance is consistent.
+TEST(RelativePose, CovarianceIsConsistentOverSeeds) {
+  double nees_translation = 0.0, nees_full = 0.0, seconds = 0.0;
+  int runs = 0;
+  for (std::uint64_t seed = 100; seed < 120; ++seed) {
+    const SyntheticPair pair = makePair(seed % 2 == 1, seed);
+    RelativePoseOptions options = testOptions();
+    options.seed = seed;
+    const RelativePoseResult result = estimateRelativePose(pair.input, options);
+    ASSERT_TRUE(result.accepted) << "seed " << seed << ": " << result.reason;
+    const Errors e = errorsOf(pair, result);
+    if (std::getenv("RELPOSE_DEBUG"))
+      std::printf("seed %d err %.3f %.3f %.3f sig %.3f %.3f %.3f rot err %.4f %.4f %.4f sig %.4f %.4f %.4f\n", int(seed),
+                  e.translation_m.x(), e.translation_m.y(), e.translation_m.z(), std::sqrt(result.covariance(0, 0)),
+                  std::sqrt(result.covariance(1, 1)), std::sqrt(result.covariance(2, 2)),
+                  sss::core::boxMinus(pair.T_a_b_true, result.T_a_b)(3), sss::core::boxMinus(pair.T_a_b_true, result.T_a_b)(4),
+                  sss::core::boxMinus(pair.T_a_b_true, result.T_a_b)(5), std::sqrt(result.covariance(3, 3)),
+                  std::sqrt(result.covariance(4, 4)), std::sqrt(result.covariance(5, 5)));
+    nees_translation += e.nees_translation;
+    nees_full += e.nees_full;
+    seconds += result.seconds;
+    ++runs;
+  }
+  nees_translation /= runs;
+  nees_full /= runs;
+  std::printf("mean NEES over %d pairs: translation %.2f (dof 3), full pose %.2f (dof 6); %.3f s per pair\n", runs,
+              nees_translation, nees_full, seconds / runs);
+  EXPECT_GT(nees_translation, 0.3 * 3);
+  EXPECT_LT(nees_translation, 3.0 * 3);
+}
+
+TEST(RelativePose, RejectsGeometricallyInconsistentMatches) {
+  const SyntheticPair pair = makePair(false, 5, 1000, 0.0, /*all_random=*/true);
+  const RelativePoseResult result = estimateRelativePose(pair.input, testOptions());
+  std::printf("random matches: accepted %d, %d inliers, reason: %s\n", result.accepted, result.num_inliers,
+              result.reason.c_str());
+  EXPECT_FALSE(result.accepted);
+  EXPECT_FALSE(result.reason.empty());
+}
+
+TEST(RelativePose, RejectsTooFewMatchesWithAReason) {
+  SyntheticPair pair = makePair(false, 3, 10);
+  const RelativePoseResult result = estimateRelativePose(pair.input, testOptions());
+  EXPECT_FALSE(result.accepted);
+  EXPECT_NE(result.reason.find("usable correspondences"), std::string::npos) << result.reason;
+}
+
+}  // namespace
+}  // namespace sss::matcher
