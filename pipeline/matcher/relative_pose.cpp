@@ -1,0 +1,553 @@
+// Relative pose of a subframe pair (paper Sec. "Subframe Pose Estimation", eqs. (1)-(4), Alg. 1):
+// Ceres problem over T_a_b and one landmark per correspondence, inside a RANSAC loop.
+#include "pipeline/matcher/relative_pose.hpp"
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <random>
+#include <sstream>
+
+namespace sss::matcher {
+namespace {
+
+using sss::core::Pose;
+using Clock = std::chrono::steady_clock;
+
+// One side-scan bin seen from one ping: the sonar pose in the centre body frame of its subframe.
+struct BinObservation {
+  Pose T_centre_sonar;
+  double slant_range_m = 0.0;
+  int side = 1;  // +1 starboard (+y of the sonar), -1 port
+};
+
+struct Measurement {
+  BinObservation a;
+  BinObservation b;
+  Eigen::Vector3d landmark_init_a;  // flat-seabed geo-reference in A (frame a)
+  Eigen::Vector3d down_a;           // world down in frame a
+  double seabed_depth_a_m = 0.0;    // down_a . x of the seabed under A's ping (frame a)
+};
+
+// The pose of a fractional row: slerp/lerp between the neighbouring pings.
+std::optional<std::pair<Pose, double>> pingAt(const std::vector<Pose>& poses, const std::vector<double>& altitude_m,
+                                              double row) {
+  const int n = static_cast<int>(poses.size());
+  if (!(row >= 0.0) || row > n - 1) return std::nullopt;
+  const int i0 = std::min(static_cast<int>(std::floor(row)), n - 1);
+  const int i1 = std::min(i0 + 1, n - 1);
+  const double f = row - i0;
+  return std::make_pair(sss::core::interpolate(poses[i0], poses[i1], f),
+                        (1.0 - f) * altitude_m[i0] + f * altitude_m[i1]);
+}
+
+// Canonical transform's flat-seabed model: signed ground range of a column (port mirrored left),
+// slant range r = sqrt(g^2 + h^2).
+double signedGroundRangeM(const RelativePoseInput& in, double column) {
+  if (column < in.bins_per_side) return -(in.first_bin_range_m + (in.bins_per_side - 1 - column) * in.bin_size_m);
+  return in.first_bin_range_m + (column - in.bins_per_side) * in.bin_size_m;
+}
+
+// Seabed point in the fan plane of T_world_sonar at slant range r, altitude h, on the given side
+// (same geometry as sss::subframe::georeferencePixel, in slant range).
+std::optional<Eigen::Vector3d> seabedPoint(const Pose& T_world_sonar, double altitude_m, double slant_range_m,
+                                           int side) {
+  const Eigen::Vector3d normal = T_world_sonar.rotation * Eigen::Vector3d::UnitX();
+  const Eigen::Vector3d down = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d v = down.cross(normal);
+  if (v.norm() < 1e-9) return std::nullopt;
+  v.normalize();
+  if (v.dot(T_world_sonar.rotation * Eigen::Vector3d::UnitY()) < 0.0) v = -v;
+  const Eigen::Vector3d w = v.cross(down);
+  const double nw = normal.dot(w);
+  if (std::abs(nw) < 1e-9) return std::nullopt;
+  const double h = altitude_m;
+  const double t = -h * normal.z() / nw;
+  const double s2 = slant_range_m * slant_range_m - h * h - t * t;
+  if (s2 < 0.0) return std::nullopt;
+  return Eigen::Vector3d(T_world_sonar.translation + h * down + t * w + side * std::sqrt(s2) * v);
+}
+
+// Rotates/translates a double point of T by a Jet-typed point: R * p + t.
+template <typename T>
+Eigen::Matrix<T, 3, 1> inverseTransform(const Pose& pose, const Eigen::Matrix<T, 3, 1>& p) {
+  const Eigen::Matrix3d Rt = pose.rotation.toRotationMatrix().transpose();
+  return Rt.cast<T>() * (p - pose.translation.cast<T>());
+}
+
+// paper eq. (1): z = (|pi(x)|, (1,0,0) . pi(x)), whitened by eq. (4): sigma_r and r * alpha.
+template <typename T>
+void binResidual(const Eigen::Matrix<T, 3, 1>& p_sonar, double slant_range_m, double range_sigma_m,
+                 double plane_sigma_m, T* residual) {
+  residual[0] = (p_sonar.norm() - T(slant_range_m)) / T(range_sigma_m);
+  residual[1] = p_sonar.x() / T(plane_sigma_m);
+}
+
+// A's bin: A's centre is the fixed frame, so only the landmark is a parameter.
+struct BinResidualA {
+  BinObservation obs;
+  double range_sigma_m, plane_sigma_m;
+  template <typename T>
+  bool operator()(const T* landmark, T* residual) const {
+    const Eigen::Matrix<T, 3, 1> x(landmark[0], landmark[1], landmark[2]);
+    binResidual<T>(inverseTransform<T>(obs.T_centre_sonar, x), obs.slant_range_m, range_sigma_m, plane_sigma_m,
+                   residual);
+    return true;
+  }
+};
+
+// B's bin: T_a_b = anchor * Exp(delta) with delta = [dt, dr] (our boxPlus), then B's ping moves
+// rigidly with B's centre (paper eq. (2): T_c_b of the ping is DR and fixed).
+struct BinResidualB {
+  BinObservation obs;
+  const Pose* anchor;
+  double range_sigma_m, plane_sigma_m;
+  template <typename T>
+  bool operator()(const T* delta, const T* landmark, T* residual) const {
+    const Eigen::Matrix<T, 3, 1> x(landmark[0], landmark[1], landmark[2]);
+    Eigen::Matrix<T, 3, 1> y = inverseTransform<T>(*anchor, x);
+    y -= Eigen::Matrix<T, 3, 1>(delta[0], delta[1], delta[2]);
+    const T minus_dr[3] = {-delta[3], -delta[4], -delta[5]};
+    Eigen::Matrix<T, 3, 1> z;
+    ceres::AngleAxisRotatePoint(minus_dr, y.data(), z.data());
+    binResidual<T>(inverseTransform<T>(obs.T_centre_sonar, z), obs.slant_range_m, range_sigma_m, plane_sigma_m,
+                   residual);
+    return true;
+  }
+};
+
+// Seabed prior: the landmark lies on the seabed under A's ping (sonar depth + altitude). This is
+// what makes the lateral offset between two lines observable.
+struct SeabedResidual {
+  Eigen::Vector3d down_a;
+  double depth_m, sigma_m;
+  template <typename T>
+  bool operator()(const T* landmark, T* residual) const {
+    residual[0] = (T(down_a.x()) * landmark[0] + T(down_a.y()) * landmark[1] + T(down_a.z()) * landmark[2] -
+                   T(depth_m)) /
+                  T(sigma_m);
+    return true;
+  }
+};
+
+// paper eq. (3), second term: boxMinus(T_a_b, T_a_b_dr) whitened with L^-1, Sigma_t = L L^T.
+struct OdometryResidual {
+  const Pose* anchor;
+  Pose dr;
+  Eigen::Matrix<double, 6, 6> sqrt_information;
+  template <typename T>
+  bool operator()(const T* delta, T* residual) const {
+    Eigen::Matrix<T, 6, 1> e;
+    // Translation: R_dr^T (t_anchor + R_anchor dt - t_dr).
+    const Eigen::Matrix3d R_anchor = anchor->rotation.toRotationMatrix();
+    const Eigen::Matrix<T, 3, 1> dt(delta[0], delta[1], delta[2]);
+    const Eigen::Matrix<T, 3, 1> t = anchor->translation.cast<T>() + R_anchor.cast<T>() * dt;
+    e.template head<3>() = inverseTransform<T>(dr, t);
+    // Rotation: Log(R_dr^T R_anchor Exp(dr)).
+    const Eigen::Quaterniond q_fixed = dr.rotation.conjugate() * anchor->rotation;
+    const T qf[4] = {T(q_fixed.w()), T(q_fixed.x()), T(q_fixed.y()), T(q_fixed.z())};
+    T q_delta[4], q[4];
+    ceres::AngleAxisToQuaternion(delta + 3, q_delta);
+    ceres::QuaternionProduct(qf, q_delta, q);
+    if (q[0] < T(0)) {
+      for (T& c : q) c = -c;
+    }
+    T angle_axis[3];
+    ceres::QuaternionToAngleAxis(q, angle_axis);
+    e(3) = angle_axis[0];
+    e(4) = angle_axis[1];
+    e(5) = angle_axis[2];
+    Eigen::Map<Eigen::Matrix<T, 6, 1>> whitened(residual);
+    whitened = sqrt_information.cast<T>() * e;
+    return true;
+  }
+};
+
+Pose applyDelta(const Pose& anchor, const double* delta) {
+  sss::core::Vector6d d;
+  for (int i = 0; i < 6; ++i) d(i) = delta[i];
+  return sss::core::boxPlus(anchor, d);
+}
+
+struct Solved {
+  Pose T_a_b;
+  std::vector<Eigen::Vector3d> landmarks;
+  double final_cost = 0.0;
+  double range_cost = 0.0;  // mean squared whitened residual over A and B bins
+  double plane_cost = 0.0;
+  bool usable = false;
+  std::optional<sss::core::Matrix6d> covariance;
+};
+
+// Builds and solves eq. (3) over the given measurements; optionally the pose covariance, taken
+// after re-anchoring at the solution so that delta = 0 is exactly our [dt, dr] tangent there.
+Solved solve(const std::vector<Measurement>& measurements, const std::vector<int>& subset, const Pose& initial,
+             const Pose& dr, const Eigen::Matrix<double, 6, 6>& sqrt_information, const RelativePoseOptions& options,
+             int max_iterations, double max_seconds, bool with_covariance) {
+  Pose anchor = initial;
+  double delta[6] = {0, 0, 0, 0, 0, 0};
+  std::vector<Eigen::Vector3d> landmarks;
+  landmarks.reserve(subset.size());
+  for (int k : subset) landmarks.push_back(measurements[k].landmark_init_a);
+
+  ceres::Problem::Options problem_options;
+  problem_options.enable_fast_removal = false;
+  ceres::Problem problem(problem_options);
+  problem.AddParameterBlock(delta, 6);
+  for (size_t i = 0; i < subset.size(); ++i) {
+    const Measurement& m = measurements[subset[i]];
+    double* x = landmarks[i].data();
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BinResidualA, 2, 3>(new BinResidualA{
+                                 m.a, options.range_sigma_m, m.a.slant_range_m * options.beam_width_rad}),
+                             nullptr, x);
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BinResidualB, 2, 6, 3>(new BinResidualB{
+                                 m.b, &anchor, options.range_sigma_m, m.b.slant_range_m * options.beam_width_rad}),
+                             nullptr, delta, x);
+    if (options.use_seabed_prior) {
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SeabedResidual, 1, 3>(
+                                   new SeabedResidual{m.down_a, m.seabed_depth_a_m, options.seabed_sigma_m}),
+                               nullptr, x);
+    }
+  }
+  problem.AddResidualBlock(
+      new ceres::AutoDiffCostFunction<OdometryResidual, 6, 6>(new OdometryResidual{&anchor, dr, sqrt_information}),
+      nullptr, delta);
+
+  ceres::Solver::Options solver_options;
+  // Landmarks are the Schur-eliminated block (paper: LM); the pose block is 6x6.
+  solver_options.linear_solver_type = subset.size() > 50 ? ceres::SPARSE_SCHUR : ceres::DENSE_SCHUR;
+  solver_options.max_num_iterations = max_iterations;
+  solver_options.max_solver_time_in_seconds = std::max(max_seconds, 1e-3);
+  solver_options.num_threads = 1;
+  solver_options.logging_type = ceres::SILENT;
+  // The lateral/depth direction is a long shallow valley (constrained only through the seabed
+  // prior): the default relative tolerances stop short of its bottom.
+  solver_options.function_tolerance = 1e-10;
+  solver_options.parameter_tolerance = 1e-10;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem, &summary);
+
+  Solved out;
+  out.usable = summary.IsSolutionUsable();
+  out.final_cost = summary.final_cost;
+  out.T_a_b = applyDelta(anchor, delta);
+  out.landmarks = landmarks;
+  if (!subset.empty()) {
+    double range_sum = 0.0, plane_sum = 0.0;
+    for (size_t i = 0; i < subset.size(); ++i) {
+      const Measurement& m = measurements[subset[i]];
+      double r[2];
+      BinResidualA{m.a, options.range_sigma_m, m.a.slant_range_m * options.beam_width_rad}(landmarks[i].data(), r);
+      range_sum += r[0] * r[0];
+      plane_sum += r[1] * r[1];
+      BinResidualB{m.b, &anchor, options.range_sigma_m, m.b.slant_range_m * options.beam_width_rad}(
+          delta, landmarks[i].data(), r);
+      range_sum += r[0] * r[0];
+      plane_sum += r[1] * r[1];
+    }
+    out.range_cost = range_sum / (2.0 * subset.size());
+    out.plane_cost = plane_sum / (2.0 * subset.size());
+  }
+  if (with_covariance && out.usable) {
+    anchor = out.T_a_b;  // functors read the anchor through a pointer
+    std::fill(delta, delta + 6, 0.0);
+    ceres::Covariance::Options covariance_options;
+    covariance_options.algorithm_type = ceres::SPARSE_QR;
+    ceres::Covariance covariance(covariance_options);
+    const std::vector<std::pair<const double*, const double*>> blocks = {{delta, delta}};
+    if (covariance.Compute(blocks, &problem)) {
+      sss::core::Matrix6d c;
+      covariance.GetCovarianceBlock(delta, delta, c.data());  // row-major; symmetric anyway
+      out.covariance = 0.5 * (c + c.transpose());
+    }
+  }
+  return out;
+}
+
+// Hypothesis check (Alg. 1, HypothesisCheck): with the hypothesis fixed, each landmark is
+// re-triangulated by a few Gauss-Newton steps on its own residuals (A and B bins, seabed prior),
+// starting from A's flat-seabed geo-reference; the match is an inlier when that landmark's
+// whitened cost is below the threshold squared (chi^2 with 2 dof, 1 without the seabed prior).
+struct Score {
+  double range_cost = 0.0;  // sum of squared whitened range residuals, truncated at the threshold
+  double plane_cost = 0.0;  // the same for the plane residuals
+  std::vector<int> inliers;
+};
+
+struct BinInA {
+  Eigen::Vector3d sonar, normal, starboard;  // sonar position, x axis and y axis in frame a
+};
+
+BinInA binInA(const Pose& T_a_sonar) {
+  return {T_a_sonar.translation, T_a_sonar.rotation * Eigen::Vector3d::UnitX(),
+          T_a_sonar.rotation * Eigen::Vector3d::UnitY()};
+}
+
+Score scoreHypothesis(const std::vector<Measurement>& measurements, const std::vector<int>& candidates,
+                      const Pose& T_a_b, const RelativePoseOptions& options, const std::vector<char>* skip) {
+  Score score;
+  const double threshold2 = options.inlier_threshold_sigma * options.inlier_threshold_sigma;
+  for (int k : candidates) {
+    const Measurement& m = measurements[k];
+    const BinInA bins[2] = {binInA(m.a.T_centre_sonar), binInA(T_a_b * m.b.T_centre_sonar)};
+    const double ranges[2] = {m.a.slant_range_m, m.b.slant_range_m};
+    Eigen::Vector3d x = m.landmark_init_a;
+    Eigen::Matrix<double, 5, 1> r;
+    Eigen::Matrix<double, 5, 3> J;
+    const int rows = options.use_seabed_prior ? 5 : 4;
+    auto evaluate = [&] {
+      for (int o = 0; o < 2; ++o) {
+        const Eigen::Vector3d d = x - bins[o].sonar;
+        const double range = d.norm();
+        const double plane_sigma = ranges[o] * options.beam_width_rad;
+        r(2 * o) = (range - ranges[o]) / options.range_sigma_m;  // paper eq. (1), (4)
+        J.row(2 * o) = d.transpose() / (range * options.range_sigma_m);
+        r(2 * o + 1) = bins[o].normal.dot(d) / plane_sigma;
+        J.row(2 * o + 1) = bins[o].normal.transpose() / plane_sigma;
+      }
+      r(4) = (m.down_a.dot(x) - m.seabed_depth_a_m) / options.seabed_sigma_m;
+      J.row(4) = m.down_a.transpose() / options.seabed_sigma_m;
+    };
+    for (int iteration = 0; iteration < 3; ++iteration) {
+      evaluate();
+      const Eigen::MatrixXd Jt = J.topRows(rows).transpose();
+      const Eigen::Matrix3d H = Jt * J.topRows(rows);
+      x -= H.ldlt().solve(Jt * r.head(rows));
+    }
+    evaluate();
+    const bool same_side = (x - bins[1].sonar).dot(bins[1].starboard) * m.b.side > 0.0;
+    const double cost = r.head(rows).squaredNorm();
+    if (same_side && cost < threshold2) score.inliers.push_back(k);
+    if (skip && (*skip)[k]) continue;
+    score.range_cost += same_side ? std::min(r(0) * r(0) + r(2) * r(2), threshold2) : threshold2;
+    score.plane_cost += same_side ? std::min(r(1) * r(1) + r(3) * r(3), threshold2) : threshold2;
+  }
+  return score;
+}
+
+}  // namespace
+
+RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const RelativePoseOptions& options) {
+  const Clock::time_point start = Clock::now();
+  auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
+  RelativePoseResult result;
+  auto reject = [&](const std::string& reason) {
+    result.accepted = false;
+    result.reason = reason;
+    result.seconds = elapsed();
+    return result;
+  };
+
+  const std::vector<std::string> option_problems = validateRelativePoseOptions(options);
+  if (!option_problems.empty()) return reject("invalid options: " + option_problems.front());
+  const int rows_a = static_cast<int>(input.dr_poses_a.size());
+  const int rows_b = static_cast<int>(input.dr_poses_b.size());
+  if (rows_a == 0 || rows_b == 0 || input.altitude_a_m.size() != input.dr_poses_a.size() ||
+      input.altitude_b_m.size() != input.dr_poses_b.size() || input.centre_a < 0 || input.centre_a >= rows_a ||
+      input.centre_b < 0 || input.centre_b >= rows_b || input.bins_per_side <= 0 || !(input.bin_size_m > 0.0)) {
+    return reject("inconsistent input: poses, altitudes, centre rows or bin geometry do not agree; check the subframes");
+  }
+  Eigen::LLT<sss::core::Matrix6d> llt(input.dr_covariance_ab);
+  if (llt.info() != Eigen::Success) return reject("dr_covariance_ab is not positive definite");
+  const sss::core::Matrix6d L = llt.matrixL();
+  const sss::core::Matrix6d sqrt_information = L.inverse();  // whitening: (L^-1 e) has unit covariance
+
+  const Pose T_world_a = input.dr_poses_a[input.centre_a];
+  const Pose T_world_bc = input.dr_poses_b[input.centre_b];
+  const Pose T_a_b_dr = T_world_a.inverse() * T_world_bc;
+  const Eigen::Vector3d down_a = T_world_a.rotation.conjugate() * Eigen::Vector3d::UnitZ();
+
+  // Per-correspondence geometry (paper eq. (2)); matches outside the images or without a seabed
+  // intersection are skipped.
+  std::vector<Measurement> measurements;
+  std::vector<int> match_index;
+  measurements.reserve(input.matches.size());
+  for (size_t k = 0; k < input.matches.size(); ++k) {
+    const Correspondence& c = input.matches[k];
+    const auto ping_a = pingAt(input.dr_poses_a, input.altitude_a_m, c.row_a);
+    const auto ping_b = pingAt(input.dr_poses_b, input.altitude_b_m, c.row_b);
+    if (!ping_a || !ping_b) continue;
+    if (c.col_a < 0 || c.col_a > 2 * input.bins_per_side - 1 || c.col_b < 0 || c.col_b > 2 * input.bins_per_side - 1)
+      continue;
+    const double g_a = signedGroundRangeM(input, c.col_a);
+    const double g_b = signedGroundRangeM(input, c.col_b);
+    const double h_a = ping_a->second, h_b = ping_b->second;
+    Measurement m;
+    const Pose T_world_sonar_a = ping_a->first * input.T_body_sonar;
+    m.a.T_centre_sonar = T_world_a.inverse() * T_world_sonar_a;
+    m.a.slant_range_m = std::sqrt(g_a * g_a + h_a * h_a);
+    m.a.side = g_a < 0.0 ? -1 : 1;
+    m.b.T_centre_sonar = T_world_bc.inverse() * ping_b->first * input.T_body_sonar;
+    m.b.slant_range_m = std::sqrt(g_b * g_b + h_b * h_b);
+    m.b.side = g_b < 0.0 ? -1 : 1;
+    const auto seabed = seabedPoint(T_world_sonar_a, h_a, m.a.slant_range_m, m.a.side);
+    if (!seabed) continue;
+    m.landmark_init_a = T_world_a.inverse() * *seabed;
+    m.down_a = down_a;
+    m.seabed_depth_a_m = down_a.dot(m.a.T_centre_sonar.translation) + h_a;
+    measurements.push_back(m);
+    match_index.push_back(static_cast<int>(k));
+  }
+  const int n = static_cast<int>(measurements.size());
+  if (n < std::max(options.ransac_subset, options.min_inliers)) {
+    std::ostringstream text;
+    text << "only " << n << " usable correspondences (of " << input.matches.size() << "); need at least "
+         << std::max(options.ransac_subset, options.min_inliers);
+    return reject(text.str());
+  }
+
+  // paper Alg. 1: keep a hypothesis only if plane, range and optimisation costs all improve.
+  std::mt19937_64 rng(options.seed);
+  double best_plane = std::numeric_limits<double>::infinity();
+  double best_range = best_plane, best_optimisation = best_plane;
+  std::optional<Pose> best_pose;
+  std::vector<char> in_subset(n, 0);
+  std::vector<int> subset;
+  // Hypotheses are scored on an even sample of the matches (bounded time); the RANSAC winner's
+  // inliers are then re-scored on all of them.
+  std::vector<int> all(n);
+  for (int k = 0; k < n; ++k) all[k] = k;
+  std::vector<int> score_sample;
+  const int sample_size = std::min(n, options.ransac_score_sample);
+  for (int i = 0; i < sample_size; ++i) score_sample.push_back(static_cast<int>(static_cast<long>(i) * n / sample_size));
+  const double ransac_budget_s = 0.6 * options.time_limit_s;
+  const int hypothesis_iterations = std::max(5, options.max_solver_iterations / 4);
+  for (int iteration = 0; iteration < options.ransac_iterations && elapsed() < ransac_budget_s; ++iteration) {
+    ++result.ransac_iterations_run;
+    subset.clear();
+    while (static_cast<int>(subset.size()) < options.ransac_subset) {
+      const int k = std::uniform_int_distribution<int>(0, n - 1)(rng);
+      if (!in_subset[k]) {
+        in_subset[k] = 1;
+        subset.push_back(k);
+      }
+    }
+    const Solved hypothesis = solve(measurements, subset, T_a_b_dr, T_a_b_dr, sqrt_information, options,
+                                    hypothesis_iterations, ransac_budget_s - elapsed(), false);
+    if (hypothesis.usable) {
+      const Score score = scoreHypothesis(measurements, score_sample, hypothesis.T_a_b, options, &in_subset);
+      if (score.plane_cost < best_plane && score.range_cost < best_range && hypothesis.final_cost < best_optimisation) {
+        best_plane = score.plane_cost;
+        best_range = score.range_cost;
+        best_optimisation = hypothesis.final_cost;
+        best_pose = hypothesis.T_a_b;
+      }
+    }
+    for (int k : subset) in_subset[k] = 0;
+  }
+  if (!best_pose) return reject("no RANSAC hypothesis converged");
+  Pose pose = *best_pose;
+  std::vector<int> inliers = scoreHypothesis(measurements, all, pose, options, nullptr).inliers;
+  const int needed = std::max(options.min_inliers, options.ransac_subset);
+  if (static_cast<int>(inliers.size()) < needed) {
+    std::ostringstream text;
+    text << "RANSAC found only " << inliers.size() << " geometrically consistent matches of " << n
+         << " after " << result.ransac_iterations_run << " hypotheses; need " << needed
+         << ": wrong pair or bad data association";
+    result.T_a_b = pose;
+    result.num_inliers = static_cast<int>(inliers.size());
+    return reject(text.str());
+  }
+
+  // Final refinement on the inliers (evenly sampled down to max_correspondences), twice: the
+  // second pass re-selects the inliers with the refined pose.
+  auto sampleEvenly = [&](const std::vector<int>& candidates) {
+    if (static_cast<int>(candidates.size()) <= options.max_correspondences) return candidates;
+    std::vector<int> sampled;
+    sampled.reserve(options.max_correspondences);
+    for (int i = 0; i < options.max_correspondences; ++i)
+      sampled.push_back(candidates[static_cast<size_t>(i) * candidates.size() / options.max_correspondences]);
+    return sampled;
+  };
+  Solved refined;
+  for (int pass = 0; pass < 2; ++pass) {
+    if (static_cast<int>(inliers.size()) < options.ransac_subset) break;
+    const std::vector<int> used = sampleEvenly(inliers);
+    const double remaining_s = std::max(options.time_limit_s - elapsed(), 0.05);
+    refined = solve(measurements, used, pose, T_a_b_dr, sqrt_information, options, options.max_solver_iterations,
+                    pass == 0 ? 0.5 * remaining_s : remaining_s, pass == 1);
+    if (!refined.usable) break;
+    pose = refined.T_a_b;
+    result.inlier_indices.clear();
+    for (int k : used) result.inlier_indices.push_back(match_index[k]);
+    result.landmarks_a = refined.landmarks;
+    inliers = scoreHypothesis(measurements, all, pose, options, nullptr).inliers;
+  }
+
+  result.T_a_b = pose;
+  result.num_inliers = static_cast<int>(inliers.size());
+  result.range_cost = refined.range_cost;
+  result.plane_cost = refined.plane_cost;
+  result.total_cost = refined.final_cost;
+  if (refined.covariance) result.covariance = *refined.covariance;
+
+  std::ostringstream text;
+  if (!refined.usable || !refined.covariance) {
+    text << "final refinement failed (" << inliers.size() << " inliers): no usable solution or covariance";
+  } else if (result.num_inliers < options.min_inliers) {
+    text << result.num_inliers << " inliers, below min_inliers " << options.min_inliers;
+  } else if (result.num_inliers < options.min_inlier_fraction * n) {
+    text << result.num_inliers << " inliers of " << n << " usable correspondences, below min_inlier_fraction "
+         << options.min_inlier_fraction;
+  } else if (result.range_cost > options.max_mean_cost || result.plane_cost > options.max_mean_cost) {
+    text << "mean costs range " << result.range_cost << ", plane " << result.plane_cost << " above max_mean_cost "
+         << options.max_mean_cost;
+  }
+  result.reason = text.str();
+  result.accepted = result.reason.empty();
+  result.seconds = elapsed();
+  return result;
+}
+
+std::vector<std::string> validateRelativePoseOptions(const RelativePoseOptions& o) {
+  std::vector<std::string> problems;
+  if (!(o.range_sigma_m > 0.0)) problems.push_back("range_sigma_m must be > 0");
+  if (!(o.beam_width_rad > 0.0)) problems.push_back("beam_width_rad must be > 0");
+  if (!(o.seabed_sigma_m > 0.0)) problems.push_back("seabed_sigma_m must be > 0");
+  if (o.ransac_subset < 3) problems.push_back("ransac_subset must be >= 3");
+  if (o.ransac_iterations < 1) problems.push_back("ransac_iterations must be >= 1");
+  if (o.ransac_score_sample < 1) problems.push_back("ransac_score_sample must be >= 1");
+  if (o.max_correspondences < o.ransac_subset) problems.push_back("max_correspondences must be >= ransac_subset");
+  if (!(o.inlier_threshold_sigma > 0.0)) problems.push_back("inlier_threshold_sigma must be > 0");
+  if (o.min_inliers < 0) problems.push_back("min_inliers must be >= 0");
+  if (o.min_inlier_fraction < 0.0 || o.min_inlier_fraction > 1.0) problems.push_back("min_inlier_fraction in [0, 1]");
+  if (!(o.max_mean_cost > 0.0)) problems.push_back("max_mean_cost must be > 0");
+  if (o.max_solver_iterations < 1) problems.push_back("max_solver_iterations must be >= 1");
+  if (!(o.time_limit_s > 0.0)) problems.push_back("time_limit_s must be > 0");
+  return problems;
+}
+
+void readRelativePoseOptions(sss::core::ConfigSection& section, RelativePoseOptions& options) {
+  using sss::core::atLeast;
+  using sss::core::greaterThan;
+  using sss::core::inRange;
+  section.optional("range_sigma_m", options.range_sigma_m, {greaterThan(0.0)});
+  section.optional("beam_width_rad", options.beam_width_rad, {inRange(1e-5, 1.0)});
+  section.optional("seabed_sigma_m", options.seabed_sigma_m, {greaterThan(0.0)});
+  section.optional("use_seabed_prior", options.use_seabed_prior);
+  section.optional("ransac_subset", options.ransac_subset, {inRange(3, 100)});
+  section.optional("ransac_iterations", options.ransac_iterations, {inRange(1, 100000)});
+  section.optional("max_correspondences", options.max_correspondences, {inRange(3, 100000)});
+  section.optional("ransac_score_sample", options.ransac_score_sample, {inRange(1, 1000000)});
+  section.optional("inlier_threshold_sigma", options.inlier_threshold_sigma, {greaterThan(0.0)});
+  section.optional("min_inliers", options.min_inliers, {atLeast(0)});
+  section.optional("min_inlier_fraction", options.min_inlier_fraction, {inRange(0.0, 1.0)});
+  section.optional("max_mean_cost", options.max_mean_cost, {greaterThan(0.0)});
+  section.optional("max_solver_iterations", options.max_solver_iterations, {inRange(1, 1000)});
+  int seed = static_cast<int>(options.seed);
+  section.optional("seed", seed, {atLeast(0)});
+  options.seed = static_cast<std::uint64_t>(seed);
+  section.optional("time_limit_s", options.time_limit_s, {greaterThan(0.0)});
+  if (options.max_correspondences < options.ransac_subset)
+    section.addProblem("max_correspondences", std::to_string(options.max_correspondences),
+                       "must be >= ransac_subset (" + std::to_string(options.ransac_subset) + ")");
+}
+
+}  // namespace sss::matcher

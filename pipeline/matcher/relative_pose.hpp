@@ -1,0 +1,77 @@
+// Relative pose of a subframe pair from dense side-scan correspondences: range + fan-plane
+// residuals, seabed depth prior, DR odometry prior, RANSAC as in the paper (Alg. 1), Ceres.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "pipeline/core/config.hpp"
+#include "pipeline/core/pose.hpp"
+#include "pipeline/matcher/dense_matcher.hpp"
+
+namespace sss::matcher {
+
+struct RelativePoseOptions {
+  double range_sigma_m = 0.1;       // sigma_r of a slant range (about a bin), paper eq. (4)
+  double beam_width_rad = 0.0087;   // alpha: plane residual sigma = r * alpha, paper eq. (4)
+  // Landmark depth prior: the seabed under A's ping from altimetry (sonar depth + altitude).
+  // Without it a lateral offset between two lines on a flat seabed is absorbed by landmark depths.
+  double seabed_sigma_m = 0.3;
+  bool use_seabed_prior = true;     // false only to demonstrate the unobservable lateral offset
+  int ransac_subset = 6;            // paper: 6 correspondences per hypothesis
+  int ransac_iterations = 200;      // paper: 200
+  int ransac_score_sample = 300;    // matches each hypothesis is scored on (evenly sampled)
+  int max_correspondences = 400;    // inliers used in the final refinement, sampled evenly
+  double inlier_threshold_sigma = 3.0;
+  // Acceptance: inlier count and fraction, and the mean squared whitened range and plane
+  // residuals of the final refinement (about 1 for a consistent model).
+  int min_inliers = 30;
+  double min_inlier_fraction = 0.3;
+  double max_mean_cost = 2.5;
+  int max_solver_iterations = 50;   // final refinement; hypotheses use a quarter of it
+  std::uint64_t seed = 1;
+  double time_limit_s = 0.5;        // RANSAC stops at 60 % of it, the refinement uses the rest
+};
+
+// Everything the estimator needs from the two subframes, in each subframe's own DR frame.
+struct RelativePoseInput {
+  std::vector<sss::core::Pose> dr_poses_a;  // T_world_body per ping (row) of A, DR
+  std::vector<sss::core::Pose> dr_poses_b;
+  std::vector<double> altitude_a_m;         // sonar height above the seabed per ping
+  std::vector<double> altitude_b_m;
+  int centre_a = 0;                         // row of each subframe's centre ping
+  int centre_b = 0;
+  sss::core::Pose T_body_sonar;             // mounting (same vehicle for both)
+  double bin_size_m = 0.0;
+  double first_bin_range_m = 0.0;
+  int bins_per_side = 0;                    // column c < bins_per_side is port (mirrored)
+  std::vector<Correspondence> matches;
+  // Of the DR relative pose between the centre poses, tangent [dt, dr] (grows with distance).
+  sss::core::Matrix6d dr_covariance_ab = sss::core::Matrix6d::Identity();
+};
+
+struct RelativePoseResult {
+  bool accepted = false;
+  std::string reason;                       // why rejected (empty when accepted)
+  sss::core::Pose T_a_b;                    // B's centre body frame in A's centre body frame
+  sss::core::Matrix6d covariance = sss::core::Matrix6d::Zero();  // [dt, dr] at T_a_b (boxPlus)
+  int num_inliers = 0;                      // among all matches, scored with the final pose
+  double range_cost = 0.0;                  // mean squared whitened range residual (refinement)
+  double plane_cost = 0.0;                  // mean squared whitened plane residual (refinement)
+  double total_cost = 0.0;                  // Ceres final cost of the refinement (0.5 sum r^2)
+  std::vector<int> inlier_indices;          // into matches: the refined ones (<= max_correspondences)
+  std::vector<Eigen::Vector3d> landmarks_a; // parallel to inlier_indices, in A's centre body frame
+  int ransac_iterations_run = 0;
+  double seconds = 0.0;
+};
+
+// Never throws for field data: bad input comes back as accepted == false with a reason.
+RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const RelativePoseOptions& options);
+
+std::vector<std::string> validateRelativePoseOptions(const RelativePoseOptions& options);
+void readRelativePoseOptions(sss::core::ConfigSection& section, RelativePoseOptions& options);
+
+}  // namespace sss::matcher
