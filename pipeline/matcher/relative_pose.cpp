@@ -2,6 +2,8 @@
 // Ceres problem over T_a_b and one landmark per correspondence, inside a RANSAC loop.
 #include "pipeline/matcher/relative_pose.hpp"
 
+#include "pipeline/subframe/georeference.hpp"
+
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
 
@@ -46,33 +48,6 @@ std::optional<std::pair<Pose, double>> pingAt(const std::vector<Pose>& poses, co
   const double f = row - i0;
   return std::make_pair(sss::core::interpolate(poses[i0], poses[i1], f),
                         (1.0 - f) * altitude_m[i0] + f * altitude_m[i1]);
-}
-
-// Canonical transform's flat-seabed model: signed ground range of a column (port mirrored left),
-// slant range r = sqrt(g^2 + h^2).
-double signedGroundRangeM(const RelativePoseInput& in, double column) {
-  if (column < in.bins_per_side) return -(in.first_bin_range_m + (in.bins_per_side - 1 - column) * in.bin_size_m);
-  return in.first_bin_range_m + (column - in.bins_per_side) * in.bin_size_m;
-}
-
-// Seabed point in the fan plane of T_world_sonar at slant range r, altitude h, on the given side
-// (same geometry as sss::subframe::georeferencePixel, in slant range).
-std::optional<Eigen::Vector3d> seabedPoint(const Pose& T_world_sonar, double altitude_m, double slant_range_m,
-                                           int side) {
-  const Eigen::Vector3d normal = T_world_sonar.rotation * Eigen::Vector3d::UnitX();
-  const Eigen::Vector3d down = Eigen::Vector3d::UnitZ();
-  Eigen::Vector3d v = down.cross(normal);
-  if (v.norm() < 1e-9) return std::nullopt;
-  v.normalize();
-  if (v.dot(T_world_sonar.rotation * Eigen::Vector3d::UnitY()) < 0.0) v = -v;
-  const Eigen::Vector3d w = v.cross(down);
-  const double nw = normal.dot(w);
-  if (std::abs(nw) < 1e-9) return std::nullopt;
-  const double h = altitude_m;
-  const double t = -h * normal.z() / nw;
-  const double s2 = slant_range_m * slant_range_m - h * h - t * t;
-  if (s2 < 0.0) return std::nullopt;
-  return Eigen::Vector3d(T_world_sonar.translation + h * down + t * w + side * std::sqrt(s2) * v);
 }
 
 // Rotates/translates a double point of T by a Jet-typed point: R * p + t.
@@ -351,7 +326,7 @@ RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const Re
   const int rows_b = static_cast<int>(input.dr_poses_b.size());
   if (rows_a == 0 || rows_b == 0 || input.altitude_a_m.size() != input.dr_poses_a.size() ||
       input.altitude_b_m.size() != input.dr_poses_b.size() || input.centre_a < 0 || input.centre_a >= rows_a ||
-      input.centre_b < 0 || input.centre_b >= rows_b || input.bins_per_side <= 0 || !(input.bin_size_m > 0.0)) {
+      input.centre_b < 0 || input.centre_b >= rows_b || input.geometry.bins_per_side <= 0 || !(input.geometry.bin_size_m > 0.0)) {
     return reject("inconsistent input: poses, altitudes, centre rows or bin geometry do not agree; check the subframes");
   }
   Eigen::LLT<sss::core::Matrix6d> llt(input.dr_covariance_ab);
@@ -374,20 +349,21 @@ RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const Re
     const auto ping_a = pingAt(input.dr_poses_a, input.altitude_a_m, c.row_a);
     const auto ping_b = pingAt(input.dr_poses_b, input.altitude_b_m, c.row_b);
     if (!ping_a || !ping_b) continue;
-    if (c.col_a < 0 || c.col_a > 2 * input.bins_per_side - 1 || c.col_b < 0 || c.col_b > 2 * input.bins_per_side - 1)
+    const int last_column = input.geometry.columns() - 1;
+    if (c.col_a < 0 || c.col_a > last_column || c.col_b < 0 || c.col_b > last_column)
       continue;
-    const double g_a = signedGroundRangeM(input, c.col_a);
-    const double g_b = signedGroundRangeM(input, c.col_b);
+    const double g_a = input.geometry.signedGroundRangeM(c.col_a);
+    const double g_b = input.geometry.signedGroundRangeM(c.col_b);
     const double h_a = ping_a->second, h_b = ping_b->second;
     Measurement m;
-    const Pose T_world_sonar_a = ping_a->first * input.T_body_sonar;
+    const Pose T_world_sonar_a = ping_a->first * input.geometry.T_body_sonar;
     m.a.T_centre_sonar = T_world_a.inverse() * T_world_sonar_a;
     m.a.slant_range_m = std::sqrt(g_a * g_a + h_a * h_a);
     m.a.side = g_a < 0.0 ? -1 : 1;
-    m.b.T_centre_sonar = T_world_bc.inverse() * ping_b->first * input.T_body_sonar;
+    m.b.T_centre_sonar = T_world_bc.inverse() * ping_b->first * input.geometry.T_body_sonar;
     m.b.slant_range_m = std::sqrt(g_b * g_b + h_b * h_b);
     m.b.side = g_b < 0.0 ? -1 : 1;
-    const auto seabed = seabedPoint(T_world_sonar_a, h_a, m.a.slant_range_m, m.a.side);
+    const auto seabed = sss::subframe::georeferencePixel(input.geometry, ping_a->first, h_a, c.col_a);
     if (!seabed) continue;
     m.landmark_init_a = T_world_a.inverse() * *seabed;
     m.down_a = down_a;

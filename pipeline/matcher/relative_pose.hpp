@@ -10,6 +10,7 @@
 
 #include "pipeline/core/config.hpp"
 #include "pipeline/core/pose.hpp"
+#include "pipeline/subframe/subframe_builder.hpp"
 #include "pipeline/matcher/dense_matcher.hpp"
 
 namespace sss::matcher {
@@ -44,10 +45,9 @@ struct RelativePoseInput {
   std::vector<double> altitude_b_m;
   int centre_a = 0;                         // row of each subframe's centre ping
   int centre_b = 0;
-  sss::core::Pose T_body_sonar;             // mounting (same vehicle for both)
-  double bin_size_m = 0.0;
-  double first_bin_range_m = 0.0;
-  int bins_per_side = 0;                    // column c < bins_per_side is port (mirrored)
+  // Ground-range axis and sonar mounting of both subframes (same vehicle and transform):
+  // columns map to ground range through it, pixels to seabed points through georeferencePixel.
+  sss::subframe::SubframeGeometry geometry;
   std::vector<Correspondence> matches;
   // Of the DR relative pose between the centre poses, tangent [dt, dr] (grows with distance).
   sss::core::Matrix6d dr_covariance_ab = sss::core::Matrix6d::Identity();

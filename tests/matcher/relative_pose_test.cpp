@@ -68,10 +68,10 @@ SyntheticPair makePair(bool anti_parallel, std::uint64_t seed, int num_matches =
   for (const Pose& p : true_b) in.dr_poses_b.push_back(T_error * p);
   pair.T_a_b_true = in.dr_poses_a[in.centre_a].inverse() * true_b[in.centre_b];
 
-  in.T_body_sonar = Pose::identity();
-  in.bin_size_m = kBinSizeM;
-  in.first_bin_range_m = 0.0;
-  in.bins_per_side = kBinsPerSide;
+  in.geometry.T_body_sonar = Pose::identity();
+  in.geometry.bin_size_m = kBinSizeM;
+  in.geometry.first_bin_range_m = 0.0;
+  in.geometry.bins_per_side = kBinsPerSide;
   sss::core::Matrix6d cov = sss::core::Matrix6d::Zero();
   cov.diagonal() << 16.0, 16.0, 0.25, 1e-4, 1e-4, 4e-4;  // 4 m horizontal, 0.5 m depth, 0.02 rad heading
   in.dr_covariance_ab = cov;
