@@ -23,7 +23,7 @@ struct GeoImage {
 };
 
 struct DenseMatcherOptions {
-  int patch_size = 13;   // paper: 13 (odd)
+  int patch_size = 13;   // paper: 13 (odd); the subframe pair matcher uses 21 (see PairMatcherOptions)
   int iterations = 10;   // paper: 10 rounds of random search + propagation
   // Stop before `iterations` once fewer than this fraction of the field changed in a round.
   double min_update_fraction = 0.005;

@@ -367,7 +367,24 @@ RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const Re
     if (!seabed) continue;
     m.landmark_init_a = T_world_a.inverse() * *seabed;
     m.down_a = down_a;
+    // The seabed under A's ping (pressure depth + altitude: absolute, no horizontal DR error).
     m.seabed_depth_a_m = down_a.dot(m.a.T_centre_sonar.translation) + h_a;
+    if (options.seabed_between_lines) {
+      // The seabed is rarely level: on a 2 deg slope it is 1.4 m deeper 40 m across track than
+      // under A. B's altimeter measured it under B's ping, so the prior follows the line from A's
+      // nadir to B's nadir (u = 0 under A, 1 under B; extrapolated at most half-way beyond).
+      const Eigen::Vector3d nadir_a = m.a.T_centre_sonar.translation + h_a * down_a;
+      const Eigen::Vector3d sonar_b_in_a = T_world_a.inverse() * (ping_b->first * input.geometry.T_body_sonar).translation;
+      const Eigen::Vector3d nadir_b = sonar_b_in_a + h_b * down_a;
+      const double depth_b = down_a.dot(nadir_b);
+      Eigen::Vector3d across = nadir_b - nadir_a;
+      across -= down_a * down_a.dot(across);  // horizontal
+      const double length2 = across.squaredNorm();
+      if (length2 > 1.0) {
+        const double u = std::clamp((m.landmark_init_a - nadir_a).dot(across) / length2, -0.5, 1.5);
+        m.seabed_depth_a_m += u * (depth_b - m.seabed_depth_a_m);
+      }
+    }
     measurements.push_back(m);
     match_index.push_back(static_cast<int>(k));
   }
@@ -393,9 +410,12 @@ RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const Re
   std::vector<int> score_sample;
   const int sample_size = std::min(n, options.ransac_score_sample);
   for (int i = 0; i < sample_size; ++i) score_sample.push_back(static_cast<int>(static_cast<long>(i) * n / sample_size));
-  const double ransac_budget_s = 0.6 * options.time_limit_s;
+  // Without a wall-clock cap (the default) the result depends only on the input and the seed.
+  const bool capped = options.time_limit_s > 0.0;
+  const double ransac_budget_s = capped ? 0.6 * options.time_limit_s : 1e9;
   const int hypothesis_iterations = std::max(5, options.max_solver_iterations / 4);
-  for (int iteration = 0; iteration < options.ransac_iterations && elapsed() < ransac_budget_s; ++iteration) {
+  for (int iteration = 0; iteration < options.ransac_iterations && (!capped || elapsed() < ransac_budget_s);
+       ++iteration) {
     ++result.ransac_iterations_run;
     subset.clear();
     while (static_cast<int>(subset.size()) < options.ransac_subset) {
@@ -446,7 +466,7 @@ RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const Re
   for (int pass = 0; pass < 2; ++pass) {
     if (static_cast<int>(inliers.size()) < options.ransac_subset) break;
     const std::vector<int> used = sampleEvenly(inliers);
-    const double remaining_s = std::max(options.time_limit_s - elapsed(), 0.05);
+    const double remaining_s = capped ? std::max(options.time_limit_s - elapsed(), 0.05) : 1e9;
     refined = solve(measurements, used, pose, T_a_b_dr, sqrt_information, options, options.max_solver_iterations,
                     pass == 0 ? 0.5 * remaining_s : remaining_s, pass == 1);
     if (!refined.usable) break;
@@ -496,7 +516,7 @@ std::vector<std::string> validateRelativePoseOptions(const RelativePoseOptions& 
   if (o.min_inlier_fraction < 0.0 || o.min_inlier_fraction > 1.0) problems.push_back("min_inlier_fraction in [0, 1]");
   if (!(o.max_mean_cost > 0.0)) problems.push_back("max_mean_cost must be > 0");
   if (o.max_solver_iterations < 1) problems.push_back("max_solver_iterations must be >= 1");
-  if (!(o.time_limit_s > 0.0)) problems.push_back("time_limit_s must be > 0");
+  if (!(o.time_limit_s >= 0.0)) problems.push_back("time_limit_s must be >= 0 (0: no wall-clock cap)");
   return problems;
 }
 
@@ -519,8 +539,9 @@ void readRelativePoseOptions(sss::core::ConfigSection& section, RelativePoseOpti
   section.optional("max_solver_iterations", options.max_solver_iterations, {inRange(1, 1000)});
   int seed = static_cast<int>(options.seed);
   section.optional("seed", seed, {atLeast(0)});
+  section.optional("seabed_between_lines", options.seabed_between_lines);
   options.seed = static_cast<std::uint64_t>(seed);
-  section.optional("time_limit_s", options.time_limit_s, {greaterThan(0.0)});
+  section.optional("time_limit_s", options.time_limit_s, {sss::core::atLeast(0.0)});
   if (options.max_correspondences < options.ransac_subset)
     section.addProblem("max_correspondences", std::to_string(options.max_correspondences),
                        "must be >= ransac_subset (" + std::to_string(options.ransac_subset) + ")");

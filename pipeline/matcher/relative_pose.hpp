@@ -22,6 +22,10 @@ struct RelativePoseOptions {
   // Without it a lateral offset between two lines on a flat seabed is absorbed by landmark depths.
   double seabed_sigma_m = 0.3;
   bool use_seabed_prior = true;     // false only to demonstrate the unobservable lateral offset
+  // The prior's depth varies linearly from the seabed under A's ping to the seabed under B's
+  // (both from altimetry): a sloping seabed no longer biases the landmark depths, and through
+  // them the lateral offset. false: level seabed at A's depth (the first version).
+  bool seabed_between_lines = true;
   int ransac_subset = 6;            // paper: 6 correspondences per hypothesis
   int ransac_iterations = 200;      // paper: 200
   int ransac_score_sample = 300;    // matches each hypothesis is scored on (evenly sampled)
@@ -34,7 +38,10 @@ struct RelativePoseOptions {
   double max_mean_cost = 2.5;
   int max_solver_iterations = 50;   // final refinement; hypotheses use a quarter of it
   std::uint64_t seed = 1;
-  double time_limit_s = 0.5;        // RANSAC stops at 60 % of it, the refinement uses the rest
+  // Optional wall-clock cap (0 = none). The work is already bounded by the iteration counts above;
+  // a cap makes the result depend on machine load, so offline runs and tests leave it at 0.
+  // When set, RANSAC stops at 60 % of it and the refinement uses the rest.
+  double time_limit_s = 0.0;
 };
 
 // Everything the estimator needs from the two subframes, in each subframe's own DR frame.

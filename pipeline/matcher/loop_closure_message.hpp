@@ -1,0 +1,22 @@
+// Translation between the matcher's types and the LCM messages SSS_LOOP and SSS_TRAJECTORY. The
+// only matcher file that knows the LCM types (the optimiser uses it too).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "pipeline/matcher/matcher_engine.hpp"
+#include "sss_msgs/loop_closure_t.hpp"
+#include "sss_msgs/trajectory_t.hpp"
+
+namespace sss::matcher {
+
+sss_msgs::loop_closure_t toLoopClosureMessage(const LoopClosure& closure, int64_t utime_us);
+// False with a reason when the message is inconsistent (sizes, non-finite numbers, a zero quaternion).
+bool fromLoopClosureMessage(const sss_msgs::loop_closure_t& message, LoopClosure& closure, std::string& error);
+
+sss_msgs::trajectory_t toTrajectoryMessage(const std::vector<TrajectoryNode>& nodes, int64_t utime_us);
+bool fromTrajectoryMessage(const sss_msgs::trajectory_t& message, std::vector<TrajectoryNode>& nodes,
+                           std::string& error);
+
+}  // namespace sss::matcher

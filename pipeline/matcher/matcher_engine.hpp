@@ -1,0 +1,141 @@
+// The matcher stage without middleware: keeps recent subframes, finds overlapping pairs from their
+// footprints under the latest optimised poses, matches them and returns loop closures; re-matches
+// pairs the optimiser has moved (the paper's iterative data association, n_iter rounds).
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "pipeline/core/config.hpp"
+#include "pipeline/core/pose.hpp"
+#include "pipeline/matcher/overlap.hpp"
+#include "pipeline/matcher/pair_matcher.hpp"
+#include "pipeline/subframe/subframe_builder.hpp"
+
+namespace sss::matcher {
+
+struct MatcherEngineOptions {
+  OverlapOptions overlap;
+  PairMatcherOptions pair;
+  // Subframes kept for matching (oldest dropped first). A 200-ping subframe of 2 x 1250 bins holds
+  // ~2.5 MB: 240 of them (~3.3 h of survey at 50 s each) take ~600 MB.
+  int max_stored_subframes = 240;
+  // Paper: 2 rounds of data association with optimised poses after the DR one.
+  int max_association_rounds = 2;
+  // A pair is re-matched when the optimiser moved its two subframes relative to each other by
+  // more than this since they were last matched.
+  double reassociation_translation_m = 0.5;
+  double reassociation_rotation_rad = 0.005;
+};
+
+void readMatcherEngineOptions(sss::core::ConfigSection& section, MatcherEngineOptions& options);
+std::vector<std::string> validateMatcherEngineOptions(const MatcherEngineOptions& options);
+
+// An optimised subframe-centre pose (SSS_TRAJECTORY).
+struct TrajectoryNode {
+  int64_t subframe_id = 0;
+  int64_t utime_us = 0;
+  sss::core::Pose T_world_body;
+};
+
+// An inlier correspondence of a closure (for the bathymetric point cloud).
+struct ClosureCorrespondence {
+  int ping_index_a = 0;
+  int column_a = 0;
+  int ping_index_b = 0;
+  int column_b = 0;
+  float slant_range_a_m = 0.0f;
+  float slant_range_b_m = 0.0f;
+  Eigen::Vector3f landmark_a_m = Eigen::Vector3f::Zero();  // in A's centre-ping body frame
+};
+
+struct LoopClosure {
+  int64_t subframe_id_a = 0;  // the older subframe
+  int64_t subframe_id_b = 0;
+  int64_t centre_utime_a_us = 0;
+  int64_t centre_utime_b_us = 0;
+  sss::core::Pose T_a_b;                                         // B's centre body frame in A's
+  sss::core::Matrix6d covariance = sss::core::Matrix6d::Zero();  // [dt, dr] at T_a_b
+  int association_round = 0;                                     // 0 = DR poses
+  int num_matches = 0;
+  int num_inliers = 0;
+  double range_cost = 0.0;
+  double plane_cost = 0.0;
+  double total_cost = 0.0;
+  float mean_zncc = 0.0f;
+  std::vector<ClosureCorrespondence> correspondences;
+};
+
+// What happened to one pair: a closure when accepted, the reason when not.
+struct PairOutcome {
+  int64_t subframe_id_a = 0;
+  int64_t subframe_id_b = 0;
+  int association_round = 0;
+  bool accepted = false;
+  std::string reason;
+  double seconds = 0.0;
+  MatchTimings dense_timings;
+  double pose_seconds = 0.0;
+  LoopClosure closure;  // valid when accepted
+};
+
+struct MatcherEngineCounters {
+  uint64_t subframes_in = 0;
+  uint64_t subframes_rejected = 0;  // malformed (sizes) or a duplicate id
+  uint64_t subframes_evicted = 0;
+  uint64_t trajectory_updates = 0;
+  uint64_t pairs_attempted = 0;
+  uint64_t closures_accepted = 0;
+  uint64_t pairs_rejected = 0;
+  uint64_t rematches = 0;           // attempts with optimised poses (round >= 1)
+  double pair_seconds_total = 0.0;
+};
+
+class MatcherEngine {
+ public:
+  explicit MatcherEngine(const MatcherEngineOptions& options);
+
+  // Stores the subframe and matches it against the stored subframes it overlaps under the latest
+  // corrections (largest overlap first, at most overlap.max_candidates).
+  std::vector<PairOutcome> addSubframe(sss::subframe::Subframe subframe);
+
+  // Optimised centre poses: each named subframe's correction (optimised * DR^-1 at its centre) is
+  // applied to all its pings. Pairs whose relative pose moved beyond the thresholds are re-matched
+  // (up to max_association_rounds), pairs that overlap only under the new poses are tried.
+  std::vector<PairOutcome> updateTrajectory(const std::vector<TrajectoryNode>& nodes);
+
+  const MatcherEngineCounters& counters() const { return counters_; }
+  size_t storedSubframes() const { return stored_.size(); }
+  size_t memoryBytes() const;
+  const MatcherEngineOptions& options() const { return options_; }
+
+ private:
+  struct Stored {
+    sss::subframe::Subframe subframe;
+    sss::core::Pose correction;  // world-frame: corrected = correction * DR
+    std::vector<sss::core::Pose> poses;
+    Footprint footprint;
+  };
+  struct PairState {
+    int rounds_done = 0;              // association rounds run (1 = the DR round)
+    sss::core::Pose relative_at_match;  // correction_a^-1 * correction_b when last matched
+  };
+  using PairKey = std::pair<int64_t, int64_t>;
+
+  void setCorrection(Stored& stored, const sss::core::Pose& correction);
+  PairOutcome matchStored(const PairKey& key, int round);
+  std::vector<Footprint> footprintsExcept(int64_t id) const;
+
+  MatcherEngineOptions options_;
+  DenseMatcher dense_;
+  std::map<int64_t, Stored> stored_;
+  std::map<PairKey, PairState> pairs_;
+  MatcherEngineCounters counters_;
+};
+
+}  // namespace sss::matcher

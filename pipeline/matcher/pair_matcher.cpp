@@ -1,0 +1,189 @@
+// One subframe pair from images to relative pose.
+#include "pipeline/matcher/pair_matcher.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "pipeline/subframe/canonical_transform.hpp"
+#include "pipeline/subframe/georeference.hpp"
+
+namespace sss::matcher {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double secondsSince(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+}  // namespace
+
+void readPairMatcherOptions(sss::core::ConfigSection& section, PairMatcherOptions& options) {
+  using sss::core::atLeast;
+  using sss::core::inRange;
+  sss::core::ConfigSection dense = section.section("dense");
+  readDenseMatcherOptions(dense, options.dense);
+  dense.rejectUnknownKeys();
+  sss::core::ConfigSection pose = section.section("relative_pose");
+  readRelativePoseOptions(pose, options.pose);
+  pose.rejectUnknownKeys();
+  section.optional("dr_horizontal_sigma_fixed_m", options.dr_horizontal_sigma_fixed_m, {inRange(0.01, 1000.0)});
+  section.optional("dr_horizontal_sigma_per_m", options.dr_horizontal_sigma_per_m, {inRange(0.0, 1.0)});
+  section.optional("dr_depth_sigma_m", options.dr_depth_sigma_m, {inRange(0.001, 100.0)});
+  section.optional("dr_heading_sigma_fixed_rad", options.dr_heading_sigma_fixed_rad, {inRange(1e-5, 1.0)});
+  section.optional("dr_heading_sigma_per_m", options.dr_heading_sigma_per_m, {inRange(0.0, 0.01)});
+  section.optional("dr_roll_pitch_sigma_rad", options.dr_roll_pitch_sigma_rad, {inRange(1e-5, 1.0)});
+  section.optional("min_matches", options.min_matches, {atLeast(0)});
+  section.optional("matching_bin_size_m", options.matching_bin_size_m, {inRange(0.0, 10.0)});
+  section.optional("smoothing_sigma_px", options.smoothing_sigma_px, {inRange(0.0, 20.0)});
+}
+
+std::vector<std::string> validatePairMatcherOptions(const PairMatcherOptions& o) {
+  std::vector<std::string> problems = validateDenseMatcherOptions(o.dense);
+  for (const std::string& p : validateRelativePoseOptions(o.pose)) problems.push_back(p);
+  if (!(o.dr_horizontal_sigma_fixed_m > 0.0)) problems.push_back("dr_horizontal_sigma_fixed_m must be > 0");
+  if (!(o.dr_horizontal_sigma_per_m >= 0.0)) problems.push_back("dr_horizontal_sigma_per_m must be >= 0");
+  if (!(o.dr_depth_sigma_m > 0.0)) problems.push_back("dr_depth_sigma_m must be > 0");
+  if (!(o.dr_heading_sigma_fixed_rad > 0.0)) problems.push_back("dr_heading_sigma_fixed_rad must be > 0");
+  if (!(o.dr_heading_sigma_per_m >= 0.0)) problems.push_back("dr_heading_sigma_per_m must be >= 0");
+  if (!(o.dr_roll_pitch_sigma_rad > 0.0)) problems.push_back("dr_roll_pitch_sigma_rad must be > 0");
+  if (o.min_matches < 0) problems.push_back("min_matches must be >= 0");
+  if (!(o.matching_bin_size_m >= 0.0)) problems.push_back("matching_bin_size_m must be >= 0");
+  if (!(o.smoothing_sigma_px >= 0.0)) problems.push_back("smoothing_sigma_px must be >= 0");
+  return problems;
+}
+
+sss::core::Matrix6d drRelativeCovariance(double distance_m, const PairMatcherOptions& o) {
+  const double d = std::abs(distance_m);
+  const double horizontal = std::hypot(o.dr_horizontal_sigma_fixed_m, o.dr_horizontal_sigma_per_m * d);
+  const double heading = o.dr_heading_sigma_fixed_rad + o.dr_heading_sigma_per_m * d;
+  sss::core::Matrix6d covariance = sss::core::Matrix6d::Zero();
+  covariance.diagonal() << horizontal * horizontal, horizontal * horizontal, o.dr_depth_sigma_m * o.dr_depth_sigma_m,
+      o.dr_roll_pitch_sigma_rad * o.dr_roll_pitch_sigma_rad, o.dr_roll_pitch_sigma_rad * o.dr_roll_pitch_sigma_rad,
+      heading * heading;
+  return covariance;
+}
+
+int columnDecimation(const sss::subframe::SubframeGeometry& geometry, const PairMatcherOptions& options) {
+  if (!(geometry.bin_size_m > 0.0)) return 1;
+  const int decimation = static_cast<int>(std::lround(options.matching_bin_size_m / geometry.bin_size_m));
+  return std::clamp(decimation, 1, std::max(1, geometry.bins_per_side / 16));
+}
+
+double fullResolutionColumn(const sss::subframe::SubframeGeometry& geometry, int decimation, double k) {
+  // Port matching column k < per covers bins [B - per*f + k*f, ... + f); starboard k >= per covers
+  // [B + (k - per)*f, ... + f); the outermost B - per*f bins of each side are dropped.
+  const int per = geometry.bins_per_side / decimation;
+  const double centre = 0.5 * (decimation - 1);
+  if (k < per - 0.5) return geometry.bins_per_side - per * decimation + k * decimation + centre;
+  return geometry.bins_per_side + (k - per) * decimation + centre;
+}
+
+GeoImage toGeoImage(const sss::subframe::Subframe& subframe, const std::vector<sss::core::Pose>& T_world_body,
+                    int decimation, double smoothing_sigma_px) {
+  decimation = std::max(1, decimation);
+  const int per_side = subframe.geometry.bins_per_side / decimation;
+  const int rows = subframe.rows(), cols = 2 * per_side, full_cols = subframe.cols();
+  GeoImage image;
+  image.intensity.create(rows, cols);
+  image.valid = cv::Mat1b::zeros(rows, cols);
+  image.position_ne_m = cv::Mat2f(rows, cols, cv::Vec2f(0.0f, 0.0f));
+  image.heading_rad.create(rows, 1);
+  image.intensity.setTo(0.0f);
+  if (static_cast<int>(T_world_body.size()) != rows ||
+      subframe.image.size() != static_cast<size_t>(rows) * full_cols || subframe.mask.size() != subframe.image.size()) {
+    return image;  // nothing valid: a malformed subframe never matches
+  }
+  for (int r = 0; r < rows; ++r) {
+    image.heading_rad(r, 0) = static_cast<float>(sss::core::eulerFromQuaternion(T_world_body[r].rotation).heading_rad);
+    const size_t offset = static_cast<size_t>(r) * full_cols;
+    for (int k = 0; k < cols; ++k) {
+      const double centre = fullResolutionColumn(subframe.geometry, decimation, k);
+      const int first = static_cast<int>(std::lround(centre - 0.5 * (decimation - 1)));
+      float sum = 0.0f;
+      bool valid = true;
+      for (int c = first; c < first + decimation; ++c) {
+        sum += subframe.image[offset + c];
+        valid = valid && subframe.mask[offset + c] == sss::subframe::kMaskValid;
+      }
+      image.intensity(r, k) = sum / static_cast<float>(decimation);
+      const auto p =
+          sss::subframe::georeferencePixel(subframe.geometry, T_world_body[r], subframe.pings[r].altitude_m, centre);
+      if (!p) continue;
+      image.position_ne_m(r, k) = cv::Vec2f(static_cast<float>(p->x()), static_cast<float>(p->y()));
+      if (valid) image.valid(r, k) = 255;
+    }
+  }
+  if (smoothing_sigma_px > 0.0) {
+    // Normalised convolution: smooth intensity * mask and the mask, divide, so masked pixels
+    // (nadir, far range) do not bleed into valid ones.
+    cv::Mat1f weight, weighted;
+    image.valid.convertTo(weight, CV_32F, 1.0 / 255.0);
+    weighted = image.intensity.mul(weight);
+    cv::GaussianBlur(weighted, weighted, cv::Size(0, 0), smoothing_sigma_px, smoothing_sigma_px, cv::BORDER_REPLICATE);
+    cv::GaussianBlur(weight, weight, cv::Size(0, 0), smoothing_sigma_px, smoothing_sigma_px, cv::BORDER_REPLICATE);
+    for (int r = 0; r < rows; ++r) {
+      for (int k = 0; k < cols; ++k) {
+        if (image.valid(r, k)) image.intensity(r, k) = weighted(r, k) / std::max(weight(r, k), 1e-6f);
+      }
+    }
+  }
+  return image;
+}
+
+PairMatch matchPair(const sss::subframe::Subframe& a, const std::vector<sss::core::Pose>& poses_a,
+                    const sss::subframe::Subframe& b, const std::vector<sss::core::Pose>& poses_b,
+                    const DenseMatcher& dense, const PairMatcherOptions& options) {
+  const auto start = Clock::now();
+  PairMatch result;
+  if (a.rows() == 0 || b.rows() == 0 || static_cast<int>(poses_a.size()) != a.rows() ||
+      static_cast<int>(poses_b.size()) != b.rows()) {
+    result.reason = "subframe without pings or with a pose count different from its rows";
+    return result;
+  }
+  if (a.geometry.bins_per_side != b.geometry.bins_per_side || a.geometry.bin_size_m != b.geometry.bin_size_m ||
+      a.geometry.first_bin_range_m != b.geometry.first_bin_range_m) {
+    result.reason = "subframes with different ground-range axes (bins, bin size): not matched";
+    return result;
+  }
+  result.decimation = columnDecimation(a.geometry, options);
+  const GeoImage image_a = toGeoImage(a, poses_a, result.decimation, options.smoothing_sigma_px);
+  const GeoImage image_b = toGeoImage(b, poses_b, result.decimation, options.smoothing_sigma_px);
+  result.georeference_s = secondsSince(start);
+  result.matches = dense.match(image_a, image_b, &result.dense_timings);
+  for (Correspondence& m : result.matches) {
+    m.col_a = static_cast<float>(fullResolutionColumn(a.geometry, result.decimation, m.col_a));
+    m.col_b = static_cast<float>(fullResolutionColumn(b.geometry, result.decimation, m.col_b));
+  }
+  double zncc_sum = 0.0;
+  for (const Correspondence& m : result.matches) zncc_sum += m.zncc;
+  if (!result.matches.empty()) result.mean_zncc = zncc_sum / static_cast<double>(result.matches.size());
+  if (static_cast<int>(result.matches.size()) < options.min_matches) {
+    std::ostringstream text;
+    text << result.matches.size() << " dense matches, below min_matches " << options.min_matches
+         << " (little overlap or texture)";
+    result.reason = text.str();
+    result.seconds = secondsSince(start);
+    return result;
+  }
+
+  RelativePoseInput input;
+  input.dr_poses_a = poses_a;
+  input.dr_poses_b = poses_b;
+  for (const auto& ping : a.pings) input.altitude_a_m.push_back(ping.altitude_m);
+  for (const auto& ping : b.pings) input.altitude_b_m.push_back(ping.altitude_m);
+  input.centre_a = a.centre_ping_index;
+  input.centre_b = b.centre_ping_index;
+  input.geometry = a.geometry;
+  input.matches = result.matches;
+  input.dr_covariance_ab =
+      drRelativeCovariance(b.centre().distance_travelled_m - a.centre().distance_travelled_m, options);
+  result.pose = estimateRelativePose(input, options.pose);
+  result.accepted = result.pose.accepted;
+  result.reason = result.pose.reason;
+  result.seconds = secondsSince(start);
+  return result;
+}
+
+}  // namespace sss::matcher

@@ -1,0 +1,52 @@
+// A simulated survey cut into subframes in process (sonar rendered, DR nav, the real subframe
+// buffer), and the exact ground truth of its pixels: where a pixel lies on the true seabed and
+// which pixel of another subframe sees that point. Matcher and optimiser tests and benchmarks.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "pipeline/subframe/subframe_buffer.hpp"
+#include "tools/sim/ground_truth_geometry.hpp"
+#include "tools/sim/mission.hpp"
+
+namespace sss::sim {
+
+struct SimulatedSurvey {
+  std::unique_ptr<Mission> mission;
+  // Subframes of the DR navigation (what the live chain produces); ping_number = mission ping.
+  std::vector<sss::subframe::Subframe> subframes;
+};
+
+// Renders every ping (OpenMP) and runs them with the DR nav through a SubframeBuffer, as the
+// live chain does. The buffer's sonar geometry must match the simulator's (the defaults do).
+SimulatedSurvey simulateSurvey(const SimOptions& options, const sss::subframe::SubframeBufferOptions& buffer = {});
+
+// True T_world_body of every ping (row) of a subframe.
+std::vector<sss::core::Pose> truePoses(const Mission& mission, const sss::subframe::Subframe& subframe);
+
+// Ground truth of subframe pixels.
+class SubframeTruth {
+ public:
+  explicit SubframeTruth(const Mission& mission);
+
+  // The true seabed point seen by pixel (row, column) of the subframe: the ray-cast seabed at the
+  // slant range the canonical transform gave that column (ground range and the ping's altitude).
+  std::optional<Eigen::Vector3d> seabedPoint(const sss::subframe::Subframe& subframe, int row, double column) const;
+
+  // The (fractional) row and column of the subframe whose fan plane and slant range contain the
+  // point; nullopt when no ping of the subframe passes it within range.
+  std::optional<Eigen::Vector2d> pixelOf(const sss::subframe::Subframe& subframe, const Eigen::Vector3d& point) const;
+
+  // True relative pose of the centre pings: B's centre body frame in A's.
+  sss::core::Pose trueRelativePose(const sss::subframe::Subframe& a, const sss::subframe::Subframe& b) const;
+
+ private:
+  const Mission& mission_;
+  GroundTruthGeometry geometry_;
+};
+
+}  // namespace sss::sim
