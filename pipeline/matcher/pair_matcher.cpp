@@ -37,6 +37,9 @@ void readPairMatcherOptions(sss::core::ConfigSection& section, PairMatcherOption
   section.optional("min_matches", options.min_matches, {atLeast(0)});
   section.optional("matching_bin_size_m", options.matching_bin_size_m, {inRange(0.0, 10.0)});
   section.optional("smoothing_sigma_px", options.smoothing_sigma_px, {inRange(0.0, 20.0)});
+  section.optional("covariance_scale", options.covariance_scale, {inRange(1e-3, 1e6)});
+  section.optional("min_translation_sigma_m", options.min_translation_sigma_m, {inRange(0.0, 100.0)});
+  section.optional("min_rotation_sigma_rad", options.min_rotation_sigma_rad, {inRange(0.0, 1.0)});
 }
 
 std::vector<std::string> validatePairMatcherOptions(const PairMatcherOptions& o) {
@@ -180,6 +183,14 @@ PairMatch matchPair(const sss::subframe::Subframe& a, const std::vector<sss::cor
   input.dr_covariance_ab =
       drRelativeCovariance(b.centre().distance_travelled_m - a.centre().distance_travelled_m, options);
   result.pose = estimateRelativePose(input, options.pose);
+  if (result.pose.accepted) {
+    sss::core::Matrix6d& covariance = result.pose.covariance;
+    covariance *= options.covariance_scale;
+    for (int i = 0; i < 6; ++i) {
+      const double floor = i < 3 ? options.min_translation_sigma_m : options.min_rotation_sigma_rad;
+      covariance(i, i) = std::max(covariance(i, i), floor * floor);
+    }
+  }
   result.accepted = result.pose.accepted;
   result.reason = result.pose.reason;
   result.seconds = secondsSince(start);
