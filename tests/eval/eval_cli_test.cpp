@@ -1,0 +1,198 @@
+// sss-eval end to end on files written by the test: exit codes, the table, the JSON report's keys
+// and values, the figures, and clear errors (exit 2) for bad input.
+#include "tools/eval/heightmap_metrics.hpp"
+#include "tools/eval/trajectory_io.hpp"
+
+#include "tests/eval/eval_test_paths.hpp"
+
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#ifndef SSS_EVAL_PATH
+#error "SSS_EVAL_PATH must name the sss-eval executable"
+#endif
+
+namespace sss::eval {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ProgramRun {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string slurp(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+class EvalCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("sss_eval_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    truth_ = test::lawnmower(3, 200.0, 60.0);
+    std::string error;
+    ASSERT_TRUE(writeTum(path("truth.tum"), truth_, error)) << error;
+    ASSERT_TRUE(writeTum(path("dr.tum"), shifted(2.0), error)) << error;
+    ASSERT_TRUE(writeTum(path("slam.tum"), shifted(0.5), error)) << error;
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+
+  Trajectory shifted(double east_m) const {
+    Trajectory poses = truth_;
+    for (StampedPose& p : poses) p.T_world_body.translation.y() += east_m;
+    return poses;
+  }
+
+  ProgramRun run(const std::string& arguments) const {
+    const std::string command = std::string(SSS_EVAL_PATH) + " " + arguments + " >" + path("stdout.txt") + " 2>" +
+                                path("stderr.txt");
+    const int status = std::system(command.c_str());
+    ProgramRun result;
+    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    result.out = slurp(path("stdout.txt"));
+    result.err = slurp(path("stderr.txt"));
+    return result;
+  }
+
+  fs::path dir_;
+  Trajectory truth_;
+};
+
+TEST_F(EvalCli, EvaluatesTwoEstimatesIntoTableJsonAndFigures) {
+  const ProgramRun result = run("--gt " + path("truth.tum") + " --est " + path("dr.tum") + " --label DR --est " +
+                         path("slam.tum") + " --label SLAM --json " + path("out/report.json") + " --plot " +
+                         path("out/fig.png"));
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("DR "), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("SLAM "), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("3 survey lines"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("75.0"), std::string::npos) << result.out;  // SLAM: 0.5 m vs 2 m
+  for (const char* figure : {"out/fig.png", "out/fig_error.png"}) EXPECT_GT(fs::file_size(dir_ / figure), 1000u);
+
+  const YAML::Node json = YAML::LoadFile(path("out/report.json"));  // JSON is YAML
+  EXPECT_EQ(json["schema"].as<std::string>(), "sss-eval/1");
+  EXPECT_EQ(json["truth"]["poses"].as<size_t>(), truth_.size());
+  EXPECT_EQ(json["truth"]["lines"].size(), 3u);
+  for (const char* key : {"index", "start_utime_us", "end_utime_us", "length_m", "heading_deg"}) {
+    EXPECT_TRUE(json["truth"]["lines"][0][key]) << key;
+  }
+  for (const char* key : {"interpolate_truth", "max_interpolation_gap_s", "max_time_difference_s", "rpe_windows_m"}) {
+    EXPECT_TRUE(json["options"][key]) << key;
+  }
+  ASSERT_EQ(json["estimates"].size(), 2u);
+  const YAML::Node dr = json["estimates"][0];
+  const YAML::Node slam = json["estimates"][1];
+  EXPECT_EQ(dr["label"].as<std::string>(), "DR");
+  EXPECT_EQ(dr["matched"].as<size_t>(), truth_.size());
+  for (const char* key : {"label", "path", "poses", "matched", "exact", "interpolated", "nearest", "unmatched", "ate",
+                          "rpe", "lines", "improvement_vs_first_percent", "series"}) {
+    EXPECT_TRUE(dr[key]) << key;
+  }
+  for (const char* key : {"position_m", "horizontal_m", "vertical_m", "rotation_deg", "aligned_position_m",
+                          "aligned_horizontal_m", "alignment"}) {
+    EXPECT_TRUE(dr["ate"][key]) << key;
+  }
+  for (const char* key : {"count", "rmse", "mean", "median", "max"}) EXPECT_TRUE(dr["ate"]["horizontal_m"][key]) << key;
+  EXPECT_NEAR(dr["ate"]["horizontal_m"]["rmse"].as<double>(), 2.0, 1e-5);
+  EXPECT_NEAR(dr["ate"]["aligned_horizontal_m"]["rmse"].as<double>(), 0.0, 1e-5);
+  EXPECT_NEAR(dr["ate"]["alignment"]["translation_m"][1].as<double>(), -2.0, 1e-5);
+  EXPECT_EQ(dr["ate"]["alignment"]["quaternion_xyzw"].size(), 4u);
+  EXPECT_TRUE(dr["improvement_vs_first_percent"].IsNull());
+  EXPECT_NEAR(slam["improvement_vs_first_percent"].as<double>(), 75.0, 1e-3);
+  ASSERT_EQ(dr["rpe"].size(), 3u);
+  EXPECT_DOUBLE_EQ(dr["rpe"][1]["window_m"].as<double>(), 50.0);
+  for (const char* key : {"translation_percent", "translation_m", "rotation_deg"}) EXPECT_TRUE(dr["rpe"][1][key]) << key;
+  EXPECT_EQ(dr["lines"].size(), 3u);
+  for (const char* key : {"time_s", "distance_m", "position_m", "horizontal_m", "aligned_horizontal_m", "along_track_m",
+                          "across_track_m", "line"}) {
+    EXPECT_EQ(dr["series"][key].size(), truth_.size()) << key;
+  }
+  EXPECT_EQ(json["heightmaps"].size(), 0u);
+  EXPECT_EQ(json["outputs"]["plots"].size(), 2u);
+}
+
+TEST_F(EvalCli, ComparesHeightmapsAndWritesErrorMaps) {
+  HeightmapRaster seabed;
+  seabed.rows = 80;
+  seabed.cols = 60;
+  seabed.resolution_m = 1.0;
+  seabed.north_min_m = -10.0;
+  seabed.east_min_m = -10.0;
+  seabed.depth_m.assign(80 * 60, 50.0f);
+  HeightmapRaster estimate = seabed;
+  for (size_t i = 0; i < estimate.depth_m.size(); ++i) estimate.depth_m[i] = i % 4 == 0 ? NAN : 50.3f;
+  std::string error;
+  ASSERT_TRUE(writeHeightmap(path("seabed"), seabed, error)) << error;
+  ASSERT_TRUE(writeHeightmap(path("recon.yaml"), estimate, error)) << error;
+  const ProgramRun result = run("--seabed " + path("seabed.yaml") + " --heightmap " + path("recon.yaml") + " --json " +
+                         path("hm.json") + " --plot " + path("hm.png") + " --error-map " + path("err"));
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const YAML::Node json = YAML::LoadFile(path("hm.json"));
+  ASSERT_EQ(json["heightmaps"].size(), 1u);
+  const YAML::Node h = json["heightmaps"][0];
+  EXPECT_EQ(h["label"].as<std::string>(), "recon");
+  EXPECT_NEAR(h["abs_error_m"]["mean"].as<double>(), 0.3, 1e-5);
+  EXPECT_NEAR(h["coverage_fraction"].as<double>(), 0.75, 1e-12);
+  EXPECT_EQ(h["compared_cells"].as<size_t>(), 3600u);
+  EXPECT_EQ(h["error_map_yaml"].as<std::string>(), path("err_recon.yaml"));
+  EXPECT_EQ(h["error_map_png"].as<std::string>(), path("hm_heightmap_recon.png"));
+  EXPECT_TRUE(fs::exists(path("err_recon_depth.f32")));
+  EXPECT_GT(fs::file_size(path("hm_heightmap_recon.png")), 1000u);
+  EXPECT_EQ(json["estimates"].size(), 0u);
+}
+
+TEST_F(EvalCli, BadInputsExitWithCodeTwoAndAClearMessage) {
+  {
+    std::ofstream bad(path("bad.tum"));
+    bad << "# estimate\n1780300800.0 0 0 30 0 0 0 1\n1780300800.25 0 0 30 0 0 1\n";
+  }
+  ProgramRun result = run("--gt " + path("truth.tum") + " --est " + path("bad.tum"));
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.err.find(path("bad.tum") + ":3:"), std::string::npos) << result.err;
+
+  result = run("--gt " + path("missing.tum") + " --est " + path("dr.tum"));
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.err.find("missing.tum: cannot open"), std::string::npos) << result.err;
+
+  Trajectory later = truth_;
+  for (StampedPose& p : later) p.utime_us += 86400LL * 1000000;
+  std::string error;
+  ASSERT_TRUE(writeTum(path("later.tum"), later, error));
+  result = run("--gt " + path("truth.tum") + " --est " + path("later.tum"));
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.err.find("same clock"), std::string::npos) << result.err;
+
+  EXPECT_EQ(run("").exit_code, 2);
+  EXPECT_EQ(run("--est " + path("dr.tum")).exit_code, 2);                              // no --gt
+  EXPECT_EQ(run("--gt " + path("truth.tum") + " --est").exit_code, 2);                 // flag without value
+  EXPECT_EQ(run("--gt " + path("truth.tum") + " --bogus x").exit_code, 2);
+  EXPECT_EQ(run("--gt " + path("truth.tum") + " --est " + path("dr.tum") + " --rpe-windows-m 10,x").exit_code, 2);
+  EXPECT_EQ(run("--gt " + path("truth.tum") + " --est " + path("dr.tum") + " --rpe-windows-m 0").exit_code, 2);
+  EXPECT_EQ(run("--gt " + path("truth.tum") + " --est " + path("dr.tum") + " --label a --label b").exit_code, 2);
+  EXPECT_EQ(run("--gt " + path("truth.tum") + " --est " + path("dr.tum") + " --plot x.jpg").exit_code, 2);
+  EXPECT_EQ(run("--heightmap " + path("x.yaml")).exit_code, 2);  // no --seabed
+  result = run("--seabed " + path("truth.tum") + " --heightmap " + path("truth.tum"));  // not YAML maps
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.err.find("truth.tum"), std::string::npos) << result.err;
+  EXPECT_EQ(run("--help").exit_code, 0);
+}
+
+}  // namespace
+}  // namespace sss::eval

@@ -1,0 +1,173 @@
+// sss-eval: trajectory (ATE, RPE, per survey line) and heightmap accuracy against the simulator's
+// ground truth; prints a table, writes the JSON report (keys in report.hpp) and PNG figures.
+#include "tools/eval/report.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <vector>
+
+namespace {
+
+const char* kUsage =
+    "usage: sss-eval --gt TRUTH.tum --est EST.tum [--est MORE.tum ...] [--label NAME ...]\n"
+    "                [--seabed seabed.yaml --heightmap HM.yaml [--heightmap ...] [--heightmap-label NAME ...]]\n"
+    "                [--json OUT.json] [--plot OUT.png] [--error-map PREFIX]\n"
+    "                [--time-tolerance-s S] [--max-gap-s S] [--no-interpolation] [--rpe-windows-m 10,50,100]\n"
+    "TUM lines: 'sec.usec x y z qx qy qz qw' in local NED metres (as sss-sim writes them).\n"
+    "--label names the estimates in order (default: file name); the first estimate is the baseline\n"
+    "  of the 'vs first' column (horizontal ATE RMSE improvement, %).\n"
+    "--plot OUT.png writes OUT.png (trajectories, north/east), OUT_error.png (error over time) and\n"
+    "  OUT_heightmap_<label>.png per heightmap; --error-map PREFIX writes PREFIX_<label>.yaml +\n"
+    "  PREFIX_<label>_depth.f32 (estimate - true depth, the seabed raster format).\n"
+    "Truth is interpolated at estimate times (gaps up to --max-gap-s, default 1 s); otherwise the\n"
+    "  nearest truth pose within --time-tolerance-s (default 0.02 s) is used.\n"
+    "Exit codes: 0 ok, 1 an output could not be written, 2 bad arguments or input files.\n";
+
+bool parsePositive(const std::string& flag, const std::string& text, double& value) {
+  char* end = nullptr;
+  errno = 0;
+  value = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0' || errno == ERANGE || !std::isfinite(value) || value < 0.0) {
+    std::cerr << "sss-eval: " << flag << " expects a non-negative number, got '" << text << "'\n";
+    return false;
+  }
+  return true;
+}
+
+bool endsWith(const std::string& text, const std::string& suffix) {
+  return text.size() >= suffix.size() && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  sss::eval::EvalRequest request;
+  sss::eval::EvalOptions options;
+  std::vector<std::string> labels, heightmap_labels, estimates, heightmaps;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") {
+      std::cout << kUsage;
+      return 0;
+    }
+    if (arg == "--no-interpolation") {
+      options.trajectory.association.interpolate_truth = false;
+      continue;
+    }
+    if (arg.rfind("--", 0) != 0 || i + 1 >= argc) {
+      std::cerr << "sss-eval: unexpected argument '" << arg << "' (or a flag without its value)\n" << kUsage;
+      return 2;
+    }
+    const std::string value = argv[++i];
+    double number = 0.0;
+    if (arg == "--gt") request.truth_path = value;
+    else if (arg == "--est") estimates.push_back(value);
+    else if (arg == "--label") labels.push_back(value);
+    else if (arg == "--seabed") request.seabed_path = value;
+    else if (arg == "--heightmap") heightmaps.push_back(value);
+    else if (arg == "--heightmap-label") heightmap_labels.push_back(value);
+    else if (arg == "--json") request.json_path = value;
+    else if (arg == "--plot") request.plot_path = value;
+    else if (arg == "--error-map") request.error_map_prefix = value;
+    else if (arg == "--time-tolerance-s") {
+      if (!parsePositive(arg, value, number)) return 2;
+      options.trajectory.association.max_time_difference_s = number;
+    } else if (arg == "--max-gap-s") {
+      if (!parsePositive(arg, value, number)) return 2;
+      options.trajectory.association.max_interpolation_gap_s = number;
+    } else if (arg == "--rpe-windows-m") {
+      options.trajectory.rpe.windows_m.clear();
+      std::string item;
+      for (size_t k = 0; k <= value.size(); ++k) {
+        if (k < value.size() && value[k] != ',') {
+          item += value[k];
+          continue;
+        }
+        if (!parsePositive(arg, item, number) || number <= 0.0) {
+          if (number <= 0.0) std::cerr << "sss-eval: --rpe-windows-m expects positive lengths, e.g. 10,50,100\n";
+          return 2;
+        }
+        options.trajectory.rpe.windows_m.push_back(number);
+        item.clear();
+      }
+    } else {
+      std::cerr << "sss-eval: unknown flag " << arg << "\n" << kUsage;
+      return 2;
+    }
+  }
+  if (estimates.empty() && heightmaps.empty()) {
+    std::cerr << "sss-eval: nothing to evaluate: give --gt TRUTH.tum --est EST.tum and/or --seabed S.yaml --heightmap H.yaml\n"
+              << kUsage;
+    return 2;
+  }
+  if (!estimates.empty() && request.truth_path.empty()) {
+    std::cerr << "sss-eval: --est needs --gt TRUTH.tum\n";
+    return 2;
+  }
+  if (!heightmaps.empty() && request.seabed_path.empty()) {
+    std::cerr << "sss-eval: --heightmap needs --seabed seabed.yaml (the true seabed)\n";
+    return 2;
+  }
+  if (labels.size() > estimates.size() || heightmap_labels.size() > heightmaps.size()) {
+    std::cerr << "sss-eval: more --label (" << labels.size() << ") or --heightmap-label (" << heightmap_labels.size()
+              << ") than --est (" << estimates.size() << ") or --heightmap (" << heightmaps.size() << ")\n";
+    return 2;
+  }
+  if (!request.plot_path.empty() && !endsWith(request.plot_path, ".png")) {
+    std::cerr << "sss-eval: --plot expects a file name ending in .png, got '" << request.plot_path << "'\n";
+    return 2;
+  }
+  for (size_t k = 0; k < estimates.size(); ++k) request.estimates.push_back({k < labels.size() ? labels[k] : "", estimates[k]});
+  for (size_t k = 0; k < heightmaps.size(); ++k) {
+    request.heightmaps.push_back({k < heightmap_labels.size() ? heightmap_labels[k] : "", heightmaps[k]});
+  }
+
+  // Output folders are created as needed (like sss-sim --out).
+  for (const std::string& output : {request.json_path, request.plot_path, request.error_map_prefix}) {
+    const std::filesystem::path parent = std::filesystem::path(output).parent_path();
+    std::error_code ec;
+    if (!output.empty() && !parent.empty()) std::filesystem::create_directories(parent, ec);
+    if (ec) {
+      std::cerr << "sss-eval: cannot create " << parent.string() << ": " << ec.message() << "\n";
+      return 1;
+    }
+  }
+
+  try {
+    sss::eval::EvalReport report;
+    std::string error;
+    if (!sss::eval::runEvaluation(request, options, report, error)) {
+      std::cerr << "sss-eval: " << error << "\n";
+      return 2;
+    }
+    std::cout << sss::eval::formatTable(report);
+    if (!sss::eval::writeFigures(request, report, error)) {
+      std::cerr << "sss-eval: " << error << "\n";
+      return 1;
+    }
+    if (!request.json_path.empty()) {
+      report.json_path = request.json_path;
+      std::ofstream out(request.json_path, std::ios::binary);
+      out << sss::eval::reportJson(report);
+      out.close();
+      if (!out) {
+        std::cerr << "sss-eval: cannot write " << request.json_path << "; check the directory exists and is writable\n";
+        return 1;
+      }
+    }
+    for (const std::string& plot : report.plots) std::cout << "wrote " << plot << "\n";
+    if (!request.json_path.empty()) std::cout << "wrote " << request.json_path << "\n";
+  } catch (const std::bad_alloc&) {
+    std::cerr << "sss-eval: out of memory; are the inputs the right files?\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "sss-eval: " << e.what() << "\n";
+    return 2;
+  }
+  return 0;
+}

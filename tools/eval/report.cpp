@@ -1,0 +1,429 @@
+// sss-eval runs: inputs -> metrics -> table, JSON, figures. See report.hpp.
+#include "tools/eval/report.hpp"
+
+#include "tools/eval/json_writer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace sss::eval {
+namespace {
+
+std::string defaultLabel(const EvalInput& input) {
+  if (!input.label.empty()) return input.label;
+  return std::filesystem::path(input.path).stem().string();
+}
+
+void writeStats(JsonWriter& json, const std::string& key, const ErrorStatistics& stats) {
+  json.key(key).beginObject();
+  json.key("count").value(static_cast<uint64_t>(stats.count));
+  json.key("rmse").value(stats.rmse);
+  json.key("mean").value(stats.mean);
+  json.key("median").value(stats.median);
+  json.key("max").value(stats.max);
+  json.endObject();
+}
+
+// printf-style cell: fixed decimals, "-" for NaN.
+std::string cell(double value, int decimals) {
+  if (!std::isfinite(value)) return "-";
+  char text[48];
+  std::snprintf(text, sizeof text, "%.*f", decimals, value);
+  return text;
+}
+
+// Renders rows of cells as columns: first column left-aligned, others right-aligned.
+std::string columns(const std::vector<std::vector<std::string>>& rows) {
+  std::vector<size_t> width;
+  for (const auto& row : rows) {
+    if (width.size() < row.size()) width.resize(row.size(), 0);
+    for (size_t c = 0; c < row.size(); ++c) width[c] = std::max(width[c], row[c].size());
+  }
+  std::string out;
+  for (const auto& row : rows) {
+    std::string line;
+    for (size_t c = 0; c < row.size(); ++c) {
+      const std::string padding(width[c] - row[c].size(), ' ');
+      line += c == 0 ? row[c] + padding : "  " + padding + row[c];
+    }
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    out += line + "\n";
+  }
+  return out;
+}
+
+size_t tableRpeIndex(const EvalReport& report) {
+  const std::vector<double>& windows = report.options.trajectory.rpe.windows_m;
+  size_t best = 0;
+  for (size_t k = 1; k < windows.size(); ++k) {
+    if (std::abs(windows[k] - report.options.table_rpe_window_m) <
+        std::abs(windows[best] - report.options.table_rpe_window_m)) {
+      best = k;
+    }
+  }
+  return best;
+}
+
+std::string withSuffix(const std::string& png_path, const std::string& suffix) {
+  const std::string stem = png_path.substr(0, png_path.size() - 4);  // checked to end in .png
+  return stem + suffix + ".png";
+}
+
+}  // namespace
+
+std::string fileSafeLabel(const std::string& label) {
+  std::string safe = label;
+  for (char& c : safe) {
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' || c == '_' ||
+                    c == '-';
+    if (!ok) c = '_';
+  }
+  return safe.empty() ? "unnamed" : safe;
+}
+
+bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalReport& report, std::string& error) {
+  report = EvalReport();
+  report.options = options;
+  report.truth_path = request.truth_path;
+  if (!request.estimates.empty()) {
+    if (request.truth_path.empty()) {
+      error = "estimates need the truth trajectory (--gt TRUTH.tum)";
+      return false;
+    }
+    TumReadResult truth = readTum(request.truth_path);
+    if (!truth.ok) {
+      error = truth.error;
+      return false;
+    }
+    report.truth = std::move(truth.poses);
+    const std::vector<double> distance = cumulativeDistanceM(report.truth);
+    report.truth_distance_m = distance.back();
+    report.lines = segmentSurveyLines(report.truth, options.trajectory.lines);
+  }
+  for (const EvalInput& input : request.estimates) {
+    const TumReadResult estimate = readTum(input.path);
+    if (!estimate.ok) {
+      error = estimate.error;
+      return false;
+    }
+    EstimateReport entry;
+    entry.input = {defaultLabel(input), input.path};
+    entry.evaluation = evaluateTrajectory(report.truth, estimate.poses, report.lines, options.trajectory);
+    if (!entry.evaluation.ok) {
+      error = input.path + ": " + entry.evaluation.error;
+      return false;
+    }
+    report.estimates.push_back(std::move(entry));
+  }
+  if (!report.estimates.empty()) {
+    const double first = report.estimates.front().evaluation.ate.horizontal_m.rmse;
+    for (size_t i = 1; i < report.estimates.size(); ++i) {
+      const double value = report.estimates[i].evaluation.ate.horizontal_m.rmse;
+      if (first > 0.0) report.estimates[i].improvement_vs_first_percent = 100.0 * (first - value) / first;
+    }
+  }
+
+  if (!request.heightmaps.empty()) {
+    if (request.seabed_path.empty()) {
+      error = "heightmaps need the true seabed (--seabed seabed.yaml)";
+      return false;
+    }
+    HeightmapRaster seabed;
+    if (!readHeightmap(request.seabed_path, seabed, error)) return false;
+    for (const EvalInput& input : request.heightmaps) {
+      HeightmapRaster estimate;
+      if (!readHeightmap(input.path, estimate, error)) return false;
+      HeightmapReport entry;
+      entry.input = {defaultLabel(input), input.path};
+      entry.result = compareHeightmaps(seabed, estimate);
+      if (!entry.result.ok) {
+        error = input.path + ": " + entry.result.error;
+        return false;
+      }
+      report.heightmaps.push_back(std::move(entry));
+    }
+  }
+  return true;
+}
+
+bool writeFigures(const EvalRequest& request, EvalReport& report, std::string& error) {
+  if (!request.plot_path.empty() && !report.estimates.empty()) {
+    PlotTrajectory truth{"truth", {}};
+    for (const StampedPose& p : report.truth) truth.north_east_m.push_back(p.T_world_body.translation.head<2>());
+    std::vector<PlotTrajectory> estimates;
+    for (const EstimateReport& e : report.estimates) {
+      PlotTrajectory t{e.input.label, {}};
+      for (const AssociatedPose& p : e.evaluation.association.pairs) t.north_east_m.push_back(p.estimate.translation.head<2>());
+      estimates.push_back(std::move(t));
+    }
+    const std::string title = "Trajectories (north/east), truth: " + std::filesystem::path(report.truth_path).filename().string();
+    if (!writeTrajectoryPlot(request.plot_path, truth, estimates, title, error)) return false;
+    report.plots.push_back(request.plot_path);
+
+    // Error over time since the truth's first pose, in minutes; survey lines shaded.
+    const int64_t t0 = report.truth.front().utime_us;
+    std::vector<PlotCurve> curves;
+    for (size_t i = 0; i < report.estimates.size(); ++i) {
+      const EstimateReport& e = report.estimates[i];
+      PlotCurve raw{e.input.label + " horizontal", {}, {}, static_cast<int>(i), false};
+      PlotCurve aligned{e.input.label + " horizontal, SE(3)-aligned", {}, {}, static_cast<int>(i), true};
+      for (const ErrorSample& s : e.evaluation.series) {
+        const double minutes = static_cast<double>(s.utime_us - t0) / 60e6;
+        raw.x.push_back(minutes);
+        raw.y.push_back(s.horizontal_m);
+        aligned.x.push_back(minutes);
+        aligned.y.push_back(s.aligned_horizontal_m);
+      }
+      curves.push_back(std::move(raw));
+      curves.push_back(std::move(aligned));
+    }
+    std::vector<PlotBand> bands;
+    for (const SurveyLine& line : report.lines) {
+      bands.push_back({static_cast<double>(line.start_utime_us - t0) / 60e6, static_cast<double>(line.end_utime_us - t0) / 60e6,
+                       "line " + std::to_string(line.index)});
+    }
+    const std::string error_path = withSuffix(request.plot_path, "_error");
+    if (!writeCurvePlot(error_path, curves, bands, "Horizontal position error over the mission", "time since start (min)",
+                        "horizontal error (m)", error)) {
+      return false;
+    }
+    report.plots.push_back(error_path);
+  }
+  for (HeightmapReport& h : report.heightmaps) {
+    const std::string safe = fileSafeLabel(h.input.label);
+    if (!request.error_map_prefix.empty()) {
+      const std::string prefix = request.error_map_prefix + "_" + safe;
+      if (!writeHeightmap(prefix, h.result.error_map, error)) return false;
+      h.error_map_yaml = prefix + ".yaml";
+    }
+    if (!request.plot_path.empty()) {
+      const std::string png = withSuffix(request.plot_path, "_heightmap_" + safe);
+      char title[256];
+      std::snprintf(title, sizeof title, "Heightmap error %s: MAE %.3f m over %.1f %% coverage", h.input.label.c_str(),
+                    h.result.abs_error_m.mean, 100.0 * h.result.coverage_fraction);
+      if (!writeErrorMapPng(png, h.result.error_map, title, error, report.options.error_map_png)) return false;
+      h.error_map_png = png;
+      report.plots.push_back(png);
+    }
+  }
+  return true;
+}
+
+std::string formatTable(const EvalReport& report) {
+  std::ostringstream out;
+  if (!report.estimates.empty()) {
+    char summary[512];
+    std::snprintf(summary, sizeof summary, "truth %s: %zu poses, %.1f s, %.0f m, %zu survey lines\n",
+                  report.truth_path.c_str(), report.truth.size(),
+                  static_cast<double>(report.truth.back().utime_us - report.truth.front().utime_us) * 1e-6,
+                  report.truth_distance_m, report.lines.size());
+    out << summary;
+    const size_t rpe_index = tableRpeIndex(report);
+    const std::string rpe_window = report.options.trajectory.rpe.windows_m.empty()
+                                       ? "RPE"
+                                       : "RPE " + cell(report.options.trajectory.rpe.windows_m[rpe_index], 0) + " m";
+    std::vector<std::vector<std::string>> rows = {
+        {"estimate", "poses", "ATE raw", "ATE aligned", "horiz ATE", "horiz max", rpe_window, rpe_window, "vs first"},
+        {"", "matched", "RMSE m", "RMSE m", "RMSE m", "m", "mean %", "mean deg", "horiz %"}};
+    for (const EstimateReport& e : report.estimates) {
+      const TrajectoryEvaluation& ev = e.evaluation;
+      const RpeResult* rpe = ev.rpe.empty() ? nullptr : &ev.rpe[rpe_index];
+      rows.push_back({e.input.label, std::to_string(ev.association.pairs.size()) + "/" + std::to_string(ev.estimate_poses),
+                      cell(ev.ate.position_m.rmse, 3), cell(ev.ate.aligned_position_m.rmse, 3),
+                      cell(ev.ate.horizontal_m.rmse, 3), cell(ev.ate.horizontal_m.max, 3),
+                      rpe ? cell(rpe->translation_percent.mean, 3) : "-", rpe ? cell(rpe->rotation_deg.mean, 3) : "-",
+                      std::isfinite(e.improvement_vs_first_percent) ? cell(e.improvement_vs_first_percent, 1) : "-"});
+    }
+    out << "\n" << columns(rows);
+    if (!report.lines.empty()) {
+      out << "\nhorizontal ATE RMSE per survey line (m, raw)\n";
+      std::vector<std::vector<std::string>> line_rows(1);
+      line_rows[0].push_back("estimate");
+      for (const SurveyLine& line : report.lines) {
+        line_rows[0].push_back("L" + std::to_string(line.index) + " " + cell(line.heading_deg, 0) + "deg");
+      }
+      for (const EstimateReport& e : report.estimates) {
+        std::vector<std::string> row = {e.input.label};
+        for (const SurveyLine& line : report.lines) {
+          std::string value = "-";
+          for (const LineError& l : e.evaluation.lines) {
+            if (l.line == line.index) value = cell(l.horizontal_m.rmse, 3);
+          }
+          row.push_back(value);
+        }
+        line_rows.push_back(row);
+      }
+      out << columns(line_rows);
+    }
+  }
+  if (!report.heightmaps.empty()) {
+    std::vector<std::vector<std::string>> rows = {
+        {"heightmap", "cells", "coverage", "MAE", "RMSE", "median", "max", "bias"},
+        {"", "compared", "%", "m", "m", "m", "m", "m"}};
+    for (const HeightmapReport& h : report.heightmaps) {
+      const HeightmapErrorResult& r = h.result;
+      rows.push_back({h.input.label, std::to_string(r.compared_cells), cell(100.0 * r.coverage_fraction, 1),
+                      cell(r.abs_error_m.mean, 3), cell(r.abs_error_m.rmse, 3), cell(r.abs_error_m.median, 3),
+                      cell(r.abs_error_m.max, 3), cell(r.mean_signed_error_m, 3)});
+    }
+    out << "\n" << columns(rows);
+  }
+  return out.str();
+}
+
+std::string reportJson(const EvalReport& report) {
+  JsonWriter json;
+  json.beginObject();
+  json.key("schema").value("sss-eval/1");
+
+  json.key("truth").beginObject();
+  json.key("path").value(report.truth_path);
+  json.key("poses").value(static_cast<uint64_t>(report.truth.size()));
+  if (report.truth.empty()) {
+    json.key("start_utime_us").null();
+    json.key("duration_s").null();
+  } else {
+    json.key("start_utime_us").value(static_cast<int64_t>(report.truth.front().utime_us));
+    json.key("duration_s").value(static_cast<double>(report.truth.back().utime_us - report.truth.front().utime_us) * 1e-6);
+  }
+  json.key("distance_m").value(report.truth_distance_m);
+  json.key("lines").beginArray();
+  for (const SurveyLine& line : report.lines) {
+    json.beginObject();
+    json.key("index").value(line.index);
+    json.key("start_utime_us").value(static_cast<int64_t>(line.start_utime_us));
+    json.key("end_utime_us").value(static_cast<int64_t>(line.end_utime_us));
+    json.key("length_m").value(line.length_m);
+    json.key("heading_deg").value(line.heading_deg);
+    json.endObject();
+  }
+  json.endArray();
+  json.endObject();
+
+  const TrajectoryEvaluationOptions& o = report.options.trajectory;
+  json.key("options").beginObject();
+  json.key("interpolate_truth").value(o.association.interpolate_truth);
+  json.key("max_interpolation_gap_s").value(o.association.max_interpolation_gap_s);
+  json.key("max_time_difference_s").value(o.association.max_time_difference_s);
+  json.key("rpe_windows_m").numbers(o.rpe.windows_m, 10);
+  json.key("line_course_window_m").value(o.lines.course_window_m);
+  json.key("line_max_turn_rate_deg_per_m").value(o.lines.max_turn_rate_deg_per_m);
+  json.key("line_max_heading_change_deg").value(o.lines.max_heading_change_deg);
+  json.key("line_min_length_m").value(o.lines.min_line_length_m);
+  json.endObject();
+
+  json.key("estimates").beginArray();
+  for (const EstimateReport& e : report.estimates) {
+    const TrajectoryEvaluation& ev = e.evaluation;
+    json.beginObject();
+    json.key("label").value(e.input.label);
+    json.key("path").value(e.input.path);
+    json.key("poses").value(static_cast<uint64_t>(ev.estimate_poses));
+    json.key("matched").value(static_cast<uint64_t>(ev.association.pairs.size()));
+    json.key("exact").value(static_cast<uint64_t>(ev.association.exact));
+    json.key("interpolated").value(static_cast<uint64_t>(ev.association.interpolated));
+    json.key("nearest").value(static_cast<uint64_t>(ev.association.nearest));
+    json.key("unmatched").value(static_cast<uint64_t>(ev.association.unmatched));
+
+    json.key("ate").beginObject();
+    writeStats(json, "position_m", ev.ate.position_m);
+    writeStats(json, "horizontal_m", ev.ate.horizontal_m);
+    writeStats(json, "vertical_m", ev.ate.vertical_m);
+    writeStats(json, "rotation_deg", ev.ate.rotation_deg);
+    writeStats(json, "aligned_position_m", ev.ate.aligned_position_m);
+    writeStats(json, "aligned_horizontal_m", ev.ate.aligned_horizontal_m);
+    json.key("alignment").beginObject();
+    const Eigen::Vector3d& t = ev.ate.T_truth_estimate.translation;
+    const Eigen::Quaterniond& q = ev.ate.T_truth_estimate.rotation;
+    json.key("translation_m").numbers({t.x(), t.y(), t.z()}, 10);
+    json.key("quaternion_xyzw").numbers({q.x(), q.y(), q.z(), q.w()}, 10);
+    json.key("rotation_deg").value(ev.ate.alignment_rotation_deg);
+    json.key("heading_deg").value(ev.ate.alignment_heading_deg);
+    json.endObject();
+    json.endObject();
+
+    json.key("rpe").beginArray();
+    for (const RpeResult& rpe : ev.rpe) {
+      json.beginObject();
+      json.key("window_m").value(rpe.window_m);
+      writeStats(json, "translation_percent", rpe.translation_percent);
+      writeStats(json, "translation_m", rpe.translation_m);
+      writeStats(json, "rotation_deg", rpe.rotation_deg);
+      json.endObject();
+    }
+    json.endArray();
+
+    json.key("lines").beginArray();
+    for (const LineError& line : ev.lines) {
+      json.beginObject();
+      json.key("index").value(line.line);
+      writeStats(json, "horizontal_m", line.horizontal_m);
+      writeStats(json, "position_m", line.position_m);
+      writeStats(json, "aligned_horizontal_m", line.aligned_horizontal_m);
+      json.endObject();
+    }
+    json.endArray();
+    json.key("improvement_vs_first_percent").value(e.improvement_vs_first_percent);
+
+    std::vector<double> time, distance, position, horizontal, aligned, along, across, line;
+    const int64_t t0 = report.truth.front().utime_us;
+    for (const ErrorSample& s : ev.series) {
+      time.push_back(static_cast<double>(s.utime_us - t0) * 1e-6);
+      distance.push_back(s.distance_m);
+      position.push_back(s.position_m);
+      horizontal.push_back(s.horizontal_m);
+      aligned.push_back(s.aligned_horizontal_m);
+      along.push_back(s.along_track_m);
+      across.push_back(s.across_track_m);
+      line.push_back(s.line);
+    }
+    json.key("series").beginObject();
+    json.key("time_s").numbers(time, 10);
+    json.key("distance_m").numbers(distance, 7);
+    json.key("position_m").numbers(position, 5);
+    json.key("horizontal_m").numbers(horizontal, 5);
+    json.key("aligned_horizontal_m").numbers(aligned, 5);
+    json.key("along_track_m").numbers(along, 5);
+    json.key("across_track_m").numbers(across, 5);
+    json.key("line").numbers(line, 5);
+    json.endObject();
+    json.endObject();
+  }
+  json.endArray();
+
+  json.key("heightmaps").beginArray();
+  for (const HeightmapReport& h : report.heightmaps) {
+    const HeightmapErrorResult& r = h.result;
+    json.beginObject();
+    json.key("label").value(h.input.label);
+    json.key("path").value(h.input.path);
+    json.key("estimate_cells").value(static_cast<uint64_t>(r.estimate_cells));
+    json.key("cells_with_data").value(static_cast<uint64_t>(r.cells_with_data));
+    json.key("compared_cells").value(static_cast<uint64_t>(r.compared_cells));
+    json.key("coverage_fraction").value(r.coverage_fraction);
+    json.key("covered_area_m2").value(r.covered_area_m2);
+    writeStats(json, "abs_error_m", r.abs_error_m);
+    json.key("mean_signed_error_m").value(r.mean_signed_error_m);
+    if (h.error_map_yaml.empty()) json.key("error_map_yaml").null();
+    else json.key("error_map_yaml").value(h.error_map_yaml);
+    if (h.error_map_png.empty()) json.key("error_map_png").null();
+    else json.key("error_map_png").value(h.error_map_png);
+    json.endObject();
+  }
+  json.endArray();
+
+  json.key("outputs").beginObject();
+  json.key("json").value(report.json_path);
+  json.key("plots").beginArray();
+  for (const std::string& plot : report.plots) json.value(plot);
+  json.endArray();
+  json.endObject();
+  json.endObject();
+  return json.str();
+}
+
+}  // namespace sss::eval

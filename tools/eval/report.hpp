@@ -1,0 +1,109 @@
+// One evaluation run of sss-eval: reads the truth, the estimates and heightmaps, computes every
+// metric, and renders the terminal table, the JSON report and the figures.
+//
+// JSON report (schema "sss-eval/1"; keys are stable, new keys may be added; numbers that do not
+// exist, e.g. statistics over zero samples, are null). `stats` is
+// {"count", "rmse", "mean", "median", "max"}.
+// {
+//   "schema": "sss-eval/1",
+//   "truth": {"path", "poses", "start_utime_us", "duration_s", "distance_m",
+//             "lines": [{"index", "start_utime_us", "end_utime_us", "length_m", "heading_deg"}]},
+//   "options": {"interpolate_truth", "max_interpolation_gap_s", "max_time_difference_s",
+//               "rpe_windows_m": [...], "line_course_window_m", "line_max_turn_rate_deg_per_m",
+//               "line_max_heading_change_deg", "line_min_length_m"},
+//   "estimates": [{
+//     "label", "path", "poses", "matched", "exact", "interpolated", "nearest", "unmatched",
+//     "ate": {"position_m": stats, "horizontal_m": stats, "vertical_m": stats, "rotation_deg": stats,
+//             "aligned_position_m": stats, "aligned_horizontal_m": stats,
+//             "alignment": {"translation_m": [n, e, d], "quaternion_xyzw": [x, y, z, w],
+//                           "rotation_deg", "heading_deg"}},
+//     "rpe": [{"window_m", "translation_percent": stats, "translation_m": stats, "rotation_deg": stats}],
+//     "lines": [{"index", "horizontal_m": stats, "position_m": stats, "aligned_horizontal_m": stats}],
+//     "improvement_vs_first_percent": (first horizontal ATE RMSE - this) / first * 100, null for the first,
+//     "series": {"time_s" (since the truth's first pose), "distance_m", "position_m", "horizontal_m",
+//                "aligned_horizontal_m", "along_track_m", "across_track_m", "line" (-1 off lines)}
+//   }],
+//   "heightmaps": [{"label", "path", "estimate_cells", "cells_with_data", "compared_cells",
+//                   "coverage_fraction", "covered_area_m2", "abs_error_m": stats (MAE = mean),
+//                   "mean_signed_error_m", "error_map_yaml", "error_map_png" (null when not written)}],
+//   "outputs": {"json", "plots": [...]}
+// }
+#pragma once
+
+#include "tools/eval/heightmap_metrics.hpp"
+#include "tools/eval/plots.hpp"
+#include "tools/eval/trajectory_io.hpp"
+#include "tools/eval/trajectory_metrics.hpp"
+
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace sss::eval {
+
+struct EvalInput {
+  std::string label;  // empty: the file name without its extension
+  std::string path;
+};
+
+struct EvalRequest {
+  std::string truth_path;              // TUM; needed when there are estimates
+  std::vector<EvalInput> estimates;    // TUM
+  std::string seabed_path;             // heightmap YAML of the true seabed; needed with heightmaps
+  std::vector<EvalInput> heightmaps;   // heightmap YAMLs
+  std::string json_path;               // empty: no JSON
+  std::string plot_path;               // X.png: X.png (trajectories), X_error.png, X_heightmap_<label>.png
+  std::string error_map_prefix;        // P: P_<label>.yaml + P_<label>_depth.f32 per heightmap
+};
+
+struct EvalOptions {
+  TrajectoryEvaluationOptions trajectory;
+  double table_rpe_window_m = 50.0;  // the table shows the configured window closest to this
+  ErrorMapPngOptions error_map_png;
+};
+
+struct EstimateReport {
+  EvalInput input;
+  TrajectoryEvaluation evaluation;
+  double improvement_vs_first_percent = std::numeric_limits<double>::quiet_NaN();
+};
+
+struct HeightmapReport {
+  EvalInput input;
+  HeightmapErrorResult result;
+  std::string error_map_yaml;  // written files, empty when not written
+  std::string error_map_png;
+};
+
+struct EvalReport {
+  EvalOptions options;
+  std::string truth_path;
+  Trajectory truth;
+  double truth_distance_m = 0.0;
+  std::vector<SurveyLine> lines;
+  std::vector<EstimateReport> estimates;
+  std::vector<HeightmapReport> heightmaps;
+  std::vector<std::string> plots;  // figure files written
+  std::string json_path;
+};
+
+// Reads every input and computes every metric. False with a message naming the file (and line)
+// for bad or unusable input: unreadable or malformed files, an estimate with no pose in the
+// truth's time span, a heightmap that does not overlap the seabed.
+bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalReport& report, std::string& error);
+
+// Figures and error-map rasters of the request (plot_path, error_map_prefix). False with a
+// message when a file cannot be written.
+bool writeFigures(const EvalRequest& request, EvalReport& report, std::string& error);
+
+// The aligned terminal table: one row per estimate (ATE RMSE raw and aligned, horizontal ATE RMSE
+// and max, RPE, improvement vs the first estimate), per-line horizontal RMSE, heightmaps.
+std::string formatTable(const EvalReport& report);
+
+// The JSON report described at the top of this file.
+std::string reportJson(const EvalReport& report);
+
+// A label usable in a file name: [A-Za-z0-9._-], others replaced by '_'.
+std::string fileSafeLabel(const std::string& label);
+
+}  // namespace sss::eval
