@@ -17,22 +17,12 @@
 #include "pipeline/matcher/loop_closure_message.hpp"
 #include "pipeline/subframe/subframe_message.hpp"
 #include "pipeline/transport/lcm_bus.hpp"
+#include "tests/support/spawn_process.hpp"
 #include "sss_msgs/status_t.hpp"
 #include "tests/matcher/matcher_test_survey.hpp"
 
-extern char** environ;
-
 namespace sss::matcher {
 namespace {
-
-pid_t spawn(std::vector<std::string> args) {
-  std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  if (posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0) return -1;
-  return pid;
-}
 
 TEST(MatcherNode, SubframesInLoopClosuresOutBadMessagesCounted) {
   const auto& survey = test::threeLineSurvey();
@@ -63,7 +53,7 @@ TEST(MatcherNode, SubframesInLoopClosuresOutBadMessagesCounted) {
     }
   });
 
-  const pid_t matcher = spawn({SSS_MATCHER_PATH, "--config", config});
+  const pid_t matcher = sss::test::spawnProcess({SSS_MATCHER_PATH, "--config", config});
   ASSERT_GT(matcher, 0);
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   // A subframe whose image is shorter than its size says, and a trajectory with a zero quaternion.

@@ -15,20 +15,6 @@ namespace {
 
 using sss::core::Pose;
 
-// B's DR poses moved rigidly in the world by `along` metres along A's heading and `lateral`
-// metres to A's starboard: the DR error between two lines the estimator must remove.
-std::vector<Pose> withDrError(const sss::subframe::Subframe& a, const sss::subframe::Subframe& b, double along_m,
-                              double lateral_m) {
-  const Eigen::Matrix3d R = a.centre().T_world_body.rotation.toRotationMatrix();
-  Eigen::Vector3d forward = R.col(0), starboard = R.col(1);
-  forward.z() = starboard.z() = 0.0;
-  const Pose shift(Eigen::Quaterniond::Identity(),
-                   along_m * forward.normalized() + lateral_m * starboard.normalized());
-  std::vector<Pose> poses;
-  for (const auto& ping : b.pings) poses.push_back(shift * ping.T_world_body);
-  return poses;
-}
-
 struct PairCase {
   const char* name;
   int line_a;
@@ -44,12 +30,12 @@ void expectPairRecoversDrError(const PairCase& pair_case) {
   PairMatcherOptions options;
   const DenseMatcher dense(options.dense);
   const PairMatch match =
-      matchPair(*a, sss::subframe::drPoses(*a), *b, withDrError(*a, *b, 3.0, 2.0), dense, options);
+      matchPair(*a, sss::subframe::drPoses(*a), *b, sss::sim::posesWithDrError(*a, *b, 3.0, 2.0), dense, options);
   const test::MatchEvaluation e = test::evaluateMatches(survey, *a, *b, match.matches, options.dense.stride, match.decimation);
   const sss::sim::SubframeTruth truth(*survey.mission);
   const Pose T_true = truth.trueRelativePose(*a, *b);
   const Eigen::Vector3d error = match.pose.T_a_b.translation - T_true.translation;
-  const Pose T_dr = sss::core::between(a->centre().T_world_body, withDrError(*a, *b, 3.0, 2.0)[b->centre_ping_index]);
+  const Pose T_dr = sss::core::between(a->centre().T_world_body, sss::sim::posesWithDrError(*a, *b, 3.0, 2.0)[b->centre_ping_index]);
   const Eigen::Vector3d dr_error = T_dr.translation - T_true.translation;
   std::printf("%s: decimation %d, %ld matches (%ld with truth), within 2 px %.3f, recall %.3f, mean error %.2f px; DR error "
               "[%.2f %.2f %.2f] m -> estimate error [%.3f %.3f %.3f] m, sigma [%.3f %.3f] m, %d inliers, %s; "
@@ -95,7 +81,7 @@ TEST(PairMatcher, ImagesOfDifferentSeabedClaimedToOverlapAreRejected) {
     options.min_matches = min_matches;
     const DenseMatcher dense(options.dense);
     const PairMatch match =
-        matchPair(*a, sss::subframe::drPoses(*a), *b, withDrError(*a, *b, 60.0, 0.0), dense, options);
+        matchPair(*a, sss::subframe::drPoses(*a), *b, sss::sim::posesWithDrError(*a, *b, 60.0, 0.0), dense, options);
     std::printf("wrong pair (min_matches %d): %zu matches, %s\n", min_matches, match.matches.size(),
                 match.accepted ? "accepted" : match.reason.c_str());
     EXPECT_FALSE(match.accepted);

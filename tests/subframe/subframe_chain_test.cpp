@@ -16,32 +16,16 @@
 #include "pipeline/core/time.hpp"
 #include "pipeline/subframe/subframe_message.hpp"
 #include "pipeline/transport/lcm_bus.hpp"
-
-extern char** environ;
+#include "tests/support/spawn_process.hpp"
 
 namespace sss::subframe {
 namespace {
-
-pid_t spawn(std::vector<std::string> args) {
-  std::vector<char*> argv;
-  for (std::string& a : args) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  if (posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0) return -1;
-  return pid;
-}
-
-int waitExit(pid_t pid) {
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
 
 TEST(SubframeChain, SimulatedMissionThroughDriverBridgeAndBufferProcesses) {
   const std::string dir = ::testing::TempDir() + "/subframe_chain_" + std::to_string(getpid());
   std::filesystem::remove_all(dir);
   // Two 200 m lines: ~100 s = ~400 pings each at 4 Hz, so two full subframes per line.
-  ASSERT_EQ(waitExit(spawn({SIM_PATH, "--out", dir, "--lines", "2", "--line-length-m", "200", "--seed", "5"})), 0);
+  ASSERT_EQ(sss::test::waitExitCode(sss::test::spawnProcess({SIM_PATH, "--out", dir, "--lines", "2", "--line-length-m", "200", "--seed", "5"})), 0);
 
   const std::string lcm_url =
       "udpm://239.255.76.67:" + std::to_string(25000 + getpid() % 2000) + "?ttl=0&recv_buf_size=16777216";
@@ -68,10 +52,10 @@ TEST(SubframeChain, SimulatedMissionThroughDriverBridgeAndBufferProcesses) {
     }
   });
 
-  const pid_t buffer = spawn({SUBFRAME_BUFFER_PATH, "--config", config});
+  const pid_t buffer = sss::test::spawnProcess({SUBFRAME_BUFFER_PATH, "--config", config});
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
-  const pid_t bridge = spawn({INS_BRIDGE_PATH, "--config", config, "--file", dir + "/ins.nmea", "--speed", "40"});
-  const pid_t driver = spawn({SONAR_DRIVER_PATH, "--config", config, "--file", dir + "/sonar.jsf", "--speed", "40"});
+  const pid_t bridge = sss::test::spawnProcess({INS_BRIDGE_PATH, "--config", config, "--file", dir + "/ins.nmea", "--speed", "40"});
+  const pid_t driver = sss::test::spawnProcess({SONAR_DRIVER_PATH, "--config", config, "--file", dir + "/sonar.jsf", "--speed", "40"});
   ASSERT_GT(buffer, 0);
   ASSERT_GT(bridge, 0);
   ASSERT_GT(driver, 0);
@@ -87,7 +71,7 @@ TEST(SubframeChain, SimulatedMissionThroughDriverBridgeAndBufferProcesses) {
   const int64_t grace = sss::core::monotonicUtime() + 2'500'000;
   while (sss::core::monotonicUtime() < grace) bus.handleTimeout(50);
   ::kill(buffer, SIGTERM);
-  EXPECT_EQ(waitExit(buffer), 0);
+  EXPECT_EQ(sss::test::waitExitCode(buffer), 0);
   EXPECT_EQ(driver_exit, 0);
   EXPECT_EQ(bridge_exit, 0);
   std::filesystem::remove_all(dir);

@@ -10,6 +10,7 @@
 
 #include "pipeline/subframe/ping_nav_fusion.hpp"
 #include "tools/sim/mission.hpp"
+#include "tools/sim/simulated_survey.hpp"
 
 namespace sss::subframe::test {
 
@@ -19,19 +20,6 @@ struct TestMission {
   std::vector<NavInput> dr_nav;     // the INS/DVL DR at 20 Hz
   std::vector<NavInput> true_nav;   // ground truth at 20 Hz, true altitude
 };
-
-inline NavInput navFrom(int64_t utime_us, const sss::core::Pose& T_world_body, double altitude_m) {
-  NavInput nav;
-  nav.utime_us = utime_us;
-  nav.position_ned_m = T_world_body.translation;
-  const sss::core::EulerAngles e = sss::core::eulerFromQuaternion(T_world_body.rotation);
-  nav.roll_rad = e.roll_rad;
-  nav.pitch_rad = e.pitch_rad;
-  nav.heading_rad = e.heading_rad;
-  nav.altitude_m = altitude_m;
-  nav.altitude_valid = true;
-  return nav;
-}
 
 inline std::unique_ptr<TestMission> makeTestMission(const sss::sim::SimOptions& options) {
   auto m = std::make_unique<TestMission>();
@@ -55,12 +43,12 @@ inline std::unique_ptr<TestMission> makeTestMission(const sss::sim::SimOptions& 
   }
   const int64_t start = options.start_utime_us;
   for (const sss::sim::NavSample& s : mission.deadReckoning().samples()) {
-    m->dr_nav.push_back(navFrom(start + static_cast<int64_t>(std::llround(s.time_s * 1e6)), s.T_world_body, s.altitude_m));
+    m->dr_nav.push_back(sss::sim::navInputFrom(start + static_cast<int64_t>(std::llround(s.time_s * 1e6)), s.T_world_body, s.altitude_m));
   }
   const double dt = 1.0 / options.dead_reckoning.rate_hz;
   for (double t = 0.0; t <= mission.durationS() + 1e-9; t += dt) {
     const sss::sim::TrajectorySample truth = mission.trajectory().sample(t);
-    m->true_nav.push_back(navFrom(start + static_cast<int64_t>(std::llround(t * 1e6)), truth.T_world_body, truth.altitude_m));
+    m->true_nav.push_back(sss::sim::navInputFrom(start + static_cast<int64_t>(std::llround(t * 1e6)), truth.T_world_body, truth.altitude_m));
   }
   return m;
 }

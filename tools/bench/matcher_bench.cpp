@@ -21,17 +21,6 @@ namespace {
 
 using sss::core::Pose;
 
-std::vector<Pose> withDrError(const sss::subframe::Subframe& a, const sss::subframe::Subframe& b, double along_m,
-                              double lateral_m) {
-  const Eigen::Matrix3d R = a.centre().T_world_body.rotation.toRotationMatrix();
-  Eigen::Vector3d forward = R.col(0), starboard = R.col(1);
-  forward.z() = starboard.z() = 0.0;
-  const Pose shift(Eigen::Quaterniond::Identity(), along_m * forward.normalized() + lateral_m * starboard.normalized());
-  std::vector<Pose> poses;
-  for (const auto& ping : b.pings) poses.push_back(shift * ping.T_world_body);
-  return poses;
-}
-
 double percentile(std::vector<double> v, double q) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -87,7 +76,7 @@ int main(int argc, char** argv) {
       if (area < overlap.min_overlap_fraction * std::min(footprints[i].area_m2, footprints[j].area_m2)) continue;
       const bool parallel = (b.line_id - a.line_id) % 2 == 0;
       for (int k = 0; k < repeat; ++k) {
-        const auto match = sss::matcher::matchPair(a, sss::subframe::drPoses(a), b, withDrError(a, b, 3.0, 2.0), dense,
+        const auto match = sss::matcher::matchPair(a, sss::subframe::drPoses(a), b, sss::sim::posesWithDrError(a, b, 3.0, 2.0), dense,
                                                    options);
         seconds.push_back(match.seconds);
         georef.push_back(match.georeference_s);

@@ -14,7 +14,9 @@ using sss::subframe::NavInput;
 using sss::subframe::PingInput;
 using sss::subframe::Subframe;
 
-NavInput navFrom(int64_t utime_us, const sss::core::Pose& T_world_body, double altitude_m) {
+}  // namespace
+
+NavInput navInputFrom(int64_t utime_us, const sss::core::Pose& T_world_body, double altitude_m) {
   NavInput nav;
   nav.utime_us = utime_us;
   nav.position_ned_m = T_world_body.translation;
@@ -27,7 +29,17 @@ NavInput navFrom(int64_t utime_us, const sss::core::Pose& T_world_body, double a
   return nav;
 }
 
-}  // namespace
+std::vector<sss::core::Pose> posesWithDrError(const Subframe& a, const Subframe& b, double along_m, double lateral_m) {
+  const Eigen::Matrix3d R = a.centre().T_world_body.rotation.toRotationMatrix();
+  Eigen::Vector3d forward = R.col(0), starboard = R.col(1);
+  forward.z() = starboard.z() = 0.0;
+  const sss::core::Pose shift(Eigen::Quaterniond::Identity(),
+                              along_m * forward.normalized() + lateral_m * starboard.normalized());
+  std::vector<sss::core::Pose> poses;
+  poses.reserve(b.pings.size());
+  for (const auto& ping : b.pings) poses.push_back(shift * ping.T_world_body);
+  return poses;
+}
 
 SimulatedSurvey simulateSurvey(const SimOptions& options, const sss::subframe::SubframeBufferOptions& buffer_options) {
   SimulatedSurvey survey;
@@ -50,7 +62,7 @@ SimulatedSurvey simulateSurvey(const SimOptions& options, const sss::subframe::S
   // Nav up to 0.2 s past each ping first, as it arrives live.
   std::vector<NavInput> nav;
   for (const NavSample& s : mission.deadReckoning().samples()) {
-    nav.push_back(navFrom(options.start_utime_us + static_cast<int64_t>(std::llround(s.time_s * 1e6)), s.T_world_body,
+    nav.push_back(navInputFrom(options.start_utime_us + static_cast<int64_t>(std::llround(s.time_s * 1e6)), s.T_world_body,
                           s.altitude_m));
   }
   sss::subframe::SubframeBuffer buffer(buffer_options);

@@ -25,6 +25,14 @@ struct SimulatedSurvey {
 // live chain does. The buffer's sonar geometry must match the simulator's (the defaults do).
 SimulatedSurvey simulateSurvey(const SimOptions& options, const sss::subframe::SubframeBufferOptions& buffer = {});
 
+// B's DR poses moved rigidly in the world by along_m along A's centre heading and lateral_m to
+// A's starboard: a known DR error between two lines for tests and benchmarks.
+std::vector<sss::core::Pose> posesWithDrError(const sss::subframe::Subframe& a, const sss::subframe::Subframe& b,
+                                              double along_m, double lateral_m);
+
+// The INS/DVL input the subframe buffer takes, from a pose and an altitude.
+sss::subframe::NavInput navInputFrom(int64_t utime_us, const sss::core::Pose& T_world_body, double altitude_m);
+
 // True T_world_body of every ping (row) of a subframe.
 std::vector<sss::core::Pose> truePoses(const Mission& mission, const sss::subframe::Subframe& subframe);
 
