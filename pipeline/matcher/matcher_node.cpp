@@ -20,6 +20,7 @@
 #include "pipeline/subframe/subframe_message.hpp"
 #include "pipeline/transport/logging.hpp"
 #include "pipeline/transport/process_loop.hpp"
+#include "pipeline/transport/process_options.hpp"
 
 namespace {
 
@@ -58,21 +59,9 @@ struct Results {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string config_path, lcm_url_override;
-  bool check_config_only = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--config" && i + 1 < argc) {
-      config_path = argv[++i];
-    } else if (arg == "--check-config") {
-      check_config_only = true;
-    } else if (arg == "--lcm-url" && i + 1 < argc) {
-      lcm_url_override = argv[++i];
-    } else {
-      std::fprintf(stderr, "usage: %s [--config FILE [--check-config]] [--lcm-url URL]\n", argv[0]);
-      return arg == "--help" ? 0 : 2;
-    }
-  }
+  sss::transport::NodeArguments arguments;
+  if (const int exit_code = sss::transport::parseNodeArguments(argc, argv, arguments); exit_code >= 0) return exit_code;
+  const std::string& config_path = arguments.config_path;
   NodeOptions options;
   options.process.process_name = "sss-matcher";
   if (!config_path.empty()) {
@@ -94,11 +83,11 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  if (check_config_only) {
+  if (arguments.check_config_only) {
     std::printf("sss-matcher: configuration '%s' is valid\n", config_path.c_str());
     return 0;
   }
-  if (!lcm_url_override.empty()) options.process.lcm_url = lcm_url_override;
+  if (!arguments.lcm_url_override.empty()) options.process.lcm_url = arguments.lcm_url_override;
 
   sss::transport::initLogging(options.process.process_name, options.process.log_level);
   sss::transport::ProcessLoop loop(options.process);

@@ -1,6 +1,8 @@
 // Shared process options, see process_options.hpp.
 #include "pipeline/transport/process_options.hpp"
 
+#include <cstdio>
+
 namespace sss::transport {
 
 void readProcessOptions(sss::core::ConfigSection& section, ProcessOptions& options) {
@@ -16,6 +18,23 @@ void readProcessOptions(sss::core::ConfigSection& section, ProcessOptions& optio
   section.optional("status_period_s", options.status_period_s, {inRange(0.05, 60.0)});
   section.optional("log_level", options.log_level,
                    {oneOf({"trace", "debug", "info", "warn", "error", "critical", "off"})});
+}
+
+int parseNodeArguments(int argc, char** argv, NodeArguments& arguments) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--config" && i + 1 < argc) {
+      arguments.config_path = argv[++i];
+    } else if (arg == "--check-config") {
+      arguments.check_config_only = true;
+    } else if (arg == "--lcm-url" && i + 1 < argc) {
+      arguments.lcm_url_override = argv[++i];
+    } else {
+      std::fprintf(stderr, "usage: %s [--config FILE [--check-config]] [--lcm-url URL]\n", argv[0]);
+      return arg == "--help" ? 0 : 2;
+    }
+  }
+  return -1;
 }
 
 }  // namespace sss::transport

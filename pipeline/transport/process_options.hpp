@@ -24,4 +24,14 @@ struct ProcessOptions {
 // log_level); process_name is set by the program.
 void readProcessOptions(sss::core::ConfigSection& section, ProcessOptions& options);
 
+// The command line of a pipeline process that takes only the common flags:
+//   NAME [--config FILE [--check-config]] [--lcm-url URL]
+struct NodeArguments {
+  std::string config_path;
+  std::string lcm_url_override;
+  bool check_config_only = false;
+};
+// -1 to go on; otherwise the exit code to return (usage printed: 0 for --help, 2 for bad flags).
+int parseNodeArguments(int argc, char** argv, NodeArguments& arguments);
+
 }  // namespace sss::transport
