@@ -1,0 +1,972 @@
+// Sliding-window pose graph, see pose_graph.hpp. Checkpoint I/O is in pose_graph_checkpoint.cpp.
+//
+// Models (why, in short):
+// - Odometry: the DR relative pose of consecutive subframe centres, covariance from the distance
+//   travelled (PoseGraphOptions); paper eq. (6), first term.
+// - INS absolute factors: depth, roll, pitch and heading of each node against its DR pose. They
+//   are measured against absolute references and do not drift; without them a long chain of
+//   adjacent-line closures (each with a little heading noise) steers the heading and so the position
+//   further than the DR drifted (measured: 23 m after 60 lines with a perfect DR).
+// - Closures: relative pose with the matcher's covariance under a Cauchy loss (paper eq. (6),
+//   second term), admitted by a chi-square gate against the current estimate and a pairwise
+//   consistency test (PCM, Mangelson et al. 2018) on DR cycles with a greedy maximum clique.
+// - Window: nodes older than the newest window_size are marginalised with the Schur complement of
+//   the Gauss-Newton system on the [dt, dr] tangent, linearised at the current estimate (robust
+//   closures enter with their IRLS weight); the result is a dense prior r = r0 + J boxMinus(x, x_lin)
+//   on the nodes they were connected to.
+// - Closures to marginalised nodes: the old node is a constant at its estimate and the closure
+//   covariance grows by that node's covariance given the window when it was marginalised
+//   (H_mm^-1). The conditional, not the marginal covariance: what ties the old node to the
+//   window's absolute pose (the DR chain, earlier closures) is already inside the prior, so adding
+//   the old node's absolute (mission-long) drift would count it twice and leave an old-node
+//   closure almost powerless. The price is that the old node does not follow later corrections
+//   of the window; full smoothing re-solves everything.
+#include "pipeline/optimiser/pose_graph.hpp"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+
+#include "pipeline/optimiser/pose_manifold.hpp"
+
+namespace sss::optimiser {
+
+using sss::core::Matrix6d;
+using sss::core::Pose;
+using sss::core::Vector6d;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+bool finitePose(const Pose& pose) {
+  return pose.translation.allFinite() && pose.rotation.coeffs().allFinite() &&
+         std::abs(pose.rotation.norm() - 1.0) < 1e-3;
+}
+
+Pose normalisedPose(const Pose& pose) {
+  Pose out = pose;
+  out.rotation.normalize();
+  return out;
+}
+
+}  // namespace
+
+const char* closureRejectionName(ClosureRejection rejection) {
+  switch (rejection) {
+    case ClosureRejection::kNone: return "none";
+    case ClosureRejection::kChiSquareGate: return "chi2_gate";
+    case ClosureRejection::kInconsistent: return "inconsistent";
+    case ClosureRejection::kNoSupport: return "no_support";
+  }
+  return "unknown";
+}
+
+// ---- options ----------------------------------------------------------------------------------
+
+std::vector<std::string> validatePoseGraphOptions(const PoseGraphOptions& o) {
+  std::vector<std::string> problems;
+  auto positive = [&](double value, const char* name) {
+    if (!(value > 0.0) || !std::isfinite(value)) problems.push_back(std::string(name) + " must be > 0");
+  };
+  auto nonNegative = [&](double value, const char* name) {
+    if (!(value >= 0.0) || !std::isfinite(value)) problems.push_back(std::string(name) + " must be >= 0");
+  };
+  if (o.window_size < 2) problems.push_back("window_size must be >= 2");
+  nonNegative(o.odometry_random_walk_m_per_sqrt_m, "odometry_random_walk_m_per_sqrt_m");
+  nonNegative(o.odometry_drift_fraction, "odometry_drift_fraction");
+  positive(o.odometry_min_sigma_m, "odometry_min_sigma_m");
+  positive(o.odometry_depth_sigma_m, "odometry_depth_sigma_m");
+  nonNegative(o.odometry_heading_random_walk_rad_per_sqrt_m, "odometry_heading_random_walk_rad_per_sqrt_m");
+  positive(o.odometry_min_heading_sigma_rad, "odometry_min_heading_sigma_rad");
+  positive(o.odometry_attitude_sigma_rad, "odometry_attitude_sigma_rad");
+  nonNegative(o.absolute_depth_sigma_m, "absolute_depth_sigma_m");
+  nonNegative(o.absolute_roll_pitch_sigma_rad, "absolute_roll_pitch_sigma_rad");
+  nonNegative(o.absolute_heading_sigma_rad, "absolute_heading_sigma_rad");
+  positive(o.first_node_sigma_m, "first_node_sigma_m");
+  positive(o.first_node_sigma_rad, "first_node_sigma_rad");
+  if (o.robust_loss != "cauchy" && o.robust_loss != "huber" && o.robust_loss != "none")
+    problems.push_back("robust_loss must be one of cauchy, huber, none (got '" + o.robust_loss + "')");
+  positive(o.robust_loss_scale, "robust_loss_scale");
+  if (o.min_closure_inliers < 0) problems.push_back("min_closure_inliers must be >= 0");
+  positive(o.gate_chi2, "gate_chi2");
+  if (o.gate_min_accepted_closures < 0) problems.push_back("gate_min_accepted_closures must be >= 0");
+  positive(o.pcm_chi2, "pcm_chi2");
+  if (o.pcm_max_closures < 1) problems.push_back("pcm_max_closures must be >= 1");
+  if (o.min_consistent_closures < 1) problems.push_back("min_consistent_closures must be >= 1");
+  if (o.min_consistent_closures > o.pcm_max_closures)
+    problems.push_back("min_consistent_closures must be <= pcm_max_closures");
+  if (o.max_iterations < 1) problems.push_back("max_iterations must be >= 1");
+  nonNegative(o.max_solver_time_s, "max_solver_time_s");
+  if (o.full_smoothing_max_iterations < 1) problems.push_back("full_smoothing_max_iterations must be >= 1");
+  positive(o.degraded_after_s, "degraded_after_s");
+  positive(o.nominal_speed_m_s, "nominal_speed_m_s");
+  return problems;
+}
+
+void readPoseGraphOptions(sss::core::ConfigSection& section, PoseGraphOptions& options) {
+  using sss::core::atLeast;
+  using sss::core::greaterThan;
+  using sss::core::inRange;
+  section.optional("window_size", options.window_size, {inRange(2, 10000)});
+  section.optional("odometry_random_walk_m_per_sqrt_m", options.odometry_random_walk_m_per_sqrt_m, {atLeast(0.0)});
+  section.optional("odometry_drift_fraction", options.odometry_drift_fraction, {inRange(0.0, 1.0)});
+  section.optional("odometry_min_sigma_m", options.odometry_min_sigma_m, {greaterThan(0.0)});
+  section.optional("odometry_depth_sigma_m", options.odometry_depth_sigma_m, {greaterThan(0.0)});
+  section.optional("odometry_heading_random_walk_rad_per_sqrt_m", options.odometry_heading_random_walk_rad_per_sqrt_m,
+                   {atLeast(0.0)});
+  section.optional("odometry_min_heading_sigma_rad", options.odometry_min_heading_sigma_rad, {greaterThan(0.0)});
+  section.optional("odometry_attitude_sigma_rad", options.odometry_attitude_sigma_rad, {greaterThan(0.0)});
+  section.optional("absolute_depth_sigma_m", options.absolute_depth_sigma_m, {atLeast(0.0)});
+  section.optional("absolute_roll_pitch_sigma_rad", options.absolute_roll_pitch_sigma_rad, {atLeast(0.0)});
+  section.optional("absolute_heading_sigma_rad", options.absolute_heading_sigma_rad, {atLeast(0.0)});
+  section.optional("first_node_sigma_m", options.first_node_sigma_m, {greaterThan(0.0)});
+  section.optional("first_node_sigma_rad", options.first_node_sigma_rad, {greaterThan(0.0)});
+  section.optional("robust_loss", options.robust_loss, {sss::core::oneOf({"cauchy", "huber", "none"})});
+  section.optional("robust_loss_scale", options.robust_loss_scale, {greaterThan(0.0)});
+  section.optional("min_closure_inliers", options.min_closure_inliers, {atLeast(0)});
+  section.optional("gate_chi2", options.gate_chi2, {greaterThan(0.0)});
+  section.optional("gate_min_accepted_closures", options.gate_min_accepted_closures, {atLeast(0)});
+  section.optional("pcm_chi2", options.pcm_chi2, {greaterThan(0.0)});
+  section.optional("pcm_max_closures", options.pcm_max_closures, {inRange(1, 10000)});
+  section.optional("min_consistent_closures", options.min_consistent_closures, {atLeast(1)});
+  section.optional("max_iterations", options.max_iterations, {inRange(1, 1000)});
+  section.optional("max_solver_time_s", options.max_solver_time_s, {atLeast(0.0)});
+  section.optional("full_smoothing_max_iterations", options.full_smoothing_max_iterations, {inRange(1, 10000)});
+  section.optional("degraded_after_s", options.degraded_after_s, {greaterThan(0.0)});
+  section.optional("nominal_speed_m_s", options.nominal_speed_m_s, {greaterThan(0.0)});
+  if (options.min_consistent_closures > options.pcm_max_closures)
+    section.addProblem("min_consistent_closures", std::to_string(options.min_consistent_closures),
+                       "must be <= pcm_max_closures (" + std::to_string(options.pcm_max_closures) + ")");
+}
+
+// ---- construction and input -------------------------------------------------------------------
+
+SlidingWindowPoseGraph::SlidingWindowPoseGraph(const PoseGraphOptions& options) : options_(options) {
+  const std::vector<std::string> problems = validatePoseGraphOptions(options);
+  if (!problems.empty()) {
+    std::string text = "invalid PoseGraphOptions:";
+    for (const std::string& p : problems) text += " " + p + ";";
+    throw std::invalid_argument(text);
+  }
+}
+
+Matrix6d SlidingWindowPoseGraph::odometryCovariance(const PoseGraphOptions& o, double distance_m) {
+  const double d = std::max(distance_m, 0.0);
+  const double horizontal = o.odometry_random_walk_m_per_sqrt_m * o.odometry_random_walk_m_per_sqrt_m * d +
+                            (o.odometry_drift_fraction * d) * (o.odometry_drift_fraction * d) +
+                            o.odometry_min_sigma_m * o.odometry_min_sigma_m;
+  const double heading = o.odometry_heading_random_walk_rad_per_sqrt_m *
+                             o.odometry_heading_random_walk_rad_per_sqrt_m * d +
+                         o.odometry_min_heading_sigma_rad * o.odometry_min_heading_sigma_rad;
+  const double attitude = o.odometry_attitude_sigma_rad * o.odometry_attitude_sigma_rad;
+  Vector6d diagonal;
+  diagonal << horizontal, horizontal, o.odometry_depth_sigma_m * o.odometry_depth_sigma_m, attitude, attitude, heading;
+  return diagonal.asDiagonal();
+}
+
+void SlidingWindowPoseGraph::setupDerived(Node& node, const Node* previous) const {
+  if (!previous) {
+    node.odometry = Pose::identity();
+    node.odometry_sqrt_information = Matrix6d::Identity();
+    node.chain_prefix = Matrix6d::Zero();
+    return;
+  }
+  node.odometry = sss::core::between(previous->dr, node.dr);
+  const Matrix6d sigma = odometryCovariance(options_, node.distance_m - previous->distance_m);
+  sqrtInformation(sigma, node.odometry_sqrt_information);  // diagonal and positive: cannot fail
+  const Matrix6d ad = adjoint(node.dr);
+  node.chain_prefix = previous->chain_prefix + ad * sigma * ad.transpose();
+}
+
+Status SlidingWindowPoseGraph::addNode(int64_t subframe_id, int64_t utime_us, const Pose& T_world_body_dr,
+                                       double distance_travelled_m) {
+  auto refuse = [&](const std::string& why) {
+    ++counters_.nodes_refused;
+    return Status::error("node " + std::to_string(subframe_id) + ": " + why);
+  };
+  if (!finitePose(T_world_body_dr)) return refuse("DR pose is not finite or its quaternion is not unit; node dropped");
+  if (!std::isfinite(distance_travelled_m)) return refuse("distance travelled is not finite; node dropped");
+  if (index_of_.count(subframe_id)) return refuse("duplicate subframe id; node dropped");
+  if (!nodes_.empty()) {
+    const Node& last = nodes_.back();
+    if (utime_us <= last.utime_us)
+      return refuse("utime " + std::to_string(utime_us) + " us is not after the previous node's " +
+                    std::to_string(last.utime_us) + " us; nodes must arrive in time order");
+    if (distance_travelled_m < last.distance_m - 1e-6)
+      return refuse("distance travelled decreased from " + std::to_string(last.distance_m) + " m to " +
+                    std::to_string(distance_travelled_m) + " m");
+  }
+  Node node;
+  node.id = subframe_id;
+  node.utime_us = utime_us;
+  node.dr = normalisedPose(T_world_body_dr);
+  node.distance_m = distance_travelled_m;
+  const Node* previous = nodes_.empty() ? nullptr : &nodes_.back();
+  setupDerived(node, previous);
+  if (previous) {
+    // Initial estimate: the previous estimate moved by the DR odometry; its covariance likewise.
+    node.estimate = normalisedPose(previous->estimate * node.odometry);
+    if (previous->has_covariance) {
+      const Matrix6d ad = adjoint(node.odometry.inverse());
+      node.covariance = ad * previous->covariance * ad.transpose() +
+                        odometryCovariance(options_, node.distance_m - previous->distance_m);
+      node.has_covariance = true;
+    }
+  } else {
+    node.estimate = node.dr;
+    Vector6d diagonal;
+    const double sm = options_.first_node_sigma_m * options_.first_node_sigma_m;
+    const double sr = options_.first_node_sigma_rad * options_.first_node_sigma_rad;
+    diagonal << sm, sm, sm, sr, sr, sr;
+    node.covariance = diagonal.asDiagonal();
+    node.has_covariance = true;
+  }
+  index_of_[subframe_id] = static_cast<int>(nodes_.size());
+  nodes_.push_back(std::move(node));
+  ++counters_.nodes_added;
+  return Status::success();
+}
+
+Status SlidingWindowPoseGraph::addLoopClosure(const LoopClosure& closure) {
+  ++counters_.closures_received;
+  const std::string name =
+      "closure " + std::to_string(closure.subframe_id_a) + " -> " + std::to_string(closure.subframe_id_b) + ": ";
+  auto refuse = [&](const std::string& why) {
+    ++counters_.closures_refused;
+    return Status::error(name + why);
+  };
+  const auto a = index_of_.find(closure.subframe_id_a);
+  const auto b = index_of_.find(closure.subframe_id_b);
+  if (a == index_of_.end())
+    return refuse("subframe id " + std::to_string(closure.subframe_id_a) + " is unknown (no such node added)");
+  if (b == index_of_.end())
+    return refuse("subframe id " + std::to_string(closure.subframe_id_b) + " is unknown (no such node added)");
+  if (a->second == b->second) return refuse("both ends are the same node");
+  if (!finitePose(closure.T_a_b)) return refuse("T_a_b is not finite or its quaternion is not unit");
+  Matrix6d sqrt_information;
+  if (!sqrtInformation(closure.covariance, sqrt_information))
+    return refuse("covariance is not finite, symmetric and positive definite");
+  if (closure.num_inliers < options_.min_closure_inliers)
+    return refuse(std::to_string(closure.num_inliers) + " inliers, fewer than min_closure_inliers (" +
+                  std::to_string(options_.min_closure_inliers) + ")");
+
+  const std::pair<int64_t, int64_t> key = std::minmax(closure.subframe_id_a, closure.subframe_id_b);
+  const auto existing = latest_for_pair_.find(key);
+  if (existing != latest_for_pair_.end()) {
+    Closure& old = closures_[existing->second];
+    if (closure.association_round < old.record.closure.association_round)
+      return refuse("association round " + std::to_string(closure.association_round) + " is older than round " +
+                    std::to_string(old.record.closure.association_round) + " already held for this pair");
+    if (old.record.marginalised && old.record.status == ClosureStatus::kAccepted)
+      return refuse("the pair's earlier closure is already marginalised; a second one would count the pair twice");
+    setStatus(old, ClosureStatus::kSuperseded, ClosureRejection::kNone);
+  }
+
+  Closure c;
+  c.record.closure = closure;
+  c.record.closure.T_a_b = normalisedPose(closure.T_a_b);
+  c.record.closure.covariance = 0.5 * (closure.covariance + closure.covariance.transpose());
+  c.a = a->second;
+  c.b = b->second;
+  c.sqrt_information = sqrt_information;
+  const int index = static_cast<int>(closures_.size());
+  closures_.push_back(c);
+  ++counters_.closures_pending;
+  latest_for_pair_[key] = index;
+  nodes_[c.a].closures.push_back(index);
+  nodes_[c.b].closures.push_back(index);
+  return Status::success();
+}
+
+void SlidingWindowPoseGraph::setStatus(Closure& c, ClosureStatus status, ClosureRejection rejection) {
+  auto counter = [&](ClosureStatus s, ClosureRejection r) -> uint64_t* {
+    switch (s) {
+      case ClosureStatus::kPending: return &counters_.closures_pending;
+      case ClosureStatus::kAccepted: return &counters_.closures_accepted;
+      case ClosureStatus::kSuperseded: return &counters_.closures_superseded;
+      case ClosureStatus::kRejected:
+        if (r == ClosureRejection::kChiSquareGate) return &counters_.closures_rejected_gate;
+        if (r == ClosureRejection::kNoSupport) return &counters_.closures_rejected_no_support;
+        return &counters_.closures_rejected_inconsistent;
+    }
+    return nullptr;
+  };
+  if (c.record.status == status && c.record.rejection == rejection) return;
+  if (c.record.marginalised && c.record.status == ClosureStatus::kAccepted && status != ClosureStatus::kAccepted)
+    ++counters_.closures_withdrawn_after_marginalisation;
+  uint64_t* from = counter(c.record.status, c.record.rejection);
+  if (from && *from > 0) --*from;
+  c.record.status = status;
+  c.record.rejection = status == ClosureStatus::kRejected ? rejection : ClosureRejection::kNone;
+  if (uint64_t* to = counter(status, c.record.rejection)) ++*to;
+}
+
+int64_t SlidingWindowPoseGraph::closureUtime(const Closure& c) const {
+  return std::max(nodes_[c.a].utime_us, nodes_[c.b].utime_us);
+}
+
+// ---- factors ----------------------------------------------------------------------------------
+
+bool SlidingWindowPoseGraph::useInsAbsolute() const {
+  return options_.absolute_depth_sigma_m > 0.0 || options_.absolute_roll_pitch_sigma_rad > 0.0 ||
+         options_.absolute_heading_sigma_rad > 0.0;
+}
+
+std::vector<SlidingWindowPoseGraph::Factor> SlidingWindowPoseGraph::windowFactors() const {
+  std::vector<Factor> factors;
+  const int n = static_cast<int>(nodes_.size());
+  if (n == 0) return factors;
+  if (first_active_ == 0) factors.push_back({FactorKind::kFirstNode, 0});
+  if (!prior_.empty()) factors.push_back({FactorKind::kPrior, 0});
+  if (useInsAbsolute())
+    for (int k = first_active_; k < n; ++k) factors.push_back({FactorKind::kInsAbsolute, k});
+  for (int k = first_active_ + 1; k < n; ++k) factors.push_back({FactorKind::kOdometry, k});
+  // Closures through the active nodes' lists (bounded work), each once at its first active end.
+  for (int k = first_active_; k < n; ++k) {
+    for (int index : nodes_[k].closures) {
+      const Closure& c = closures_[index];
+      if (c.record.status != ClosureStatus::kAccepted || c.record.marginalised) continue;
+      const int first_active_end = isActive(c.a) && isActive(c.b) ? std::min(c.a, c.b) : (isActive(c.a) ? c.a : c.b);
+      if (first_active_end == k) factors.push_back({FactorKind::kClosure, index});
+    }
+  }
+  return factors;
+}
+
+std::vector<SlidingWindowPoseGraph::Factor> SlidingWindowPoseGraph::allFactors() const {
+  std::vector<Factor> factors;
+  const int n = static_cast<int>(nodes_.size());
+  if (n == 0) return factors;
+  factors.push_back({FactorKind::kFirstNode, 0});
+  if (useInsAbsolute())
+    for (int k = 0; k < n; ++k) factors.push_back({FactorKind::kInsAbsolute, k});
+  for (int k = 1; k < n; ++k) factors.push_back({FactorKind::kOdometry, k});
+  for (int index = 0; index < static_cast<int>(closures_.size()); ++index)
+    if (closures_[index].record.status == ClosureStatus::kAccepted) factors.push_back({FactorKind::kClosure, index});
+  return factors;
+}
+
+std::vector<SlidingWindowPoseGraph::Factor> SlidingWindowPoseGraph::factorsTouching(int m) const {
+  std::vector<Factor> factors;
+  if (m == 0) factors.push_back({FactorKind::kFirstNode, 0});
+  if (!prior_.empty()) factors.push_back({FactorKind::kPrior, 0});
+  if (useInsAbsolute()) factors.push_back({FactorKind::kInsAbsolute, m});
+  if (m + 1 < static_cast<int>(nodes_.size())) factors.push_back({FactorKind::kOdometry, m + 1});
+  for (int index : nodes_[m].closures) {
+    const Closure& c = closures_[index];
+    if (c.record.status == ClosureStatus::kAccepted && !c.record.marginalised)
+      factors.push_back({FactorKind::kClosure, index});
+  }
+  return factors;
+}
+
+std::vector<int> SlidingWindowPoseGraph::factorNodes(const Factor& f) const {
+  switch (f.kind) {
+    case FactorKind::kFirstNode: return {0};
+    case FactorKind::kInsAbsolute: return {f.index};
+    case FactorKind::kOdometry: return {f.index - 1, f.index};
+    case FactorKind::kClosure: return {closures_[f.index].a, closures_[f.index].b};
+    case FactorKind::kPrior: return prior_.nodes;
+  }
+  return {};
+}
+
+Matrix6d SlidingWindowPoseGraph::closureCovarianceInWindow(const Closure& c) const {
+  Matrix6d sigma = c.record.closure.covariance;
+  // e = boxMinus(T_a^-1 T_b, Z): a right perturbation d of T_a enters as -Ad(Z^-1) d, one of T_b
+  // as d itself (to first order).
+  if (!isActive(c.a)) {
+    const Matrix6d ad = adjoint(c.record.closure.T_a_b.inverse());
+    sigma += ad * nodes_[c.a].conditional_covariance * ad.transpose();
+  }
+  if (!isActive(c.b)) sigma += nodes_[c.b].conditional_covariance;
+  return sigma;
+}
+
+ceres::CostFunction* SlidingWindowPoseGraph::makeCost(const Factor& f) const {
+  switch (f.kind) {
+    case FactorKind::kFirstNode: {
+      Vector6d inverse_sigma;
+      const double m = 1.0 / options_.first_node_sigma_m, r = 1.0 / options_.first_node_sigma_rad;
+      inverse_sigma << m, m, m, r, r, r;
+      return PosePriorError::create(nodes_[0].dr, inverse_sigma.asDiagonal());
+    }
+    case FactorKind::kInsAbsolute: {
+      auto weight = [](double sigma) { return sigma > 0.0 ? 1.0 / sigma : 0.0; };
+      const Eigen::Vector4d w(weight(options_.absolute_depth_sigma_m), weight(options_.absolute_roll_pitch_sigma_rad),
+                              weight(options_.absolute_roll_pitch_sigma_rad), weight(options_.absolute_heading_sigma_rad));
+      return InsAbsoluteError::create(nodes_[f.index].dr, w);
+    }
+    case FactorKind::kOdometry:
+      return RelativePoseError::create(nodes_[f.index].odometry, nodes_[f.index].odometry_sqrt_information);
+    case FactorKind::kClosure: {
+      const Closure& c = closures_[f.index];
+      Matrix6d sqrt_information = c.sqrt_information;
+      if (!isActive(c.a) || !isActive(c.b)) {
+        // Inflated covariance stays positive definite: a sum of a PD and a PSD matrix.
+        if (!sqrtInformation(closureCovarianceInWindow(c), sqrt_information)) sqrt_information = c.sqrt_information;
+      }
+      return RelativePoseError::create(c.record.closure.T_a_b, sqrt_information);
+    }
+    case FactorKind::kPrior:
+      return new MarginalPriorCost(prior_.linearisation, prior_.jacobian, prior_.residual);
+  }
+  return nullptr;
+}
+
+ceres::LossFunction* SlidingWindowPoseGraph::makeLoss(const Factor& f) const {
+  if (f.kind != FactorKind::kClosure) return nullptr;
+  if (options_.robust_loss == "cauchy") return new ceres::CauchyLoss(options_.robust_loss_scale);
+  if (options_.robust_loss == "huber") return new ceres::HuberLoss(options_.robust_loss_scale);
+  return nullptr;
+}
+
+bool SlidingWindowPoseGraph::linearise(const Factor& f, LinearisedFactor& out) const {
+  const std::vector<int> nodes = factorNodes(f);
+  std::vector<PoseParameters> parameters;
+  parameters.reserve(nodes.size());
+  for (int n : nodes) parameters.push_back(toParameters(nodes_[n].estimate));
+  std::vector<const double*> blocks;
+  for (const PoseParameters& p : parameters) blocks.push_back(p.data());
+
+  std::unique_ptr<ceres::CostFunction> cost(makeCost(f));
+  std::unique_ptr<ceres::LossFunction> loss(makeLoss(f));
+  const int rows = cost->num_residuals();
+  Eigen::VectorXd residual(rows);
+  std::vector<Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor>> ambient(
+      nodes.size(), Eigen::Matrix<double, Eigen::Dynamic, 7, Eigen::RowMajor>(rows, 7));
+  std::vector<double*> jacobians;
+  for (auto& j : ambient) jacobians.push_back(j.data());
+  if (!cost->Evaluate(blocks.data(), residual.data(), jacobians.data())) return false;
+
+  // Robust loss as iteratively reweighted least squares: scale by sqrt(rho'(s)) at this point.
+  double weight = 1.0;
+  if (loss) {
+    double rho[3];
+    loss->Evaluate(residual.squaredNorm(), rho);
+    weight = std::sqrt(std::max(rho[1], 0.0));
+  }
+  out.nodes.clear();
+  std::vector<int> columns;
+  for (size_t i = 0; i < nodes.size(); ++i)
+    if (isActive(nodes[i])) {
+      out.nodes.push_back(nodes[i]);
+      columns.push_back(static_cast<int>(i));
+    }
+  out.jacobian.resize(rows, 6 * static_cast<int>(out.nodes.size()));
+  for (size_t k = 0; k < columns.size(); ++k) {
+    const int i = columns[k];
+    out.jacobian.middleCols<6>(6 * static_cast<int>(k)) = weight * ambient[i] * plusJacobian(parameters[i].data());
+  }
+  out.residual = weight * residual;
+  return out.jacobian.allFinite() && out.residual.allFinite();
+}
+
+// ---- closure decisions ------------------------------------------------------------------------
+
+Matrix6d SlidingWindowPoseGraph::chainCovariance(int from, int to) const {
+  if (from == to) return Matrix6d::Zero();
+  if (from < to) {
+    // D = dr_from^-1 dr_to; its right-perturbation covariance is
+    // sum_e Ad(dr_to^-1 dr_{e+1}) Sigma_e Ad(.)^T = Ad(dr_to^-1) (G_to - G_from) Ad(dr_to^-1)^T.
+    const Matrix6d ad = adjoint(nodes_[to].dr.inverse());
+    const Matrix6d sum = nodes_[to].chain_prefix - nodes_[from].chain_prefix;
+    return ad * sum * ad.transpose();
+  }
+  // The inverse of D(to -> from): (D Exp(d))^-1 = D^-1 Exp(-Ad(D) d).
+  const Matrix6d ad = adjoint(sss::core::between(nodes_[to].dr, nodes_[from].dr));
+  return ad * chainCovariance(to, from) * ad.transpose();
+}
+
+bool SlidingWindowPoseGraph::pairConsistent(const Closure& i, const Closure& j) const {
+  // Cycle a_i -> b_i (closure i) -> b_j (DR) -> a_j (closure j inverted) -> a_i (DR) = identity.
+  const Pose& z_i = i.record.closure.T_a_b;
+  const Pose& z_j = j.record.closure.T_a_b;
+  const Pose a1 = z_i;
+  const Pose a2 = sss::core::between(nodes_[i.b].dr, nodes_[j.b].dr);
+  const Pose a3 = z_j.inverse();
+  const Pose a4 = sss::core::between(nodes_[j.a].dr, nodes_[i.a].dr);
+  const Matrix6d ad_zj = adjoint(z_j);
+  const Matrix6d s1 = i.record.closure.covariance;
+  const Matrix6d s2 = chainCovariance(i.b, j.b);
+  const Matrix6d s3 = ad_zj * j.record.closure.covariance * ad_zj.transpose();
+  const Matrix6d s4 = chainCovariance(j.a, i.a);
+  // Each factor's right perturbation moves to the end of the product through Ad(rest^-1).
+  const Pose rest3 = a4;
+  const Pose rest2 = a3 * a4;
+  const Pose rest1 = a2 * rest2;
+  const Matrix6d t1 = adjoint(rest1.inverse()), t2 = adjoint(rest2.inverse()), t3 = adjoint(rest3.inverse());
+  const Matrix6d s = t1 * s1 * t1.transpose() + t2 * s2 * t2.transpose() + t3 * s3 * t3.transpose() + s4;
+  const Vector6d e = sss::core::boxMinus(a1 * rest1, Pose::identity());
+  const Eigen::LDLT<Matrix6d> ldlt(s);
+  if (ldlt.info() != Eigen::Success) return false;
+  const double chi2 = e.dot(ldlt.solve(e));
+  return std::isfinite(chi2) && chi2 <= options_.pcm_chi2;
+}
+
+bool SlidingWindowPoseGraph::passesGate(const Closure& c, const Eigen::MatrixXd& covariance,
+                                        const std::vector<int>& slot) const {
+  const Pose x = sss::core::between(nodes_[c.a].estimate, nodes_[c.b].estimate);
+  const Vector6d e = sss::core::boxMinus(x, c.record.closure.T_a_b);
+  // Old nodes: their covariance when they left the window, uncorrelated with the window: a looser,
+  // conservative gate for them (PCM still checks them).
+  auto block = [&](int p, int q) -> Matrix6d {
+    if (isActive(p) && isActive(q))
+      return covariance.block<6, 6>(6 * slot[p - first_active_], 6 * slot[q - first_active_]);
+    if (p == q) return nodes_[p].covariance;
+    return Matrix6d::Zero();
+  };
+  const Matrix6d j_a = -adjoint(x.inverse());
+  const Matrix6d s_ab = block(c.a, c.b);
+  const Matrix6d s = c.record.closure.covariance + j_a * block(c.a, c.a) * j_a.transpose() + block(c.b, c.b) +
+                     j_a * s_ab + s_ab.transpose() * j_a.transpose();
+  const Eigen::LDLT<Matrix6d> ldlt(0.5 * (s + s.transpose()));
+  if (ldlt.info() != Eigen::Success) return true;  // cannot judge: leave it to PCM
+  const double chi2 = e.dot(ldlt.solve(e));
+  return std::isfinite(chi2) && chi2 <= options_.gate_chi2;
+}
+
+void SlidingWindowPoseGraph::decideClosures(UpdateReport& report) {
+  const int m = static_cast<int>(closures_.size());
+  auto eligible = [](const Closure& c) {
+    return c.record.status == ClosureStatus::kPending || c.record.status == ClosureStatus::kAccepted ||
+           (c.record.status == ClosureStatus::kRejected && c.record.rejection == ClosureRejection::kInconsistent);
+  };
+
+  // 1. Chi-square gate of the new closures against the current estimate, once it means something.
+  std::vector<int> fresh;
+  for (int index = pcm_horizon_start_; index < m; ++index)
+    if (!closures_[index].gate_checked) fresh.push_back(index);
+  if (!fresh.empty()) {
+    const bool gate_active = counters_.closures_accepted >= static_cast<uint64_t>(options_.gate_min_accepted_closures);
+    Eigen::MatrixXd covariance;
+    std::vector<int> slot;
+    const bool have_covariance = gate_active && computeWindowCovariance(covariance, slot);
+    for (int index : fresh) {
+      Closure& c = closures_[index];
+      c.gate_checked = true;
+      if (c.record.status != ClosureStatus::kPending || !have_covariance) continue;
+      if (!passesGate(c, covariance, slot)) {
+        setStatus(c, ClosureStatus::kRejected, ClosureRejection::kChiSquareGate);
+        ++report.closures_decided;
+      }
+    }
+  }
+
+  // 2. Closures leaving the PCM horizon keep their decision; pending ones never found support.
+  const int new_start = std::max(pcm_horizon_start_, m - options_.pcm_max_closures);
+  for (int index = pcm_horizon_start_; index < new_start; ++index) {
+    Closure& c = closures_[index];
+    if (c.record.status == ClosureStatus::kPending) {
+      setStatus(c, ClosureStatus::kRejected, ClosureRejection::kNoSupport);
+      ++report.closures_decided;
+    }
+    if (c.record.status == ClosureStatus::kAccepted)
+      frozen_newest_accepted_utime_us_ = std::max(frozen_newest_accepted_utime_us_, closureUtime(c));
+  }
+  if (new_start != pcm_horizon_start_) {
+    for (auto it = pcm_cache_.begin(); it != pcm_cache_.end();)
+      it = it->first.first < new_start ? pcm_cache_.erase(it) : std::next(it);
+    pcm_horizon_start_ = new_start;
+  }
+
+  // 3. Pairwise consistency over the horizon and the largest mutually consistent set (greedy).
+  std::vector<int> candidates;
+  for (int index = pcm_horizon_start_; index < m; ++index)
+    if (eligible(closures_[index])) candidates.push_back(index);
+  const int n = static_cast<int>(candidates.size());
+  std::vector<std::vector<char>> consistent(n, std::vector<char>(n, 0));
+  std::vector<int> degree(n, 0);
+  for (int p = 0; p < n; ++p) {
+    for (int q = p + 1; q < n; ++q) {
+      const std::pair<int, int> key(candidates[p], candidates[q]);
+      auto it = pcm_cache_.find(key);
+      if (it == pcm_cache_.end())
+        it = pcm_cache_.emplace(key, pairConsistent(closures_[key.first], closures_[key.second])).first;
+      consistent[p][q] = consistent[q][p] = it->second ? 1 : 0;
+      if (it->second) {
+        ++degree[p];
+        ++degree[q];
+      }
+    }
+  }
+  auto accepted = [&](int p) { return closures_[candidates[p]].record.status == ClosureStatus::kAccepted; };
+  std::vector<int> order(n);
+  for (int p = 0; p < n; ++p) order[p] = p;
+  std::stable_sort(order.begin(), order.end(), [&](int p, int q) {
+    if (degree[p] != degree[q]) return degree[p] > degree[q];
+    return accepted(p) && !accepted(q);  // prefer keeping earlier decisions on ties
+  });
+  std::vector<int> best;
+  int best_accepted = -1;
+  for (int seed : order) {
+    if (degree[seed] + 1 < static_cast<int>(best.size())) continue;
+    std::vector<int> clique{seed};
+    for (int v : order) {
+      if (v == seed || !consistent[seed][v]) continue;
+      bool with_all = true;
+      for (int member : clique) with_all = with_all && consistent[member][v];
+      if (with_all) clique.push_back(v);
+    }
+    int clique_accepted = 0;
+    for (int member : clique) clique_accepted += accepted(member) ? 1 : 0;
+    if (clique.size() > best.size() || (clique.size() == best.size() && clique_accepted > best_accepted)) {
+      best = clique;
+      best_accepted = clique_accepted;
+    }
+  }
+  const bool enough = static_cast<int>(best.size()) >= options_.min_consistent_closures;
+  std::vector<char> in_best(n, 0);
+  if (enough)
+    for (int p : best) in_best[p] = 1;
+  for (int p = 0; p < n; ++p) {
+    Closure& c = closures_[candidates[p]];
+    const ClosureStatus before = c.record.status;
+    if (in_best[p]) {
+      setStatus(c, ClosureStatus::kAccepted, ClosureRejection::kNone);
+    } else if (enough) {
+      setStatus(c, ClosureStatus::kRejected, ClosureRejection::kInconsistent);
+    } else if (c.record.status != ClosureStatus::kAccepted) {
+      setStatus(c, ClosureStatus::kPending, ClosureRejection::kNone);
+    }
+    if (c.record.status != before) ++report.closures_decided;
+  }
+  window_stats_.pcm_candidates = n;
+
+  newest_accepted_closure_utime_us_ = frozen_newest_accepted_utime_us_;
+  for (int index = pcm_horizon_start_; index < m; ++index)
+    if (closures_[index].record.status == ClosureStatus::kAccepted)
+      newest_accepted_closure_utime_us_ = std::max(newest_accepted_closure_utime_us_, closureUtime(closures_[index]));
+}
+
+// ---- solving ----------------------------------------------------------------------------------
+
+bool SlidingWindowPoseGraph::solve(const std::vector<Factor>& factors, int max_iterations, UpdateReport& report) {
+  PoseManifold manifold;  // outlives the problem, which does not own it
+  ceres::Problem::Options problem_options;
+  problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+
+  std::unordered_map<int, int> slot_of;
+  std::vector<int> node_of_slot;
+  std::vector<PoseParameters> parameters;
+  parameters.reserve(nodes_.size() - first_active_ + 16);
+  // Slots first so that the parameter storage does not move while blocks are added.
+  for (const Factor& f : factors)
+    for (int n : factorNodes(f))
+      if (slot_of.emplace(n, static_cast<int>(node_of_slot.size())).second) node_of_slot.push_back(n);
+  for (int n : node_of_slot) parameters.push_back(toParameters(nodes_[n].estimate));
+  for (size_t s = 0; s < node_of_slot.size(); ++s) {
+    problem.AddParameterBlock(parameters[s].data(), kPoseAmbientSize, &manifold);
+    if (!isActive(node_of_slot[s])) problem.SetParameterBlockConstant(parameters[s].data());
+  }
+  for (const Factor& f : factors) {
+    std::vector<double*> blocks;
+    for (int n : factorNodes(f)) blocks.push_back(parameters[slot_of[n]].data());
+    problem.AddResidualBlock(makeCost(f), makeLoss(f), blocks);
+  }
+
+  ceres::Solver::Options solver_options;
+  solver_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  if (ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE))
+    solver_options.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
+  else if (ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::EIGEN_SPARSE))
+    solver_options.sparse_linear_algebra_library_type = ceres::EIGEN_SPARSE;
+  else
+    solver_options.linear_solver_type = ceres::DENSE_QR;
+  solver_options.max_num_iterations = max_iterations;
+  if (options_.max_solver_time_s > 0.0) solver_options.max_solver_time_in_seconds = options_.max_solver_time_s;
+  solver_options.num_threads = 1;  // deterministic, and the machine's cores belong to the matcher
+  solver_options.logging_type = ceres::SILENT;
+  solver_options.minimizer_progress_to_stdout = false;
+
+  const Clock::time_point start = Clock::now();
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem, &summary);
+  report.solve_s = secondsSince(start);
+  report.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  if (!summary.IsSolutionUsable() || !std::isfinite(summary.final_cost)) {
+    report.ok = false;
+    report.message = "solver failed (" + summary.message + "); keeping the previous estimate";
+    ++counters_.solver_failures;
+    return false;
+  }
+  for (size_t s = 0; s < node_of_slot.size(); ++s) {
+    const int n = node_of_slot[s];
+    if (!isActive(n)) continue;
+    Pose pose = fromParameters(parameters[s].data());
+    if (!finitePose(pose)) continue;
+    nodes_[n].estimate = normalisedPose(pose);
+  }
+  window_stats_.residual_blocks = problem.NumResidualBlocks();
+  return true;
+}
+
+void SlidingWindowPoseGraph::marginaliseOldest() {
+  const int m = first_active_;
+  const std::vector<Factor> factors = factorsTouching(m);
+  std::vector<LinearisedFactor> linearised;
+  std::vector<int> kept;  // the other variable nodes, in ascending order
+  for (const Factor& f : factors) {
+    LinearisedFactor lf;
+    if (!linearise(f, lf)) continue;  // a non-finite factor carries no usable information
+    for (int n : lf.nodes)
+      if (n != m) kept.push_back(n);
+    linearised.push_back(std::move(lf));
+  }
+  std::sort(kept.begin(), kept.end());
+  kept.erase(std::unique(kept.begin(), kept.end()), kept.end());
+  std::unordered_map<int, int> position{{m, 0}};
+  for (size_t k = 0; k < kept.size(); ++k) position[kept[k]] = static_cast<int>(k) + 1;
+
+  const int dim = 6 * (1 + static_cast<int>(kept.size()));
+  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(dim, dim);
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(dim);
+  for (const LinearisedFactor& lf : linearised) {
+    for (size_t p = 0; p < lf.nodes.size(); ++p) {
+      const int row = 6 * position[lf.nodes[p]];
+      const auto jp = lf.jacobian.middleCols<6>(6 * static_cast<int>(p));
+      g.segment<6>(row) += jp.transpose() * lf.residual;
+      for (size_t q = 0; q < lf.nodes.size(); ++q) {
+        const int col = 6 * position[lf.nodes[q]];
+        h.block<6, 6>(row, col) += jp.transpose() * lf.jacobian.middleCols<6>(6 * static_cast<int>(q));
+      }
+    }
+  }
+
+  // Schur complement onto the kept nodes: H* = H_kk - H_km H_mm^-1 H_mk, g* = g_k - H_km H_mm^-1 g_m.
+  const Matrix6d h_mm = 0.5 * (h.topLeftCorner<6, 6>() + h.topLeftCorner<6, 6>().transpose());
+  const Eigen::LDLT<Matrix6d> ldlt(h_mm);
+  Matrix6d h_mm_inverse = ldlt.solve(Matrix6d::Identity());
+  if (ldlt.info() != Eigen::Success || !h_mm_inverse.allFinite())
+    h_mm_inverse = Eigen::CompleteOrthogonalDecomposition<Matrix6d>(h_mm).pseudoInverse();
+  nodes_[m].conditional_covariance = 0.5 * (h_mm_inverse + h_mm_inverse.transpose());
+
+  Prior prior;
+  if (!kept.empty()) {
+    const int k = dim - 6;
+    const Eigen::MatrixXd h_km = h.bottomLeftCorner(k, 6);
+    Eigen::MatrixXd h_star = h.bottomRightCorner(k, k) - h_km * h_mm_inverse * h_km.transpose();
+    h_star = 0.5 * (h_star + h_star.transpose());
+    const Eigen::VectorXd g_star = g.tail(k) - h_km * h_mm_inverse * g.head<6>();
+    // H* = V diag(l) V^T; J = diag(sqrt l) V^T and r0 = diag(1/sqrt l) V^T g* give
+    // 0.5 |r0 + J d|^2 = 0.5 d^T H* d + g*^T d + const. Null directions (gauge) are dropped.
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(h_star);
+    const Eigen::VectorXd lambda = eigen.eigenvalues();
+    const double threshold = std::max(1e-12 * lambda.maxCoeff(), 1e-12);
+    std::vector<int> keep;
+    for (int i = 0; i < k; ++i)
+      if (lambda(i) > threshold) keep.push_back(i);
+    prior.jacobian.resize(static_cast<int>(keep.size()), k);
+    prior.residual.resize(static_cast<int>(keep.size()));
+    for (size_t r = 0; r < keep.size(); ++r) {
+      const double s = std::sqrt(lambda(keep[r]));
+      const Eigen::VectorXd v = eigen.eigenvectors().col(keep[r]);
+      prior.jacobian.row(static_cast<int>(r)) = s * v.transpose();
+      prior.residual(static_cast<int>(r)) = v.dot(g_star) / s;
+    }
+    if (!keep.empty()) {
+      prior.nodes = kept;
+      for (int n : kept) prior.linearisation.push_back(nodes_[n].estimate);
+    }
+  }
+  prior_ = std::move(prior);
+  for (const Factor& f : factors)
+    if (f.kind == FactorKind::kClosure) closures_[f.index].record.marginalised = true;
+  ++first_active_;
+}
+
+bool SlidingWindowPoseGraph::computeWindowCovariance(Eigen::MatrixXd& covariance, std::vector<int>& slot) const {
+  const int n = static_cast<int>(nodes_.size()) - first_active_;
+  if (n <= 0) return false;
+  slot.resize(n);
+  for (int i = 0; i < n; ++i) slot[i] = i;
+  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(6 * n, 6 * n);
+  for (const Factor& f : windowFactors()) {
+    LinearisedFactor lf;
+    if (!linearise(f, lf)) continue;
+    for (size_t p = 0; p < lf.nodes.size(); ++p) {
+      const int row = 6 * (lf.nodes[p] - first_active_);
+      for (size_t q = 0; q < lf.nodes.size(); ++q) {
+        const int col = 6 * (lf.nodes[q] - first_active_);
+        h.block<6, 6>(row, col) += lf.jacobian.middleCols<6>(6 * static_cast<int>(p)).transpose() *
+                                   lf.jacobian.middleCols<6>(6 * static_cast<int>(q));
+      }
+    }
+  }
+  const Eigen::LLT<Eigen::MatrixXd> llt(0.5 * (h + h.transpose()));
+  if (llt.info() != Eigen::Success) return false;
+  covariance = llt.solve(Eigen::MatrixXd::Identity(6 * n, 6 * n));
+  return covariance.allFinite();
+}
+
+void SlidingWindowPoseGraph::refreshCovariances() {
+  Eigen::MatrixXd covariance;
+  std::vector<int> slot;
+  if (!computeWindowCovariance(covariance, slot)) return;
+  for (int n = first_active_; n < static_cast<int>(nodes_.size()); ++n) {
+    const int s = slot[n - first_active_];
+    const Matrix6d block = covariance.block<6, 6>(6 * s, 6 * s);
+    nodes_[n].covariance = 0.5 * (block + block.transpose());
+    nodes_[n].has_covariance = true;
+  }
+}
+
+void SlidingWindowPoseGraph::refreshWindowStats(const std::vector<Factor>& factors) {
+  window_stats_.active_nodes = static_cast<int>(nodes_.size()) - first_active_;
+  window_stats_.variable_blocks = window_stats_.active_nodes;
+  std::vector<int> constants;
+  for (const Factor& f : factors)
+    for (int n : factorNodes(f))
+      if (!isActive(n)) constants.push_back(n);
+  std::sort(constants.begin(), constants.end());
+  window_stats_.constant_blocks =
+      static_cast<int>(std::unique(constants.begin(), constants.end()) - constants.begin());
+  window_stats_.residual_blocks = static_cast<int>(factors.size());
+  window_stats_.prior_nodes = static_cast<int>(prior_.nodes.size());
+  window_stats_.prior_rows = static_cast<int>(prior_.residual.size());
+}
+
+UpdateReport SlidingWindowPoseGraph::optimize() {
+  const Clock::time_point start = Clock::now();
+  UpdateReport report;
+  if (nodes_.empty()) return report;
+  decideClosures(report);
+  const std::vector<Factor> factors = windowFactors();
+  refreshWindowStats(factors);
+  solve(factors, options_.max_iterations, report);
+  // Marginalise at the solution even after a failed solve: the window must stay bounded.
+  while (static_cast<int>(nodes_.size()) - first_active_ > options_.window_size) {
+    marginaliseOldest();
+    ++counters_.nodes_marginalised;
+  }
+  refreshCovariances();
+  update_utime_us_ = nodes_.back().utime_us;
+  report.update_s = secondsSince(start);
+  ++counters_.updates;
+  counters_.last_update_s = report.update_s;
+  counters_.last_solve_s = report.solve_s;
+  counters_.last_iterations = report.iterations;
+  return report;
+}
+
+UpdateReport SlidingWindowPoseGraph::fullSmoothing() {
+  const Clock::time_point start = Clock::now();
+  UpdateReport report;
+  if (nodes_.empty()) return report;
+  decideClosures(report);
+  // Every node is a variable: solve with the window boundary at the first node.
+  const int boundary = first_active_;
+  first_active_ = 0;
+  const std::vector<Factor> factors = allFactors();
+  const bool ok = solve(factors, options_.full_smoothing_max_iterations, report);
+  if (ok) {
+    // Re-derive the window's prior at the smoothed estimate, eliminating the old nodes in order.
+    prior_ = Prior();
+    for (Closure& c : closures_) c.record.marginalised = false;
+    while (first_active_ < boundary) marginaliseOldest();
+  } else {
+    first_active_ = boundary;
+  }
+  refreshWindowStats(windowFactors());
+  refreshCovariances();
+  update_utime_us_ = nodes_.back().utime_us;
+  report.update_s = secondsSince(start);
+  ++counters_.full_smoothings;
+  counters_.last_update_s = report.update_s;
+  counters_.last_solve_s = report.solve_s;
+  counters_.last_iterations = report.iterations;
+  return report;
+}
+
+// ---- queries ----------------------------------------------------------------------------------
+
+std::optional<Pose> SlidingWindowPoseGraph::estimate(int64_t subframe_id) const {
+  const auto it = index_of_.find(subframe_id);
+  if (it == index_of_.end()) return std::nullopt;
+  return nodes_[it->second].estimate;
+}
+
+std::optional<Matrix6d> SlidingWindowPoseGraph::covariance(int64_t subframe_id) const {
+  const auto it = index_of_.find(subframe_id);
+  if (it == index_of_.end() || !nodes_[it->second].has_covariance) return std::nullopt;
+  return nodes_[it->second].covariance;
+}
+
+std::vector<NodeState> SlidingWindowPoseGraph::nodes() const {
+  std::vector<NodeState> out;
+  out.reserve(nodes_.size());
+  for (size_t i = 0; i < nodes_.size(); ++i) {
+    const Node& n = nodes_[i];
+    out.push_back({n.id, n.utime_us, n.dr, n.estimate, n.distance_m, !isActive(static_cast<int>(i))});
+  }
+  return out;
+}
+
+std::vector<ClosureRecord> SlidingWindowPoseGraph::closures() const {
+  std::vector<ClosureRecord> out;
+  out.reserve(closures_.size());
+  for (const Closure& c : closures_) out.push_back(c.record);
+  return out;
+}
+
+Correction SlidingWindowPoseGraph::correctionAt(int64_t utime_us) const {
+  Correction out;
+  out.update_utime_us = update_utime_us_;
+  out.accepted_closures = static_cast<int>(counters_.closures_accepted);
+  if (nodes_.empty()) {
+    out.covariance = 1e6 * Matrix6d::Identity();  // nothing known yet
+    return out;
+  }
+  auto correctionOf = [&](const Node& n) { return n.estimate * n.dr.inverse(); };
+  const auto after = std::lower_bound(nodes_.begin(), nodes_.end(), utime_us,
+                                      [](const Node& n, int64_t t) { return n.utime_us < t; });
+  const Node* reference = nullptr;
+  double distance_m = 0.0;
+  // DR speed of the nearest edge, to turn time outside the nodes into distance.
+  auto speed = [&](size_t i, size_t j) {
+    const double dt_s = 1e-6 * static_cast<double>(nodes_[j].utime_us - nodes_[i].utime_us);
+    return dt_s > 0.0 ? (nodes_[j].distance_m - nodes_[i].distance_m) / dt_s : options_.nominal_speed_m_s;
+  };
+  if (after == nodes_.begin()) {
+    reference = &nodes_.front();
+    out.T_corrected_dr = correctionOf(*reference);
+    const double v = nodes_.size() > 1 ? speed(0, 1) : options_.nominal_speed_m_s;
+    distance_m = reference->distance_m - v * 1e-6 * static_cast<double>(reference->utime_us - utime_us);
+  } else if (after == nodes_.end()) {
+    reference = &nodes_.back();
+    out.T_corrected_dr = correctionOf(*reference);
+    const size_t last = nodes_.size() - 1;
+    const double v = nodes_.size() > 1 ? speed(last - 1, last) : options_.nominal_speed_m_s;
+    distance_m = reference->distance_m + v * 1e-6 * static_cast<double>(utime_us - reference->utime_us);
+  } else {
+    const Node& n1 = *after;
+    const Node& n0 = *(after - 1);
+    const double alpha = static_cast<double>(utime_us - n0.utime_us) / static_cast<double>(n1.utime_us - n0.utime_us);
+    out.T_corrected_dr = sss::core::interpolate(correctionOf(n0), correctionOf(n1), alpha);
+    reference = alpha <= 0.5 ? &n0 : &n1;
+    distance_m = n0.distance_m + alpha * (n1.distance_m - n0.distance_m);
+  }
+  const Matrix6d node_covariance = reference->has_covariance ? reference->covariance : 1e6 * Matrix6d::Identity();
+  out.covariance = node_covariance + odometryCovariance(options_, std::abs(distance_m - reference->distance_m));
+  if (counters_.closures_accepted == 0 || newest_accepted_closure_utime_us_ < 0) {
+    out.status = CorrectionStatus::kDrOnly;
+  } else {
+    const double age_s = 1e-6 * static_cast<double>(utime_us - newest_accepted_closure_utime_us_);
+    out.status = age_s > options_.degraded_after_s ? CorrectionStatus::kDegraded : CorrectionStatus::kCorrected;
+  }
+  return out;
+}
+
+}  // namespace sss::optimiser

@@ -1,0 +1,335 @@
+// Sliding-window pose graph over subframe-centre poses (DESIGN.md stage 5, paper Sec. "Pose Graph
+// Optimization", eq. (6)): DR odometry chain plus loop closures with robust rejection (Cauchy loss,
+// chi-square gate, pairwise consistency), Schur-complement marginalisation, full smoothing,
+// corrections for any time and checkpoints. Pure C++ over Ceres: no LCM, DDS or systemd.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "pipeline/core/config.hpp"
+#include "pipeline/core/pose.hpp"
+
+namespace ceres {
+class CostFunction;
+class LossFunction;
+}  // namespace ceres
+
+namespace sss::optimiser {
+
+struct PoseGraphOptions {
+  // ---- sliding window ----------------------------------------------------------------------------
+  // Nodes optimised per update; older ones are marginalised into a prior. Adjacent-line closures
+  // stay inside the window when it spans two survey lines (2 x 4 subframes for 400 m lines).
+  int window_size = 30;
+
+  // ---- DR odometry between consecutive nodes, d = distance travelled between them (m) -------------
+  // Covariance in the [dt, dr] tangent of the relative pose (see odometryCovariance()):
+  //   horizontal sigma^2 = (random_walk * sqrt(d))^2 + (drift_fraction * d)^2 + min_sigma^2 (x and y)
+  //   vertical sigma     = depth_sigma (depth is measured absolutely: relative error does not grow)
+  //   heading sigma^2    = (heading_random_walk * sqrt(d))^2 + min_heading_sigma^2
+  //   roll, pitch sigma  = attitude_sigma (the INS measures them absolutely against gravity)
+  double odometry_random_walk_m_per_sqrt_m = 0.02;  // DVL velocity noise integrated over distance
+  double odometry_drift_fraction = 0.005;           // 0.5 % of distance, 1 sigma (heading/scale bias)
+  double odometry_min_sigma_m = 0.05;               // keeps nodes a few metres apart well posed
+  double odometry_depth_sigma_m = 0.1;
+  double odometry_heading_random_walk_rad_per_sqrt_m = 2e-4;  // 0.002 rad (0.11 deg) per 100 m
+  double odometry_min_heading_sigma_rad = 1e-4;
+  double odometry_attitude_sigma_rad = 0.002;
+
+  // ---- absolute INS measurements of every node (0 switches one off) -------------------------------
+  // Depth, roll, pitch and heading are measured against absolute references (pressure, gravity,
+  // earth rotation): their error stays bounded however far the vehicle goes, unlike position. Without
+  // these a long chain of adjacent-line closures lets heading (and so position) wander further than
+  // the DR itself. Sigmas are per node and treated as independent between nodes, so they are
+  // wider than the INS's specification (which is mostly a slowly varying bias).
+  double absolute_depth_sigma_m = 0.2;
+  double absolute_roll_pitch_sigma_rad = 0.002;
+  double absolute_heading_sigma_rad = 0.005;
+
+  // ---- anchor: the first node's DR pose fixes the gauge --------------------------------------------
+  double first_node_sigma_m = 0.1;
+  double first_node_sigma_rad = 0.001;
+
+  // ---- loop closures ------------------------------------------------------------------------------
+  std::string robust_loss = "cauchy";  // "cauchy", "huber" or "none", on the whitened closure residual
+  double robust_loss_scale = 4.0;      // whitened residual norm where down-weighting starts
+  int min_closure_inliers = 0;         // closures with fewer RANSAC inliers are rejected on arrival
+  // Chi-square gate of a new closure against the current estimate (6 dof: 22.46 = 99.9 %), applied
+  // once this many closures are accepted (before that the estimate is DR and says little more
+  // than the pairwise test).
+  double gate_chi2 = 22.46;
+  int gate_min_accepted_closures = 5;
+  // Pairwise consistency (PCM): cycle closure_i * DR chain * closure_j^-1 * DR chain within this
+  // chi-square (6 dof: 16.81 = 99 %); the largest mutually consistent set among the newest
+  // pcm_max_closures closures is accepted when it has at least min_consistent_closures members.
+  double pcm_chi2 = 16.81;
+  int pcm_max_closures = 100;
+  int min_consistent_closures = 2;
+
+  // ---- solver -------------------------------------------------------------------------------------
+  int max_iterations = 10;            // per window update; deterministic bound
+  double max_solver_time_s = 0.0;     // > 0 adds a wall-clock bound (then results depend on load)
+  int full_smoothing_max_iterations = 100;
+
+  // ---- corrections --------------------------------------------------------------------------------
+  double degraded_after_s = 1800.0;   // status DEGRADED when the newest accepted closure is older
+  double nominal_speed_m_s = 2.0;     // DR growth after the newest node when no speed is known yet
+};
+
+std::vector<std::string> validatePoseGraphOptions(const PoseGraphOptions& options);
+void readPoseGraphOptions(sss::core::ConfigSection& section, PoseGraphOptions& options);
+
+// Result of an input call: ok, or why the input was refused (the graph is unchanged then).
+struct Status {
+  bool ok = true;
+  std::string message;
+  static Status success() { return {}; }
+  static Status error(std::string text) { return {false, std::move(text)}; }
+};
+
+// A loop closure from the matcher (SSS_LOOP).
+struct LoopClosure {
+  int64_t subframe_id_a = 0;
+  int64_t subframe_id_b = 0;
+  sss::core::Pose T_a_b;  // B's centre body frame in A's
+  sss::core::Matrix6d covariance = sss::core::Matrix6d::Identity();  // [dt, dr] at T_a_b (boxPlus)
+  int association_round = 0;  // a newer round of the same pair supersedes the older closure
+  int num_inliers = 0;
+  double total_cost = 0.0;
+};
+
+enum class ClosureStatus { kPending, kAccepted, kRejected, kSuperseded };
+enum class ClosureRejection {
+  kNone,
+  kChiSquareGate,    // innovation against the current estimate beyond gate_chi2
+  kInconsistent,     // outside the largest pairwise-consistent set
+  kNoSupport,        // left the PCM horizon without ever being in a large enough consistent set
+};
+const char* closureRejectionName(ClosureRejection rejection);
+
+struct ClosureRecord {
+  LoopClosure closure;
+  ClosureStatus status = ClosureStatus::kPending;
+  ClosureRejection rejection = ClosureRejection::kNone;
+  // Its information is in the marginalisation prior: a later rejection cannot withdraw it from the
+  // window (counted in closures_withdrawn_after_marginalisation), but full smoothing drops it.
+  bool marginalised = false;
+};
+
+struct NodeState {
+  int64_t subframe_id = 0;
+  int64_t utime_us = 0;
+  sss::core::Pose T_world_body_dr;
+  sss::core::Pose T_world_body;  // current estimate (frozen once marginalised, until fullSmoothing)
+  double distance_travelled_m = 0.0;
+  bool marginalised = false;
+};
+
+struct PoseGraphCounters {
+  uint64_t nodes_added = 0;
+  uint64_t nodes_refused = 0;         // bad input (order, duplicate id, non-finite)
+  uint64_t nodes_marginalised = 0;
+  uint64_t closures_received = 0;
+  uint64_t closures_refused = 0;      // unknown id, self loop, bad covariance, too few inliers...
+  // Decisions now (a PCM decision may change while the closure is in the PCM horizon):
+  uint64_t closures_pending = 0;
+  uint64_t closures_accepted = 0;
+  uint64_t closures_rejected_gate = 0;
+  uint64_t closures_rejected_inconsistent = 0;
+  uint64_t closures_rejected_no_support = 0;
+  uint64_t closures_superseded = 0;
+  uint64_t closures_withdrawn_after_marginalisation = 0;
+  uint64_t updates = 0;
+  uint64_t full_smoothings = 0;
+  uint64_t solver_failures = 0;
+  double last_update_s = 0.0;         // whole optimize(): decisions, solve, marginalisation, covariance
+  double last_solve_s = 0.0;          // the Ceres solve alone
+  int last_iterations = 0;
+};
+
+// The size of the optimisation problem solved by the last update (before that update marginalised
+// the oldest node): constant once the window is full.
+struct WindowStats {
+  int active_nodes = 0;
+  int variable_blocks = 0;   // active nodes
+  int constant_blocks = 0;   // marginalised nodes referenced by accepted closures
+  int residual_blocks = 0;
+  int prior_nodes = 0;
+  int prior_rows = 0;
+  int pcm_candidates = 0;
+};
+
+struct UpdateReport {
+  bool ok = true;
+  std::string message;  // why the solve failed (the previous estimate is kept)
+  int iterations = 0;
+  double solve_s = 0.0;
+  double update_s = 0.0;
+  int closures_decided = 0;  // closures whose status changed in this update
+};
+
+enum class CorrectionStatus { kDrOnly, kCorrected, kDegraded };
+
+// corrected = T_corrected_dr * T_world_body_dr for the same time (world-frame correction).
+struct Correction {
+  sss::core::Pose T_corrected_dr;
+  // Of the corrected pose in its [dt, dr] tangent: the covariance of the node nearest in time plus
+  // the DR odometry model over the distance travelled between that node and the query time.
+  sss::core::Matrix6d covariance = sss::core::Matrix6d::Identity();
+  CorrectionStatus status = CorrectionStatus::kDrOnly;
+  int64_t update_utime_us = 0;  // newest node of the update the correction comes from
+  int accepted_closures = 0;
+};
+
+// Not thread-safe: one owner (the optimiser process loop) calls it. Copyable, so a caller can keep
+// a snapshot; deterministic for the same input when max_solver_time_s is 0.
+class SlidingWindowPoseGraph {
+ public:
+  // Options must validate (validatePoseGraphOptions); invalid options are a programming error
+  // and throw std::invalid_argument.
+  explicit SlidingWindowPoseGraph(const PoseGraphOptions& options);
+
+  // A subframe centre: DR pose (local NED world, FRD body) and DR distance travelled since the
+  // mission start. Nodes must come in time order with unique ids; O(1), no solve.
+  Status addNode(int64_t subframe_id, int64_t utime_us, const sss::core::Pose& T_world_body_dr,
+                 double distance_travelled_m);
+  // Queues a closure for the next optimize(); refused (with the reason) when an id is unknown, the
+  // input is not finite, the covariance is not positive definite or it has too few inliers. A
+  // closure to a marginalised node acts through that node held constant (see pose_graph.cpp); one
+  // between two marginalised nodes only counts in fullSmoothing().
+  Status addLoopClosure(const LoopClosure& closure);
+
+  // Decides pending closures, solves the window, marginalises nodes beyond window_size and
+  // updates the covariances. Never throws on field data.
+  UpdateReport optimize();
+  // Re-optimises all nodes with all odometry and accepted closures (end of mission), then
+  // re-derives the marginalisation prior at the smoothed estimate so the window can go on.
+  UpdateReport fullSmoothing();
+
+  // ---- queries ------------------------------------------------------------------------------------
+  std::optional<sss::core::Pose> estimate(int64_t subframe_id) const;
+  // [dt, dr] covariance of the node: from the window's information matrix at the last update, or
+  // for a marginalised node the one it had when it left the window.
+  std::optional<sss::core::Matrix6d> covariance(int64_t subframe_id) const;
+  std::vector<NodeState> nodes() const;
+  size_t numNodes() const { return nodes_.size(); }
+  std::vector<ClosureRecord> closures() const;  // in arrival order
+  const PoseGraphCounters& counters() const { return counters_; }
+  const WindowStats& windowStats() const { return window_stats_; }
+  const PoseGraphOptions& options() const { return options_; }
+  Correction correctionAt(int64_t utime_us) const;
+
+  // ---- checkpoint ---------------------------------------------------------------------------------
+  // Everything needed to resume (nodes, closures and their decisions, prior, counters), versioned
+  // text with a checksum, written to a temporary file, fsync'ed and renamed into place. Options are
+  // not stored: a restored graph runs with the options it was constructed with (the deployment's).
+  Status saveCheckpoint(const std::string& path) const;
+  // Replaces this graph's state; a missing, truncated or corrupt file leaves it unchanged.
+  Status loadCheckpoint(const std::string& path);
+
+  // The odometry model (see PoseGraphOptions) for distance d.
+  static sss::core::Matrix6d odometryCovariance(const PoseGraphOptions& options, double distance_m);
+
+ private:
+  struct Node {
+    int64_t id = 0;
+    int64_t utime_us = 0;
+    sss::core::Pose dr;
+    double distance_m = 0.0;
+    sss::core::Pose estimate;
+    // Odometry from the previous node (identity for the first).
+    sss::core::Pose odometry;
+    sss::core::Matrix6d odometry_sqrt_information = sss::core::Matrix6d::Identity();
+    // Sum over the chain edges e < this node of Ad(dr_{e+1}) Sigma_e Ad(dr_{e+1})^T: the DR chain
+    // covariance between any two nodes in O(1) (see chainCovariance()).
+    sss::core::Matrix6d chain_prefix = sss::core::Matrix6d::Zero();
+    bool has_covariance = false;
+    sss::core::Matrix6d covariance = sss::core::Matrix6d::Zero();
+    // Covariance given the rest of the window when it was marginalised (H_mm^-1): the uncertainty
+    // of this node relative to the window it stayed tied to.
+    sss::core::Matrix6d conditional_covariance = sss::core::Matrix6d::Zero();
+    std::vector<int> closures;  // indices into closures_ of closures touching this node
+  };
+
+  struct Closure {
+    ClosureRecord record;
+    int a = -1, b = -1;  // node indices
+    bool gate_checked = false;
+    sss::core::Matrix6d sqrt_information = sss::core::Matrix6d::Identity();  // of the closure alone
+  };
+
+  struct Prior {
+    std::vector<int> nodes;
+    std::vector<sss::core::Pose> linearisation;
+    Eigen::MatrixXd jacobian;
+    Eigen::VectorXd residual;
+    bool empty() const { return nodes.empty(); }
+  };
+
+  enum class FactorKind { kFirstNode, kInsAbsolute, kOdometry, kClosure, kPrior };
+  struct Factor {
+    FactorKind kind;
+    int index;  // node (first node, INS absolute; odometry: the newer node) or closure index
+  };
+
+  struct LinearisedFactor {
+    std::vector<int> nodes;  // variable nodes only
+    Eigen::MatrixXd jacobian;  // rows x 6 * nodes.size(), tangent space
+    Eigen::VectorXd residual;
+  };
+
+  // Factors of the current window: nodes >= first_active_ are variables, older ones constants.
+  std::vector<Factor> windowFactors() const;
+  // Every odometry edge and accepted closure over all nodes (full smoothing).
+  std::vector<Factor> allFactors() const;
+  // The window factors that involve node m (the one being marginalised), the prior included.
+  std::vector<Factor> factorsTouching(int m) const;
+  std::vector<int> factorNodes(const Factor& factor) const;
+  ceres::CostFunction* makeCost(const Factor& factor) const;
+  ceres::LossFunction* makeLoss(const Factor& factor) const;
+  sss::core::Matrix6d closureCovarianceInWindow(const Closure& closure) const;
+  bool linearise(const Factor& factor, LinearisedFactor& out) const;
+
+  void decideClosures(UpdateReport& report);
+  bool passesGate(const Closure& closure, const Eigen::MatrixXd& covariance, const std::vector<int>& slot) const;
+  bool pairConsistent(const Closure& i, const Closure& j) const;
+  sss::core::Matrix6d chainCovariance(int from, int to) const;
+  bool solve(const std::vector<Factor>& factors, int max_iterations, UpdateReport& report);
+  void marginaliseOldest();
+  // Joint covariance of the active nodes (6 x 6 blocks in node order); slot[n - first_active_] is
+  // the block of node n.
+  bool computeWindowCovariance(Eigen::MatrixXd& covariance, std::vector<int>& slot) const;
+  void refreshCovariances();
+  void refreshWindowStats(const std::vector<Factor>& factors);
+  void setStatus(Closure& closure, ClosureStatus status, ClosureRejection rejection);
+  void setupDerived(Node& node, const Node* previous) const;
+  bool isActive(int node) const { return node >= first_active_; }
+  bool useInsAbsolute() const;
+  int64_t closureUtime(const Closure& closure) const;
+
+  PoseGraphOptions options_;
+  std::vector<Node> nodes_;
+  std::unordered_map<int64_t, int> index_of_;
+  std::vector<Closure> closures_;
+  std::map<std::pair<int64_t, int64_t>, int> latest_for_pair_;  // (smaller id, larger id) -> closure
+  std::map<std::pair<int, int>, bool> pcm_cache_;               // pair consistency within the horizon
+  int pcm_horizon_start_ = 0;  // closures before it are decided for good
+  int first_active_ = 0;
+  Prior prior_;
+  PoseGraphCounters counters_;
+  WindowStats window_stats_;
+  int64_t update_utime_us_ = 0;
+  // Newest node time of an accepted closure that left the PCM horizon (its decision is final).
+  int64_t frozen_newest_accepted_utime_us_ = -1;
+  int64_t newest_accepted_closure_utime_us_ = -1;
+};
+
+}  // namespace sss::optimiser

@@ -1,0 +1,400 @@
+// Checkpoint of the sliding-window pose graph: versioned text ("%.17g" doubles round-trip exactly),
+// an FNV-1a checksum line, written to a temporary file, fsync'ed and renamed into place.
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cinttypes>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <string>
+
+#include "pipeline/optimiser/pose_graph.hpp"
+#include "pipeline/optimiser/pose_manifold.hpp"
+
+namespace sss::optimiser {
+
+using sss::core::Matrix6d;
+using sss::core::Pose;
+
+namespace {
+
+constexpr const char* kMagic = "sss-pose-graph-checkpoint";
+constexpr int kVersion = 1;
+constexpr size_t kMaxFileBytes = size_t{1} << 31;  // 2 GiB: far above any mission
+
+uint64_t fnv1a(const char* data, size_t size) {
+  uint64_t hash = 1469598103934665603ull;
+  for (size_t i = 0; i < size; ++i) {
+    hash ^= static_cast<unsigned char>(data[i]);
+    hash *= 1099511628211ull;
+  }
+  return hash;
+}
+
+class Writer {
+ public:
+  void word(const char* w) { separate(); text_ += w; }
+  void integer(int64_t v) {
+    separate();
+    text_ += std::to_string(v);
+  }
+  void unsignedInteger(uint64_t v) {
+    separate();
+    text_ += std::to_string(v);
+  }
+  void real(double v) {
+    char buffer[40];
+    std::snprintf(buffer, sizeof(buffer), "%.17g", v);
+    separate();
+    text_ += buffer;
+  }
+  void pose(const Pose& p) {
+    for (double v : toParameters(p)) real(v);
+  }
+  void matrix(const Eigen::MatrixXd& m) {
+    for (int r = 0; r < m.rows(); ++r)
+      for (int c = 0; c < m.cols(); ++c) real(m(r, c));
+  }
+  void endLine() {
+    text_ += '\n';
+    at_line_start_ = true;
+  }
+  std::string& text() { return text_; }
+
+ private:
+  void separate() {
+    if (!at_line_start_) text_ += ' ';
+    at_line_start_ = false;
+  }
+  std::string text_;
+  bool at_line_start_ = true;
+};
+
+class Reader {
+ public:
+  explicit Reader(const std::string& text) : text_(text) {}
+
+  bool token(std::string& out) {
+    while (pos_ < text_.size() && std::isspace(static_cast<unsigned char>(text_[pos_]))) ++pos_;
+    if (pos_ >= text_.size()) return false;
+    const size_t start = pos_;
+    while (pos_ < text_.size() && !std::isspace(static_cast<unsigned char>(text_[pos_]))) ++pos_;
+    out.assign(text_, start, pos_ - start);
+    return true;
+  }
+  bool expect(const char* word) {
+    std::string t;
+    return token(t) && t == word;
+  }
+  bool integer(int64_t& v) {
+    std::string t;
+    if (!token(t)) return false;
+    errno = 0;
+    char* end = nullptr;
+    const long long parsed = std::strtoll(t.c_str(), &end, 10);
+    if (errno != 0 || end != t.c_str() + t.size() || t.empty()) return false;
+    v = parsed;
+    return true;
+  }
+  bool unsignedInteger(uint64_t& v) {
+    std::string t;
+    if (!token(t) || t.empty() || t[0] == '-') return false;
+    errno = 0;
+    char* end = nullptr;
+    const unsigned long long parsed = std::strtoull(t.c_str(), &end, 10);
+    if (errno != 0 || end != t.c_str() + t.size()) return false;
+    v = parsed;
+    return true;
+  }
+  bool boundedInt(int& v, int64_t min, int64_t max) {
+    int64_t parsed = 0;
+    if (!integer(parsed) || parsed < min || parsed > max) return false;
+    v = static_cast<int>(parsed);
+    return true;
+  }
+  bool real(double& v) {
+    std::string t;
+    if (!token(t)) return false;
+    errno = 0;
+    char* end = nullptr;
+    const double parsed = std::strtod(t.c_str(), &end);
+    if (end != t.c_str() + t.size() || t.empty()) return false;
+    v = parsed;
+    return true;
+  }
+  bool finite(double& v) { return real(v) && std::isfinite(v); }
+  bool pose(Pose& p) {
+    double x[kPoseAmbientSize];
+    for (double& v : x)
+      if (!finite(v)) return false;
+    p = fromParameters(x);
+    return std::abs(p.rotation.norm() - 1.0) < 1e-6;
+  }
+  bool matrix(Eigen::MatrixXd& m, int rows, int cols) {
+    m.resize(rows, cols);
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < cols; ++c)
+        if (!finite(m(r, c))) return false;
+    return true;
+  }
+  bool matrix6(Matrix6d& m) {
+    Eigen::MatrixXd d;
+    if (!matrix(d, 6, 6)) return false;
+    m = d;
+    return true;
+  }
+  // Upper bound of the records of `tokens_per_record` tokens that could still follow: guards
+  // allocations against a corrupt count.
+  size_t remainingRecords(size_t tokens_per_record) const {
+    return (text_.size() - pos_) / (2 * tokens_per_record) + 1;
+  }
+
+ private:
+  const std::string& text_;
+  size_t pos_ = 0;
+};
+
+}  // namespace
+
+Status SlidingWindowPoseGraph::saveCheckpoint(const std::string& path) const {
+  Writer w;
+  w.word(kMagic);
+  w.integer(kVersion);
+  w.endLine();
+  w.word("state");
+  w.integer(static_cast<int64_t>(nodes_.size()));
+  w.integer(static_cast<int64_t>(closures_.size()));
+  w.integer(first_active_);
+  w.integer(pcm_horizon_start_);
+  w.integer(update_utime_us_);
+  w.integer(frozen_newest_accepted_utime_us_);
+  w.integer(newest_accepted_closure_utime_us_);
+  w.endLine();
+  for (const Node& n : nodes_) {
+    w.word("node");
+    w.integer(n.id);
+    w.integer(n.utime_us);
+    w.real(n.distance_m);
+    w.pose(n.dr);
+    w.pose(n.estimate);
+    w.integer(n.has_covariance ? 1 : 0);
+    w.matrix(n.covariance);
+    w.matrix(n.conditional_covariance);
+    w.endLine();
+  }
+  for (const Closure& c : closures_) {
+    const LoopClosure& l = c.record.closure;
+    w.word("closure");
+    w.integer(l.subframe_id_a);
+    w.integer(l.subframe_id_b);
+    w.integer(l.association_round);
+    w.integer(l.num_inliers);
+    w.real(l.total_cost);
+    w.pose(l.T_a_b);
+    w.matrix(l.covariance);
+    w.integer(static_cast<int>(c.record.status));
+    w.integer(static_cast<int>(c.record.rejection));
+    w.integer(c.record.marginalised ? 1 : 0);
+    w.integer(c.gate_checked ? 1 : 0);
+    w.endLine();
+  }
+  w.word("prior");
+  w.integer(static_cast<int64_t>(prior_.nodes.size()));
+  w.integer(static_cast<int64_t>(prior_.residual.size()));
+  for (int n : prior_.nodes) w.integer(n);
+  for (const Pose& p : prior_.linearisation) w.pose(p);
+  w.matrix(prior_.jacobian);
+  w.matrix(prior_.residual);
+  w.endLine();
+  const PoseGraphCounters& k = counters_;
+  w.word("counters");
+  for (uint64_t v : {k.nodes_added, k.nodes_refused, k.nodes_marginalised, k.closures_received, k.closures_refused,
+                     k.closures_pending, k.closures_accepted, k.closures_rejected_gate,
+                     k.closures_rejected_inconsistent, k.closures_rejected_no_support, k.closures_superseded,
+                     k.closures_withdrawn_after_marginalisation, k.updates, k.full_smoothings, k.solver_failures})
+    w.unsignedInteger(v);
+  w.real(k.last_update_s);
+  w.real(k.last_solve_s);
+  w.integer(k.last_iterations);
+  w.endLine();
+  const WindowStats& s = window_stats_;
+  w.word("window");
+  for (int v : {s.active_nodes, s.variable_blocks, s.constant_blocks, s.residual_blocks, s.prior_nodes, s.prior_rows,
+                s.pcm_candidates})
+    w.integer(v);
+  w.endLine();
+  std::string& text = w.text();
+  char checksum[64];
+  std::snprintf(checksum, sizeof(checksum), "checksum %016" PRIx64 "\n", fnv1a(text.data(), text.size()));
+  text += checksum;
+
+  const std::string temporary = path + ".tmp";
+  FILE* file = std::fopen(temporary.c_str(), "wb");
+  if (!file) return Status::error("checkpoint " + temporary + ": cannot open for writing: " + std::strerror(errno));
+  const bool written = std::fwrite(text.data(), 1, text.size(), file) == text.size() && std::fflush(file) == 0 &&
+                       ::fsync(::fileno(file)) == 0;
+  const int write_errno = errno;
+  if (std::fclose(file) != 0 || !written) {
+    std::remove(temporary.c_str());
+    return Status::error("checkpoint " + temporary + ": write failed: " + std::strerror(write_errno) +
+                         "; the previous checkpoint is kept");
+  }
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    const int rename_errno = errno;
+    std::remove(temporary.c_str());
+    return Status::error("checkpoint " + path + ": rename failed: " + std::strerror(rename_errno));
+  }
+  // Make the rename itself durable (best effort: some file systems refuse fsync on directories).
+  const size_t slash = path.find_last_of('/');
+  const std::string directory = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+  const int dir = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY);
+  if (dir >= 0) {
+    ::fsync(dir);
+    ::close(dir);
+  }
+  return Status::success();
+}
+
+Status SlidingWindowPoseGraph::loadCheckpoint(const std::string& path) {
+  auto fail = [&](const std::string& why) {
+    return Status::error("checkpoint " + path + ": " + why + "; graph left unchanged");
+  };
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return fail(std::string("cannot open: ") + std::strerror(errno));
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size < 0 || static_cast<uint64_t>(size) > kMaxFileBytes) return fail("unreadable size or larger than 2 GiB");
+  in.seekg(0, std::ios::beg);
+  std::string text(static_cast<size_t>(size), '\0');
+  if (!in.read(text.data(), size)) return fail("read failed");
+
+  // Checksum line: the last line, over every byte before it.
+  const size_t line = text.rfind("checksum ");
+  if (line == std::string::npos || (line > 0 && text[line - 1] != '\n'))
+    return fail("no checksum line (truncated?)");
+  const std::string checksum_line = text.substr(line);
+  uint64_t stored = 0;
+  char tail = 0;
+  if (std::sscanf(checksum_line.c_str(), "checksum %16" SCNx64 "%c", &stored, &tail) != 2 || tail != '\n' ||
+      checksum_line.size() != 9 + 16 + 1)
+    return fail("malformed checksum line (truncated?)");
+  if (fnv1a(text.data(), line) != stored) return fail("checksum mismatch: the file is corrupt");
+  text.resize(line);
+
+  Reader r(text);
+  int64_t version = 0;
+  if (!r.expect(kMagic)) return fail("not a pose-graph checkpoint");
+  if (!r.integer(version)) return fail("bad version field");
+  if (version != kVersion)
+    return fail("version " + std::to_string(version) + " not supported (expected " + std::to_string(kVersion) + ")");
+
+  SlidingWindowPoseGraph g(options_);
+  int64_t num_nodes = 0, num_closures = 0, first_active = 0, horizon = 0;
+  if (!r.expect("state") || !r.integer(num_nodes) || !r.integer(num_closures) || !r.integer(first_active) ||
+      !r.integer(horizon) || !r.integer(g.update_utime_us_) || !r.integer(g.frozen_newest_accepted_utime_us_) ||
+      !r.integer(g.newest_accepted_closure_utime_us_))
+    return fail("bad state record");
+  if (num_nodes < 0 || static_cast<uint64_t>(num_nodes) > r.remainingRecords(90) || num_closures < 0 ||
+      static_cast<uint64_t>(num_closures) > r.remainingRecords(50) || first_active < 0 || first_active > num_nodes ||
+      horizon < 0 || horizon > num_closures)
+    return fail("inconsistent counts in the state record");
+  g.first_active_ = static_cast<int>(first_active);
+  g.pcm_horizon_start_ = static_cast<int>(horizon);
+
+  g.nodes_.reserve(static_cast<size_t>(num_nodes));
+  for (int64_t i = 0; i < num_nodes; ++i) {
+    Node n;
+    int has_covariance = 0;
+    if (!r.expect("node") || !r.integer(n.id) || !r.integer(n.utime_us) || !r.finite(n.distance_m) || !r.pose(n.dr) ||
+        !r.pose(n.estimate) || !r.boundedInt(has_covariance, 0, 1) || !r.matrix6(n.covariance) ||
+        !r.matrix6(n.conditional_covariance))
+      return fail("bad node record " + std::to_string(i));
+    n.has_covariance = has_covariance == 1;
+    if (g.index_of_.count(n.id)) return fail("duplicate node id " + std::to_string(n.id));
+    if (!g.nodes_.empty() && (n.utime_us <= g.nodes_.back().utime_us || n.distance_m < g.nodes_.back().distance_m - 1e-6))
+      return fail("node " + std::to_string(n.id) + " is out of time or distance order");
+    g.setupDerived(n, g.nodes_.empty() ? nullptr : &g.nodes_.back());
+    g.index_of_[n.id] = static_cast<int>(g.nodes_.size());
+    g.nodes_.push_back(std::move(n));
+  }
+  g.closures_.reserve(static_cast<size_t>(num_closures));
+  for (int64_t i = 0; i < num_closures; ++i) {
+    Closure c;
+    LoopClosure& l = c.record.closure;
+    int status = 0, rejection = 0, marginalised = 0, gate_checked = 0;
+    if (!r.expect("closure") || !r.integer(l.subframe_id_a) || !r.integer(l.subframe_id_b) ||
+        !r.boundedInt(l.association_round, std::numeric_limits<int>::min(), std::numeric_limits<int>::max()) ||
+        !r.boundedInt(l.num_inliers, std::numeric_limits<int>::min(), std::numeric_limits<int>::max()) ||
+        !r.real(l.total_cost) || !r.pose(l.T_a_b) || !r.matrix6(l.covariance) || !r.boundedInt(status, 0, 3) ||
+        !r.boundedInt(rejection, 0, 3) || !r.boundedInt(marginalised, 0, 1) || !r.boundedInt(gate_checked, 0, 1))
+      return fail("bad closure record " + std::to_string(i));
+    const auto a = g.index_of_.find(l.subframe_id_a), b = g.index_of_.find(l.subframe_id_b);
+    if (a == g.index_of_.end() || b == g.index_of_.end() || a->second == b->second)
+      return fail("closure record " + std::to_string(i) + " refers to unknown nodes");
+    if (!sqrtInformation(l.covariance, c.sqrt_information))
+      return fail("closure record " + std::to_string(i) + " has a covariance that is not positive definite");
+    c.a = a->second;
+    c.b = b->second;
+    c.record.status = static_cast<ClosureStatus>(status);
+    c.record.rejection = static_cast<ClosureRejection>(rejection);
+    c.record.marginalised = marginalised == 1;
+    c.gate_checked = gate_checked == 1;
+    const int index = static_cast<int>(g.closures_.size());
+    g.latest_for_pair_[std::minmax(l.subframe_id_a, l.subframe_id_b)] = index;
+    g.nodes_[c.a].closures.push_back(index);
+    g.nodes_[c.b].closures.push_back(index);
+    g.closures_.push_back(std::move(c));
+  }
+  int64_t prior_nodes = 0, prior_rows = 0;
+  if (!r.expect("prior") || !r.integer(prior_nodes) || !r.integer(prior_rows)) return fail("bad prior record");
+  if (prior_nodes < 0 || prior_nodes > num_nodes - first_active || prior_rows < 0 || prior_rows > 6 * prior_nodes ||
+      (prior_nodes > 0 && prior_rows == 0) ||
+      static_cast<uint64_t>(prior_rows) * static_cast<uint64_t>(6 * prior_nodes + 1) > r.remainingRecords(1))
+    return fail("inconsistent prior size");
+  for (int64_t i = 0; i < prior_nodes; ++i) {
+    int node = 0;
+    if (!r.boundedInt(node, first_active, num_nodes - 1) || (!g.prior_.nodes.empty() && node <= g.prior_.nodes.back()))
+      return fail("bad prior node list");
+    g.prior_.nodes.push_back(node);
+  }
+  for (int64_t i = 0; i < prior_nodes; ++i) {
+    Pose p;
+    if (!r.pose(p)) return fail("bad prior linearisation point");
+    g.prior_.linearisation.push_back(p);
+  }
+  Eigen::MatrixXd residual;
+  if (!r.matrix(g.prior_.jacobian, static_cast<int>(prior_rows), static_cast<int>(6 * prior_nodes)) ||
+      !r.matrix(residual, static_cast<int>(prior_rows), 1))
+    return fail("bad prior matrices");
+  g.prior_.residual = residual.col(0);
+  if (prior_nodes == 0) g.prior_ = Prior();
+
+  PoseGraphCounters& k = g.counters_;
+  if (!r.expect("counters")) return fail("bad counters record");
+  for (uint64_t* v : {&k.nodes_added, &k.nodes_refused, &k.nodes_marginalised, &k.closures_received,
+                      &k.closures_refused, &k.closures_pending, &k.closures_accepted, &k.closures_rejected_gate,
+                      &k.closures_rejected_inconsistent, &k.closures_rejected_no_support, &k.closures_superseded,
+                      &k.closures_withdrawn_after_marginalisation, &k.updates, &k.full_smoothings, &k.solver_failures})
+    if (!r.unsignedInteger(*v)) return fail("bad counters record");
+  if (!r.real(k.last_update_s) || !r.real(k.last_solve_s) ||
+      !r.boundedInt(k.last_iterations, -1, std::numeric_limits<int>::max()))
+    return fail("bad counters record");
+  WindowStats& s = g.window_stats_;
+  if (!r.expect("window")) return fail("bad window record");
+  for (int* v : {&s.active_nodes, &s.variable_blocks, &s.constant_blocks, &s.residual_blocks, &s.prior_nodes,
+                 &s.prior_rows, &s.pcm_candidates})
+    if (!r.boundedInt(*v, 0, std::numeric_limits<int>::max())) return fail("bad window record");
+  std::string extra;
+  if (r.token(extra)) return fail("unexpected data after the window record");
+
+  *this = std::move(g);
+  return Status::success();
+}
+
+}  // namespace sss::optimiser

@@ -1,0 +1,166 @@
+// SE(3) for Ceres in the project's tangent convention (pose.hpp boxPlus: [dt, dr], perturbation in
+// the pose's own frame), and the pose-graph residuals, so solver, covariances and priors agree.
+#pragma once
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <array>
+#include <vector>
+
+#include "pipeline/core/pose.hpp"
+
+namespace sss::optimiser {
+
+// Parameter block of one pose: [tx ty tz qx qy qz qw] (translation first, like the tangent).
+constexpr int kPoseAmbientSize = 7;
+constexpr int kPoseTangentSize = 6;
+using PoseParameters = std::array<double, kPoseAmbientSize>;
+
+PoseParameters toParameters(const sss::core::Pose& pose);
+// Copies the quaternion as stored (no re-normalisation), so a round trip is bit-exact.
+sss::core::Pose fromParameters(const double* x);
+
+// Plus(x, delta) = boxPlus(x, delta); Minus(y, x) = boxMinus(y, x). A custom manifold rather than
+// EigenQuaternionManifold + Euclidean because Ceres' quaternion manifold perturbs on the left (world
+// frame): with it every covariance and the marginalisation prior would need converting.
+class PoseManifold final : public ceres::Manifold {
+ public:
+  int AmbientSize() const override { return kPoseAmbientSize; }
+  int TangentSize() const override { return kPoseTangentSize; }
+  bool Plus(const double* x, const double* delta, double* x_plus_delta) const override;
+  bool PlusJacobian(const double* x, double* jacobian) const override;  // 7x6 row-major at delta = 0
+  bool Minus(const double* y, const double* x, double* y_minus_x) const override;
+  bool MinusJacobian(const double* x, double* jacobian) const override;  // 6x7 row-major at y = x
+};
+
+// d Plus(x, delta) / d delta at delta = 0, and its left inverse (P^+ P = I for a unit quaternion).
+Eigen::Matrix<double, 7, 6> plusJacobian(const double* x);
+Eigen::Matrix<double, 6, 7> plusJacobianLeftInverse(const double* x);
+
+// Adjoint in the [dt, dr] ordering: T * boxPlus(I, d) * T^-1 = boxPlus(I, adjoint(T) d) to first
+// order, so a right perturbation of A in A*B moves to B's frame with adjoint(B^-1).
+sss::core::Matrix6d adjoint(const sss::core::Pose& T);
+// Inverse of the SO(3) right Jacobian: d Log(R Exp(e)) / d e = J_r^-1(Log(R)).
+Eigen::Matrix3d rightJacobianInverseSO3(const Eigen::Vector3d& rotation_vector);
+
+// Whitening matrix W with W^T W = covariance^-1 (W = L^-1, covariance = L L^T); false when the
+// covariance is not symmetric positive definite or not finite.
+bool sqrtInformation(const sss::core::Matrix6d& covariance, sss::core::Matrix6d& sqrt_information);
+
+namespace detail {
+
+// Log of a unit quaternion, shortest rotation, safe (and differentiable) at the identity.
+template <typename T>
+Eigen::Matrix<T, 3, 1> logQuaternion(const Eigen::Quaternion<T>& q) {
+  T wxyz[4] = {q.w(), q.x(), q.y(), q.z()};
+  if (wxyz[0] < T(0)) {
+    for (T& c : wxyz) c = -c;
+  }
+  Eigen::Matrix<T, 3, 1> angle_axis;
+  ceres::QuaternionToAngleAxis(wxyz, angle_axis.data());
+  return angle_axis;
+}
+
+// boxMinus(b, a) on templated poses.
+template <typename T>
+Eigen::Matrix<T, 6, 1> boxMinus(const Eigen::Matrix<T, 3, 1>& t_b, const Eigen::Quaternion<T>& q_b,
+                                const Eigen::Matrix<T, 3, 1>& t_a, const Eigen::Quaternion<T>& q_a) {
+  const Eigen::Quaternion<T> q_a_inverse = q_a.conjugate();
+  Eigen::Matrix<T, 6, 1> e;
+  e.template head<3>() = q_a_inverse * (t_b - t_a);
+  e.template tail<3>() = logQuaternion<T>(q_a_inverse * q_b);
+  return e;
+}
+
+}  // namespace detail
+
+// Error of a relative pose measurement Z = T_a_b (odometry or loop closure):
+// e = boxMinus(T_a^-1 T_b, Z), i.e. T_a^-1 T_b = boxPlus(Z, e), whitened by W (W^T W = Sigma^-1).
+struct RelativePoseError {
+  sss::core::Pose measured;
+  sss::core::Matrix6d sqrt_information;
+
+  template <typename T>
+  bool operator()(const T* x_a, const T* x_b, T* residual) const {
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_a(x_a), t_b(x_b);
+    const Eigen::Map<const Eigen::Quaternion<T>> q_a(x_a + 3), q_b(x_b + 3);
+    const Eigen::Quaternion<T> q_a_inverse = q_a.conjugate();
+    const Eigen::Matrix<T, 3, 1> t_ab = q_a_inverse * (t_b - t_a);
+    const Eigen::Quaternion<T> q_ab = q_a_inverse * q_b;
+    const Eigen::Matrix<T, 6, 1> e =
+        detail::boxMinus<T>(t_ab, q_ab, measured.translation.cast<T>(), measured.rotation.cast<T>());
+    Eigen::Map<Eigen::Matrix<T, 6, 1>> whitened(residual);
+    whitened = sqrt_information.cast<T>() * e;
+    return true;
+  }
+
+  static ceres::CostFunction* create(const sss::core::Pose& measured, const sss::core::Matrix6d& sqrt_information) {
+    return new ceres::AutoDiffCostFunction<RelativePoseError, 6, kPoseAmbientSize, kPoseAmbientSize>(
+        new RelativePoseError{measured, sqrt_information});
+  }
+};
+
+// Error of an absolute pose prior: e = boxMinus(T, prior), whitened.
+struct PosePriorError {
+  sss::core::Pose prior;
+  sss::core::Matrix6d sqrt_information;
+
+  template <typename T>
+  bool operator()(const T* x, T* residual) const {
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t(x);
+    const Eigen::Map<const Eigen::Quaternion<T>> q(x + 3);
+    const Eigen::Matrix<T, 6, 1> e = detail::boxMinus<T>(Eigen::Matrix<T, 3, 1>(t), Eigen::Quaternion<T>(q),
+                                                         prior.translation.cast<T>(), prior.rotation.cast<T>());
+    Eigen::Map<Eigen::Matrix<T, 6, 1>> whitened(residual);
+    whitened = sqrt_information.cast<T>() * e;
+    return true;
+  }
+
+  static ceres::CostFunction* create(const sss::core::Pose& prior, const sss::core::Matrix6d& sqrt_information) {
+    return new ceres::AutoDiffCostFunction<PosePriorError, 6, kPoseAmbientSize>(
+        new PosePriorError{prior, sqrt_information});
+  }
+};
+
+// The INS's absolute measurements of one node: depth (pressure sensor) and attitude (roll and pitch
+// against gravity, heading from gyrocompassing), which do not drift with distance. Residual
+// [(z - z_dr) / sigma_depth; Log(R_dr^T R) ./ (sigma_roll, sigma_pitch, sigma_heading)]; for a
+// level vehicle the body-frame rotation error is (roll, pitch, heading) error. A zero weight
+// switches a component off.
+struct InsAbsoluteError {
+  sss::core::Pose dr;
+  Eigen::Vector4d weight;  // 1 / sigma of depth, roll, pitch, heading (0: not used)
+
+  template <typename T>
+  bool operator()(const T* x, T* residual) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q(x + 3);
+    residual[0] = T(weight(0)) * (x[2] - T(dr.translation.z()));
+    const Eigen::Matrix<T, 3, 1> rotation_error =
+        detail::logQuaternion<T>(dr.rotation.conjugate().cast<T>() * Eigen::Quaternion<T>(q));
+    for (int i = 0; i < 3; ++i) residual[1 + i] = T(weight(1 + i)) * rotation_error(i);
+    return true;
+  }
+
+  static ceres::CostFunction* create(const sss::core::Pose& dr, const Eigen::Vector4d& weight) {
+    return new ceres::AutoDiffCostFunction<InsAbsoluteError, 4, kPoseAmbientSize>(new InsAbsoluteError{dr, weight});
+  }
+};
+
+// The marginalisation prior: r = r0 + J [boxMinus(x_1, x_lin_1); ...; boxMinus(x_k, x_lin_k)],
+// a Gaussian on the tangent spaces at the linearisation points (Schur complement, see pose_graph.cpp).
+class MarginalPriorCost final : public ceres::CostFunction {
+ public:
+  MarginalPriorCost(std::vector<sss::core::Pose> linearisation_points, Eigen::MatrixXd jacobian,
+                    Eigen::VectorXd residual);
+  bool Evaluate(double const* const* parameters, double* residuals, double** jacobians) const override;
+
+ private:
+  std::vector<sss::core::Pose> linearisation_points_;
+  Eigen::MatrixXd jacobian_;  // rows x (6 * nodes)
+  Eigen::VectorXd residual_;  // r0
+};
+
+}  // namespace sss::optimiser
