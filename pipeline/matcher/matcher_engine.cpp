@@ -55,12 +55,10 @@ void MatcherEngine::setCorrection(Stored& stored, const Pose& correction) {
   stored.footprint = computeFootprint(stored.subframe, stored.poses, options_.overlap);
 }
 
-std::vector<Footprint> MatcherEngine::footprintsExcept(int64_t id) const {
+std::vector<Footprint> MatcherEngine::allFootprints() const {
   std::vector<Footprint> footprints;
   footprints.reserve(stored_.size());
-  for (const auto& [other_id, stored] : stored_) {
-    if (other_id != id) footprints.push_back(stored.footprint);
-  }
+  for (const auto& [id, stored] : stored_) footprints.push_back(stored.footprint);
   return footprints;
 }
 
@@ -143,8 +141,8 @@ std::vector<PairOutcome> MatcherEngine::addSubframe(sss::subframe::Subframe subf
   }
   setCorrection(stored, correction);
 
-  const std::vector<OverlapCandidate> candidates =
-      findOverlaps(stored.footprint, footprintsExcept(id), options_.overlap);
+  // findOverlaps skips the subframe's own footprint.
+  const std::vector<OverlapCandidate> candidates = findOverlaps(stored.footprint, allFootprints(), options_.overlap);
   for (const OverlapCandidate& candidate : candidates) {
     const PairKey key{std::min(candidate.subframe_id, id), std::max(candidate.subframe_id, id)};
     outcomes.push_back(matchStored(key, 0));
@@ -187,8 +185,9 @@ std::vector<PairOutcome> MatcherEngine::updateTrajectory(const std::vector<Traje
     }
   }
   // Pairs that overlap only under the optimised poses (DR had them too far apart).
+  const std::vector<Footprint> footprints = allFootprints();
   for (const auto& [id, stored] : stored_) {
-    for (const OverlapCandidate& candidate : findOverlaps(stored.footprint, footprintsExcept(id), options_.overlap)) {
+    for (const OverlapCandidate& candidate : findOverlaps(stored.footprint, footprints, options_.overlap)) {
       if (candidate.subframe_id < id) continue;  // each pair once, from its older subframe
       const PairKey key{id, candidate.subframe_id};
       if (!pairs_.count(key)) jobs.push_back({key, 1});

@@ -129,7 +129,7 @@ class MatcherEngine {
 
   void setCorrection(Stored& stored, const sss::core::Pose& correction);
   PairOutcome matchStored(const PairKey& key, int round);
-  std::vector<Footprint> footprintsExcept(int64_t id) const;
+  std::vector<Footprint> allFootprints() const;
 
   MatcherEngineOptions options_;
   DenseMatcher dense_;

@@ -336,7 +336,8 @@ RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const Re
 
   const Pose T_world_a = input.dr_poses_a[input.centre_a];
   const Pose T_world_bc = input.dr_poses_b[input.centre_b];
-  const Pose T_a_b_dr = T_world_a.inverse() * T_world_bc;
+  const Pose T_a_world = T_world_a.inverse();
+  const Pose T_a_b_dr = T_a_world * T_world_bc;
   const Eigen::Vector3d down_a = T_world_a.rotation.conjugate() * Eigen::Vector3d::UnitZ();
 
   // Per-correspondence geometry (paper eq. (2)); matches outside the images or without a seabed
@@ -357,7 +358,7 @@ RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const Re
     const double h_a = ping_a->second, h_b = ping_b->second;
     Measurement m;
     const Pose T_world_sonar_a = ping_a->first * input.geometry.T_body_sonar;
-    m.a.T_centre_sonar = T_world_a.inverse() * T_world_sonar_a;
+    m.a.T_centre_sonar = T_a_world * T_world_sonar_a;
     m.a.slant_range_m = std::sqrt(g_a * g_a + h_a * h_a);
     m.a.side = g_a < 0.0 ? -1 : 1;
     m.b.T_centre_sonar = T_world_bc.inverse() * ping_b->first * input.geometry.T_body_sonar;
@@ -365,7 +366,7 @@ RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const Re
     m.b.side = g_b < 0.0 ? -1 : 1;
     const auto seabed = sss::subframe::georeferencePixel(input.geometry, ping_a->first, h_a, c.col_a);
     if (!seabed) continue;
-    m.landmark_init_a = T_world_a.inverse() * *seabed;
+    m.landmark_init_a = T_a_world * *seabed;
     m.down_a = down_a;
     // The seabed under A's ping (pressure depth + altitude: absolute, no horizontal DR error).
     m.seabed_depth_a_m = down_a.dot(m.a.T_centre_sonar.translation) + h_a;
@@ -374,7 +375,7 @@ RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const Re
       // under A. B's altimeter measured it under B's ping, so the prior follows the line from A's
       // nadir to B's nadir (u = 0 under A, 1 under B; extrapolated at most half-way beyond).
       const Eigen::Vector3d nadir_a = m.a.T_centre_sonar.translation + h_a * down_a;
-      const Eigen::Vector3d sonar_b_in_a = T_world_a.inverse() * (ping_b->first * input.geometry.T_body_sonar).translation;
+      const Eigen::Vector3d sonar_b_in_a = T_a_world * (ping_b->first * input.geometry.T_body_sonar).translation;
       const Eigen::Vector3d nadir_b = sonar_b_in_a + h_b * down_a;
       const double depth_b = down_a.dot(nadir_b);
       Eigen::Vector3d across = nadir_b - nadir_a;

@@ -5,9 +5,8 @@
 
 namespace sss::subframe {
 
-std::optional<Eigen::Vector3d> georeferencePixel(const SubframeGeometry& geometry, const sss::core::Pose& T_world_body,
-                                                 double altitude_m, double column) {
-  const sss::core::Pose T_world_sonar = T_world_body * geometry.T_body_sonar;
+std::optional<Eigen::Vector3d> georeferenceGroundRange(const sss::core::Pose& T_world_sonar, double altitude_m,
+                                                       double signed_ground_range_m) {
   const Eigen::Vector3d origin = T_world_sonar.translation;
   const Eigen::Vector3d normal = T_world_sonar.rotation * Eigen::Vector3d::UnitX();
   const Eigen::Vector3d down = Eigen::Vector3d::UnitZ();
@@ -23,11 +22,16 @@ std::optional<Eigen::Vector3d> georeferencePixel(const SubframeGeometry& geometr
   if (std::abs(nw) < 1e-9) return std::nullopt;
   const double h = altitude_m;
   const double t = -h * normal.z() / nw;
-  const double g = geometry.signedGroundRangeM(column);
+  const double g = signed_ground_range_m;
   const double s2 = g * g - t * t;
   if (s2 < 0.0) return std::nullopt;
   const double s = std::copysign(std::sqrt(s2), g);
   return Eigen::Vector3d(origin + h * down + t * w + s * v);
+}
+
+std::optional<Eigen::Vector3d> georeferencePixel(const SubframeGeometry& geometry, const sss::core::Pose& T_world_body,
+                                                 double altitude_m, double column) {
+  return georeferenceGroundRange(T_world_body * geometry.T_body_sonar, altitude_m, geometry.signedGroundRangeM(column));
 }
 
 std::optional<Eigen::Vector3d> georeferencePixel(const Subframe& subframe,

@@ -20,6 +20,10 @@ namespace sss::subframe {
 std::optional<Eigen::Vector3d> georeferencePixel(const SubframeGeometry& geometry, const sss::core::Pose& T_world_body,
                                                  double altitude_m, double column);
 
+// The same for a sonar pose and a signed ground range (+ starboard, - port) instead of a column.
+std::optional<Eigen::Vector3d> georeferenceGroundRange(const sss::core::Pose& T_world_sonar, double altitude_m,
+                                                       double signed_ground_range_m);
+
 // Pixel (row, column) of a subframe with the given per-ping body poses (DR, optimised, or ground
 // truth; one per row). Altitudes are the subframe's.
 std::optional<Eigen::Vector3d> georeferencePixel(const Subframe& subframe,
