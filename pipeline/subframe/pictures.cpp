@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 
 #include "pipeline/subframe/georeference.hpp"
@@ -123,6 +125,20 @@ bool writeMosaic(const std::vector<Subframe>& subframes,
   }
   if (!cv::imwrite(path, image)) {
     error = "cannot write " + path;
+    return false;
+  }
+  // Its geo-reference, in the simulator's mosaic.yaml format.
+  const std::string yaml_path = std::filesystem::path(path).replace_extension(".yaml").string();
+  std::ofstream yaml(yaml_path);
+  yaml.precision(12);
+  yaml << "# " << std::filesystem::path(path).filename().string()
+       << ": mean normalised intensity per cell, geo-referenced with the poses given.\n"
+       << "# Pixel (row, col): north = north_max_m - (row + 0.5) * resolution_m, east = east_min_m + (col + 0.5) * "
+          "resolution_m.\n"
+       << "resolution_m: " << res << "\nnorth_max_m: " << n_min + rows * res << "\neast_min_m: " << e_min
+       << "\nrows: " << rows << "\ncols: " << cols << "\n";
+  if (!yaml) {
+    error = "cannot write " + yaml_path;
     return false;
   }
   return true;

@@ -54,6 +54,7 @@ void SubframeBuffer::finish(std::vector<Subframe>& out) {
 
 void SubframeBuffer::process(std::vector<Subframe>& out) {
   for (FusedPing& fused : fused_) {
+    if (observer_) observer_(fused);
     CanonicalPing row = canonical_.transform(std::move(fused));
     if (row.turn) ++turn_rows_;
     builder_.addPing(std::move(row), out);

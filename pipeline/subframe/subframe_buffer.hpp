@@ -2,6 +2,7 @@
 // (fusion -> canonical transform -> line segmentation -> subframes), with its counters.
 #pragma once
 
+#include <functional>
 #include <vector>
 
 #include "pipeline/core/config.hpp"
@@ -43,6 +44,9 @@ class SubframeBuffer {
   const SubframeGeometry& geometry() const { return geometry_; }
   // Bytes held by the buffers (nav history, waiting pings, rows of the open subframe).
   size_t memoryBytes() const;
+  // Called with every ping that got its DR pose, turns included (the offline runner's per-ping
+  // trajectory), before the canonical transform.
+  void setFusedPingObserver(std::function<void(const FusedPing&)> observer) { observer_ = std::move(observer); }
 
  private:
   void process(std::vector<Subframe>& out);
@@ -54,6 +58,7 @@ class SubframeBuffer {
   SubframeBuilder builder_;
   std::vector<FusedPing> fused_;  // reused
   uint64_t turn_rows_ = 0;
+  std::function<void(const FusedPing&)> observer_;
 };
 
 }  // namespace sss::subframe

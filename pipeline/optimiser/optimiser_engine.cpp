@@ -1,0 +1,257 @@
+// Subframes and closures into the pose graph, corrections and bathymetry out. See optimiser_engine.hpp.
+#include "pipeline/optimiser/optimiser_engine.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sss::optimiser {
+
+using sss::core::Pose;
+
+void readOptimiserEngineOptions(sss::core::ConfigSection& section, OptimiserEngineOptions& options) {
+  using sss::core::inRange;
+  sss::core::ConfigSection graph = section.section("graph");
+  readPoseGraphOptions(graph, options.graph);
+  graph.rejectUnknownKeys();
+  sss::core::ConfigSection bathymetry = section.section("bathymetry");
+  readBathymetryOptions(bathymetry, options.bathymetry);
+  bathymetry.rejectUnknownKeys();
+  section.optional("max_trajectory_nodes", options.max_trajectory_nodes, {inRange(1, 100000)});
+  section.optional("max_pending_closures", options.max_pending_closures, {inRange(0, 100000)});
+  section.optional("max_stored_subframes", options.max_stored_subframes, {inRange(1, 1000000)});
+}
+
+std::vector<std::string> validateOptimiserEngineOptions(const OptimiserEngineOptions& options) {
+  std::vector<std::string> errors = validatePoseGraphOptions(options.graph);
+  for (const std::string& error : validateBathymetryOptions(options.bathymetry)) errors.push_back(error);
+  if (options.max_trajectory_nodes < 1) errors.push_back("max_trajectory_nodes must be >= 1");
+  if (options.max_pending_closures < 0) errors.push_back("max_pending_closures must be >= 0");
+  if (options.max_stored_subframes < 1) errors.push_back("max_stored_subframes must be >= 1");
+  return errors;
+}
+
+OptimiserEngine::OptimiserEngine(const OptimiserEngineOptions& options) : options_(options), graph_(options.graph) {}
+
+Status OptimiserEngine::addSubframe(const sss::subframe::Subframe& subframe) {
+  ++counters_.subframes_in;
+  if (subframe.pings.empty() || subframe.centre_ping_index < 0 || subframe.centre_ping_index >= subframe.rows()) {
+    ++counters_.subframes_refused;
+    return Status::error("subframe " + std::to_string(subframe.id) + " has no centre ping");
+  }
+  const sss::subframe::SubframePing& centre = subframe.centre();
+  const Status added = graph_.addNode(subframe.id, centre.utime_us, centre.T_world_body, centre.distance_travelled_m);
+  if (!added.ok) {
+    ++counters_.subframes_refused;
+    return added;
+  }
+  StoredSubframe& stored = stored_[subframe.id];
+  stored.T_body_sonar = subframe.geometry.T_body_sonar;
+  stored.centre_index = subframe.centre_ping_index;
+  for (const sss::subframe::SubframePing& ping : subframe.pings) {
+    stored.utime_us.push_back(ping.utime_us);
+    stored.dr.push_back(ping.T_world_body);
+  }
+  while (static_cast<int>(stored_.size()) > options_.max_stored_subframes) {
+    stored_.erase(stored_.begin());
+    ++counters_.subframes_forgotten;
+  }
+  newest_subframe_id_ = std::max(newest_subframe_id_, subframe.id);
+  new_input_ = true;
+
+  // Closures that were waiting for this subframe.
+  std::deque<sss::matcher::LoopClosure> still_waiting;
+  for (sss::matcher::LoopClosure& closure : waiting_) {
+    const bool known = graph_.estimate(closure.subframe_id_a) && graph_.estimate(closure.subframe_id_b);
+    if (known) {
+      addToGraph(closure);
+    } else if (std::max(closure.subframe_id_a, closure.subframe_id_b) > newest_subframe_id_) {
+      still_waiting.push_back(std::move(closure));
+    } else {
+      ++counters_.closures_refused;  // its subframe was missed (e.g. dropped on the bus)
+    }
+  }
+  waiting_ = std::move(still_waiting);
+  counters_.closures_waiting = waiting_.size();
+  return Status::success();
+}
+
+Status OptimiserEngine::addLoopClosure(const sss::matcher::LoopClosure& closure) {
+  ++counters_.closures_in;
+  const bool known = graph_.estimate(closure.subframe_id_a) && graph_.estimate(closure.subframe_id_b);
+  if (!known && std::max(closure.subframe_id_a, closure.subframe_id_b) > newest_subframe_id_ &&
+      options_.max_pending_closures > 0) {
+    waiting_.push_back(closure);
+    if (static_cast<int>(waiting_.size()) > options_.max_pending_closures) {
+      waiting_.pop_front();
+      ++counters_.closures_refused;
+    }
+    counters_.closures_waiting = waiting_.size();
+    return Status::success();
+  }
+  return addToGraph(closure);
+}
+
+Status OptimiserEngine::addToGraph(const sss::matcher::LoopClosure& closure) {
+  LoopClosure edge;
+  edge.subframe_id_a = closure.subframe_id_a;
+  edge.subframe_id_b = closure.subframe_id_b;
+  edge.T_a_b = closure.T_a_b;
+  edge.covariance = closure.covariance;
+  edge.association_round = closure.association_round;
+  edge.num_inliers = closure.num_inliers;
+  edge.total_cost = closure.total_cost;
+  const Status added = graph_.addLoopClosure(edge);
+  if (!added.ok) {
+    ++counters_.closures_refused;
+    return added;
+  }
+  new_input_ = true;
+  // The correspondences of the newest association round of the pair, thinned evenly.
+  const auto key = std::make_pair(std::min(closure.subframe_id_a, closure.subframe_id_b),
+                                  std::max(closure.subframe_id_a, closure.subframe_id_b));
+  auto existing = correspondences_.find(key);
+  if (existing != correspondences_.end() && existing->second.association_round > closure.association_round) {
+    return added;
+  }
+  StoredCorrespondences& stored = correspondences_[key];
+  stored.association_round = closure.association_round;
+  stored.mean_zncc = closure.mean_zncc;
+  stored.correspondences.clear();
+  const size_t count = closure.correspondences.size();
+  const size_t limit = static_cast<size_t>(options_.bathymetry.max_points_per_closure);
+  const size_t keep = std::min(count, limit);
+  for (size_t k = 0; k < keep; ++k) stored.correspondences.push_back(closure.correspondences[k * count / keep]);
+  // A closure stored as (b, a) has its correspondences the other way round.
+  if (closure.subframe_id_a != key.first) {
+    for (auto& c : stored.correspondences) {
+      std::swap(c.ping_index_a, c.ping_index_b);
+      std::swap(c.column_a, c.column_b);
+      std::swap(c.slant_range_a_m, c.slant_range_b_m);
+      c.landmark_a_m.setConstant(std::nanf(""));  // in B's frame now: not usable as a start
+    }
+  }
+  return added;
+}
+
+Status OptimiserEngine::loadCheckpoint(const std::string& path) {
+  const Status loaded = graph_.loadCheckpoint(path);
+  if (!loaded.ok) return loaded;
+  for (const NodeState& node : graph_.nodes()) newest_subframe_id_ = std::max(newest_subframe_id_, node.subframe_id);
+  return loaded;
+}
+
+UpdateReport OptimiserEngine::update() {
+  new_input_ = false;
+  return graph_.optimize();
+}
+
+UpdateReport OptimiserEngine::finish() {
+  new_input_ = false;
+  // Closures still waiting can no longer be resolved.
+  counters_.closures_refused += waiting_.size();
+  waiting_.clear();
+  counters_.closures_waiting = 0;
+  graph_.optimize();
+  return graph_.fullSmoothing();
+}
+
+std::vector<sss::matcher::TrajectoryNode> OptimiserEngine::trajectory() const {
+  const std::vector<NodeState> nodes = graph_.nodes();
+  const size_t first = nodes.size() > static_cast<size_t>(options_.max_trajectory_nodes)
+                           ? nodes.size() - static_cast<size_t>(options_.max_trajectory_nodes)
+                           : 0;
+  std::vector<sss::matcher::TrajectoryNode> out;
+  out.reserve(nodes.size() - first);
+  for (size_t i = first; i < nodes.size(); ++i) {
+    out.push_back({nodes[i].subframe_id, nodes[i].utime_us, nodes[i].T_world_body});
+  }
+  return out;
+}
+
+std::vector<StampedPose> OptimiserEngine::pingTrajectory(bool corrected) const {
+  std::vector<StampedPose> out;
+  for (const auto& [id, stored] : stored_) {
+    for (size_t i = 0; i < stored.dr.size(); ++i) {
+      Pose pose = stored.dr[i];
+      if (corrected) pose = graph_.correctionAt(stored.utime_us[i]).T_corrected_dr * pose;
+      out.push_back({stored.utime_us[i], pose});
+    }
+  }
+  std::stable_sort(out.begin(), out.end(), [](const StampedPose& a, const StampedPose& b) { return a.utime_us < b.utime_us; });
+  return out;
+}
+
+Pose OptimiserEngine::subframeCorrection(int64_t id, const StoredSubframe& stored, bool use_dr) const {
+  if (use_dr) return Pose::identity();
+  const auto estimate = graph_.estimate(id);
+  if (!estimate) return Pose::identity();
+  return *estimate * stored.dr[static_cast<size_t>(stored.centre_index)].inverse();
+}
+
+std::vector<SeabedPoint> OptimiserEngine::seabedPoints(bool use_dr) const {
+  // Accepted closures only: a rejected one may pair unrelated seabed.
+  std::map<std::pair<int64_t, int64_t>, bool> accepted;
+  for (const ClosureRecord& record : graph_.closures()) {
+    if (record.status != ClosureStatus::kAccepted) continue;
+    accepted[{std::min(record.closure.subframe_id_a, record.closure.subframe_id_b),
+              std::max(record.closure.subframe_id_a, record.closure.subframe_id_b)}] = true;
+  }
+  std::vector<SeabedPoint> points;
+  for (const auto& [key, stored] : correspondences_) {
+    if (!accepted.count(key)) continue;
+    const auto a = stored_.find(key.first);
+    const auto b = stored_.find(key.second);
+    if (a == stored_.end() || b == stored_.end()) continue;
+    const Pose correction_a = subframeCorrection(key.first, a->second, use_dr);
+    const Pose correction_b = subframeCorrection(key.second, b->second, use_dr);
+    const Pose centre_a = correction_a * a->second.dr[static_cast<size_t>(a->second.centre_index)];
+    for (const sss::matcher::ClosureCorrespondence& c : stored.correspondences) {
+      if (c.ping_index_a < 0 || c.ping_index_b < 0 || c.ping_index_a >= static_cast<int>(a->second.dr.size()) ||
+          c.ping_index_b >= static_cast<int>(b->second.dr.size())) {
+        continue;
+      }
+      SonarObservation observation_a{correction_a * a->second.dr[static_cast<size_t>(c.ping_index_a)] * a->second.T_body_sonar,
+                                     c.slant_range_a_m};
+      SonarObservation observation_b{correction_b * b->second.dr[static_cast<size_t>(c.ping_index_b)] * b->second.T_body_sonar,
+                                     c.slant_range_b_m};
+      // Start from the matcher's landmark; without it, straight below the midpoint of the sonars.
+      Eigen::Vector3d initial = centre_a.rotation * c.landmark_a_m.cast<double>() + centre_a.translation;
+      if (!initial.allFinite()) {
+        initial = 0.5 * (observation_a.T_world_sonar.translation + observation_b.T_world_sonar.translation);
+        initial.z() += 0.5 * (c.slant_range_a_m + c.slant_range_b_m);
+      }
+      auto point = triangulateSeabedPoint(observation_a, observation_b, initial, options_.bathymetry);
+      if (!point) continue;
+      point->subframe_id_a = key.first;
+      point->subframe_id_b = key.second;
+      points.push_back(*point);
+    }
+  }
+  return points;
+}
+
+std::vector<ClosureSummary> OptimiserEngine::closureSummaries() const {
+  std::vector<ClosureSummary> out;
+  for (const ClosureRecord& record : graph_.closures()) {
+    ClosureSummary summary;
+    summary.record = record;
+    if (auto a = graph_.estimate(record.closure.subframe_id_a)) summary.centre_a_ned_m = a->translation;
+    if (auto b = graph_.estimate(record.closure.subframe_id_b)) summary.centre_b_ned_m = b->translation;
+    const auto key = std::make_pair(std::min(record.closure.subframe_id_a, record.closure.subframe_id_b),
+                                    std::max(record.closure.subframe_id_a, record.closure.subframe_id_b));
+    if (auto found = correspondences_.find(key); found != correspondences_.end()) summary.mean_zncc = found->second.mean_zncc;
+    out.push_back(summary);
+  }
+  return out;
+}
+
+size_t OptimiserEngine::memoryBytes() const {
+  size_t bytes = 0;
+  for (const auto& [id, stored] : stored_) bytes += stored.dr.size() * (sizeof(Pose) + sizeof(int64_t));
+  for (const auto& [key, stored] : correspondences_) {
+    bytes += stored.correspondences.size() * sizeof(sss::matcher::ClosureCorrespondence);
+  }
+  return bytes + graph_.numNodes() * 1024;  // graph: ~1 kB per node (estimates, covariances, factors)
+}
+
+}  // namespace sss::optimiser

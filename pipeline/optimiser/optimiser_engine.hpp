@@ -1,0 +1,131 @@
+// The optimiser stage without middleware (DESIGN.md stage 5): subframes become pose-graph nodes
+// (centre DR pose, distance travelled), matcher loop closures become graph edges, each update
+// yields the optimised centre poses (SSS_TRAJECTORY for the matcher) and the correction of any DR
+// pose (SSS_POSE, DDS); at the end, full smoothing, the per-ping trajectory and the bathymetry.
+// Used by the sss-optimiser process and by the offline runner, so both share every line of maths.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "pipeline/core/config.hpp"
+#include "pipeline/core/pose.hpp"
+#include "pipeline/matcher/matcher_engine.hpp"
+#include "pipeline/optimiser/bathymetry.hpp"
+#include "pipeline/optimiser/pose_graph.hpp"
+#include "pipeline/subframe/subframe_builder.hpp"
+
+namespace sss::optimiser {
+
+struct OptimiserEngineOptions {
+  PoseGraphOptions graph;
+  BathymetryOptions bathymetry;
+  // Newest nodes sent to the matcher after an update (it keeps at most 240 subframes).
+  int max_trajectory_nodes = 600;
+  // Closures naming a subframe not seen yet (SSS_LOOP overtook SSS_SUBFRAME) wait for it.
+  int max_pending_closures = 64;
+  // Ping poses kept per subframe for the per-ping trajectory and the bathymetry: 200 pings of a
+  // subframe take ~20 kB, 5000 subframes (~70 h of survey) ~100 MB. Oldest dropped first.
+  int max_stored_subframes = 5000;
+};
+
+void readOptimiserEngineOptions(sss::core::ConfigSection& section, OptimiserEngineOptions& options);
+std::vector<std::string> validateOptimiserEngineOptions(const OptimiserEngineOptions& options);
+
+struct OptimiserEngineCounters {
+  uint64_t subframes_in = 0;
+  uint64_t subframes_refused = 0;      // malformed, duplicate or out of order
+  uint64_t closures_in = 0;
+  uint64_t closures_refused = 0;       // refused by the graph (see its counters) or never resolved
+  uint64_t closures_waiting = 0;       // now waiting for their subframe
+  uint64_t subframes_forgotten = 0;    // ping poses dropped beyond max_stored_subframes
+};
+
+// A stamped pose (per-ping trajectories).
+struct StampedPose {
+  int64_t utime_us = 0;
+  sss::core::Pose T_world_body;
+};
+
+// One closure for the loop_closures.csv table: the graph's record and the two centres under the
+// current estimate.
+struct ClosureSummary {
+  ClosureRecord record;
+  Eigen::Vector3d centre_a_ned_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d centre_b_ned_m = Eigen::Vector3d::Zero();
+  float mean_zncc = 0.0f;
+};
+
+// Not thread-safe: one owner calls it. Deterministic for the same input order.
+class OptimiserEngine {
+ public:
+  explicit OptimiserEngine(const OptimiserEngineOptions& options);
+
+  // A new subframe (its image is not kept): a node at its centre ping. Subframes must come in
+  // time order; a refused one leaves the engine unchanged.
+  Status addSubframe(const sss::subframe::Subframe& subframe);
+  // A closure from the matcher. One naming a subframe not seen yet waits (bounded) for it.
+  Status addLoopClosure(const sss::matcher::LoopClosure& closure);
+
+  // Decides pending closures and solves the window (see SlidingWindowPoseGraph::optimize).
+  UpdateReport update();
+  // End of mission: full smoothing over all nodes.
+  UpdateReport finish();
+  // True when input arrived since the last update.
+  bool hasNewInput() const { return new_input_; }
+
+  // Optimised centre poses of the newest max_trajectory_nodes nodes (for the matcher).
+  std::vector<sss::matcher::TrajectoryNode> trajectory() const;
+  // Correction of a DR pose at utime_us: corrected = T_corrected_dr * DR.
+  Correction correctionAt(int64_t utime_us) const { return graph_.correctionAt(utime_us); }
+
+  // Every stored ping in time order, DR or corrected (the graph's correction interpolated at the
+  // ping time).
+  std::vector<StampedPose> pingTrajectory(bool corrected) const;
+  // Seabed points of the accepted closures (latest association round of each pair), triangulated
+  // with the corrected (use_dr = false) or the DR ping poses.
+  std::vector<SeabedPoint> seabedPoints(bool use_dr) const;
+  std::vector<ClosureSummary> closureSummaries() const;
+
+  const SlidingWindowPoseGraph& graph() const { return graph_; }
+
+  // The graph's checkpoint (nodes, closures, decisions, prior). Ping poses and correspondences
+  // are not in it: after a restart, the products cover the subframes seen since.
+  Status saveCheckpoint(const std::string& path) const { return graph_.saveCheckpoint(path); }
+  Status loadCheckpoint(const std::string& path);
+  const OptimiserEngineCounters& counters() const { return counters_; }
+  const OptimiserEngineOptions& options() const { return options_; }
+  size_t memoryBytes() const;
+
+ private:
+  struct StoredSubframe {
+    sss::core::Pose T_body_sonar;
+    int centre_index = 0;
+    std::vector<int64_t> utime_us;
+    std::vector<sss::core::Pose> dr;  // T_world_body per ping
+  };
+  struct StoredCorrespondences {
+    int association_round = 0;
+    float mean_zncc = 0.0f;
+    std::vector<sss::matcher::ClosureCorrespondence> correspondences;
+  };
+
+  Status addToGraph(const sss::matcher::LoopClosure& closure);
+  // World-frame correction of a stored subframe's pings (rigid, as the matcher applies it).
+  sss::core::Pose subframeCorrection(int64_t id, const StoredSubframe& stored, bool use_dr) const;
+
+  OptimiserEngineOptions options_;
+  SlidingWindowPoseGraph graph_;
+  std::map<int64_t, StoredSubframe> stored_;
+  std::map<std::pair<int64_t, int64_t>, StoredCorrespondences> correspondences_;
+  std::deque<sss::matcher::LoopClosure> waiting_;
+  int64_t newest_subframe_id_ = -1;
+  bool new_input_ = false;
+  OptimiserEngineCounters counters_;
+};
+
+}  // namespace sss::optimiser

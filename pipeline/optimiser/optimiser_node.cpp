@@ -1,0 +1,430 @@
+// sss-optimiser: SSS_SUBFRAME + SSS_LOOP -> pose graph -> SSS_TRAJECTORY (matcher); SSS_NAV ->
+// SSS_POSE for every nav sample and the correction on DDS for the navigation computer.
+// Translation only; the logic is in OptimiserEngine. The graph is solved on a worker thread; the
+// process loop answers each nav sample from a snapshot of the newest solved graph, so a solve never
+// delays a pose. The graph is checkpointed after every update into the state directory and
+// restored at start. On SIGTERM (end of mission) or SIGUSR1 (on request) it runs full smoothing and
+// writes the products: optimised trajectory (TUM), bathymetry (PLY), heightmap (raster + PNG).
+//   sss-optimiser [--config FILE [--check-config]] [--lcm-url URL]
+#include <sys/eventfd.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <condition_variable>
+#include <csignal>
+#include <cstdio>
+#include <deque>
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "pipeline/core/geodesy.hpp"
+#include "pipeline/core/time.hpp"
+#include "pipeline/matcher/loop_closure_message.hpp"
+#include "pipeline/optimiser/optimiser_engine.hpp"
+#include "pipeline/optimiser/pose_message.hpp"
+#include "pipeline/subframe/subframe_message.hpp"
+#include "pipeline/transport/dds.hpp"
+#include "pipeline/transport/logging.hpp"
+#include "pipeline/transport/process_loop.hpp"
+#include "pipeline/transport/process_options.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+using sss::optimiser::OptimiserEngine;
+using sss::optimiser::SlidingWindowPoseGraph;
+
+struct NodeOptions {
+  sss::transport::ProcessOptions process;
+  sss::optimiser::OptimiserEngineOptions engine;
+  double origin_latitude_deg = 59.35;
+  double origin_longitude_deg = 18.07;
+  std::string subframe_channel = "SSS_SUBFRAME";
+  std::string loop_channel = "SSS_LOOP";
+  std::string nav_channel = "SSS_NAV";
+  std::string pose_channel = "SSS_POSE";
+  std::string trajectory_channel = "SSS_TRAJECTORY";
+  double update_period_s = 1.0;  // at most one solve per period, when there is new input
+  // Checkpoint and products. Empty: $STATE_DIRECTORY (systemd StateDirectory=), else none.
+  std::string state_directory;
+  std::string products_directory;  // empty: <state_directory>/products
+  bool dds_enabled = true;
+  int dds_domain_id = 0;
+  std::string dds_topic = "sss_navigation_correction";
+  double dds_rate_hz = 10.0;
+  int vehicle_id = 1;
+  bool dds_loopback_only = false;  // tests and single-host chains
+};
+
+std::atomic<bool> g_products_requested{false};
+void onSigusr1(int) { g_products_requested.store(true); }
+
+// Inputs for the worker, and what it hands back to the process loop.
+struct Shared {
+  std::mutex mutex;
+  std::condition_variable wake;
+  std::deque<sss::subframe::Subframe> subframes;
+  std::deque<sss::matcher::LoopClosure> closures;
+  bool products_requested = false;
+  bool stop = false;
+  // Results.
+  std::shared_ptr<const SlidingWindowPoseGraph> snapshot;  // newest solved graph (for corrections)
+  std::optional<std::vector<sss::matcher::TrajectoryNode>> trajectory;  // to publish
+  sss::optimiser::PoseGraphCounters graph_counters;
+  sss::optimiser::OptimiserEngineCounters engine_counters;
+  double last_update_s = 0.0;
+  size_t memory_bytes = 0;
+  std::vector<std::string> messages;  // log lines from the worker (logged by the loop)
+};
+
+bool writeProducts(OptimiserEngine& engine, const std::string& directory, std::vector<std::string>& messages) {
+  std::error_code ec;
+  fs::create_directories(directory, ec);
+  std::string error;
+  const auto trajectory = engine.pingTrajectory(true);
+  std::FILE* f = std::fopen((directory + "/slam.tum").c_str(), "w");
+  if (!f) {
+    messages.push_back("cannot write " + directory + "/slam.tum");
+    return false;
+  }
+  std::fprintf(f, "# sss-optimiser: optimised pose of every ping of the subframes (TUM, local NED)\n");
+  for (const auto& p : trajectory) {
+    const auto& q = p.T_world_body.rotation;
+    const auto& t = p.T_world_body.translation;
+    std::fprintf(f, "%lld.%06lld %.4f %.4f %.4f %.9f %.9f %.9f %.9f\n", static_cast<long long>(p.utime_us / 1000000),
+                 static_cast<long long>(p.utime_us % 1000000), t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+  }
+  std::fclose(f);
+  const auto points = engine.seabedPoints(false);
+  bool ok = sss::optimiser::writeSeabedPly(directory + "/bathymetry.ply", points, error);
+  if (ok && !points.empty()) {
+    ok = sss::optimiser::writeHeightmapFiles(directory + "/heightmap.yaml",
+                                             sss::optimiser::gridSeabedPoints(points, engine.options().bathymetry),
+                                             "sss-optimiser: seabed re-triangulated with the optimised poses", error);
+  }
+  messages.push_back(ok ? "products written to " + directory + ": " + std::to_string(trajectory.size()) +
+                              " poses, " + std::to_string(points.size()) + " seabed points"
+                        : "products: " + error);
+  return ok;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  sss::transport::NodeArguments arguments;
+  if (const int exit_code = sss::transport::parseNodeArguments(argc, argv, arguments); exit_code >= 0) return exit_code;
+  const std::string& config_path = arguments.config_path;
+  NodeOptions options;
+  options.process.process_name = "sss-optimiser";
+  if (!config_path.empty()) {
+    using namespace sss::core;
+    Config config = Config::fromFile(config_path);
+    ConfigSection mission = config.section("mission");
+    mission.optional("origin_latitude_deg", options.origin_latitude_deg, {inRange(-90.0, 90.0)});
+    mission.optional("origin_longitude_deg", options.origin_longitude_deg, {inRange(-180.0, 180.0)});
+    ConfigSection section = config.section("optimiser");
+    sss::transport::readProcessOptions(section, options.process);
+    sss::optimiser::readOptimiserEngineOptions(section, options.engine);
+    section.optional("subframe_channel", options.subframe_channel, {nonEmpty()});
+    section.optional("loop_channel", options.loop_channel, {nonEmpty()});
+    section.optional("nav_channel", options.nav_channel, {nonEmpty()});
+    section.optional("pose_channel", options.pose_channel, {nonEmpty()});
+    section.optional("trajectory_channel", options.trajectory_channel, {nonEmpty()});
+    section.optional("update_period_s", options.update_period_s, {inRange(0.0, 3600.0)});
+    section.optional("state_directory", options.state_directory);
+    section.optional("products_directory", options.products_directory);
+    ConfigSection dds = section.section("dds");
+    dds.optional("enabled", options.dds_enabled);
+    dds.optional("domain_id", options.dds_domain_id, {inRange(0, 232)});
+    dds.optional("topic", options.dds_topic, {nonEmpty()});
+    dds.optional("rate_hz", options.dds_rate_hz, {inRange(0.01, 1000.0)});
+    dds.optional("vehicle_id", options.vehicle_id, {inRange(0, 1000000)});
+    dds.optional("loopback_only", options.dds_loopback_only);
+    dds.rejectUnknownKeys();
+    section.rejectUnknownKeys();
+    for (const std::string& problem : sss::optimiser::validateOptimiserEngineOptions(options.engine)) {
+      section.addProblem("optimiser", "", problem);
+    }
+    if (!config.ok()) {
+      std::fprintf(stderr, "sss-optimiser: invalid configuration:\n%s", config.problemReport().c_str());
+      return 2;
+    }
+  }
+  if (arguments.check_config_only) {
+    std::printf("sss-optimiser: configuration '%s' is valid\n", config_path.c_str());
+    return 0;
+  }
+  if (!arguments.lcm_url_override.empty()) options.process.lcm_url = arguments.lcm_url_override;
+  if (options.state_directory.empty()) {
+    if (const char* state = std::getenv("STATE_DIRECTORY")) options.state_directory = state;
+  }
+  if (options.products_directory.empty() && !options.state_directory.empty()) {
+    options.products_directory = options.state_directory + "/products";
+  }
+
+  sss::transport::initLogging(options.process.process_name, options.process.log_level);
+  sss::transport::ProcessLoop loop(options.process);
+  sss::core::HealthMonitor& health = loop.health();
+  const sss::core::LocalTangentPlane plane(options.origin_latitude_deg, options.origin_longitude_deg);
+  // Determinism and bounded latency come from the iteration bound; the time limit is the config's.
+  OptimiserEngine engine(options.engine);
+  const std::string checkpoint_path =
+      options.state_directory.empty() ? std::string() : options.state_directory + "/optimiser.checkpoint";
+  if (!checkpoint_path.empty()) {
+    std::error_code ec;
+    fs::create_directories(options.state_directory, ec);
+    if (fs::exists(checkpoint_path)) {
+      const sss::optimiser::Status loaded = engine.loadCheckpoint(checkpoint_path);
+      if (loaded.ok) {
+        spdlog::info("resumed from {}: {} nodes, {} closures accepted", checkpoint_path, engine.graph().numNodes(),
+                     engine.graph().counters().closures_accepted);
+      } else {
+        spdlog::error("checkpoint {} not usable ({}); starting a new graph", checkpoint_path, loaded.message);
+      }
+    }
+  } else {
+    spdlog::warn("no state directory (config optimiser.state_directory or $STATE_DIRECTORY): no checkpoints, "
+                 "a restart loses the graph");
+  }
+
+  Shared shared;
+  shared.snapshot = std::make_shared<const SlidingWindowPoseGraph>(engine.graph());
+  const int results_fd = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+  if (results_fd < 0) {
+    spdlog::error("cannot create an eventfd for the optimiser thread");
+    return 1;
+  }
+  auto notifyLoop = [&] {
+    const uint64_t one = 1;
+    if (write(results_fd, &one, sizeof one) < 0) {
+      // Saturated counter: the loop is already due to read.
+    }
+  };
+
+  std::thread worker([&] {
+    double last_update_monotonic_s = -1e9;
+    for (;;) {
+      std::deque<sss::subframe::Subframe> subframes;
+      std::deque<sss::matcher::LoopClosure> closures;
+      bool products = false;
+      {
+        std::unique_lock<std::mutex> lock(shared.mutex);
+        shared.wake.wait_for(lock, std::chrono::duration<double>(std::max(options.update_period_s, 0.05)), [&] {
+          return shared.stop || !shared.subframes.empty() || !shared.closures.empty() || shared.products_requested;
+        });
+        if (shared.stop) return;
+        subframes.swap(shared.subframes);
+        closures.swap(shared.closures);
+        products = shared.products_requested;
+        shared.products_requested = false;
+      }
+      std::vector<std::string> messages;
+      for (const auto& subframe : subframes) {
+        const auto status = engine.addSubframe(subframe);
+        if (!status.ok) messages.push_back("subframe " + std::to_string(subframe.id) + " refused: " + status.message);
+      }
+      for (const auto& closure : closures) {
+        const auto status = engine.addLoopClosure(closure);
+        if (!status.ok) {
+          messages.push_back("closure " + std::to_string(closure.subframe_id_a) + "-" +
+                             std::to_string(closure.subframe_id_b) + " refused: " + status.message);
+        }
+      }
+      const double now_s = 1e-6 * static_cast<double>(sss::core::monotonicUtime());
+      bool updated = false;
+      if (products) {
+        engine.finish();
+        if (!options.products_directory.empty()) writeProducts(engine, options.products_directory, messages);
+        updated = true;
+      } else if (engine.hasNewInput() && now_s - last_update_monotonic_s >= options.update_period_s) {
+        const auto report = engine.update();
+        if (!report.ok) messages.push_back("update failed: " + report.message);
+        last_update_monotonic_s = now_s;
+        updated = true;
+      }
+      if (updated && !checkpoint_path.empty()) {
+        const auto saved = engine.saveCheckpoint(checkpoint_path);
+        if (!saved.ok) messages.push_back("checkpoint: " + saved.message);
+      }
+      if (!updated && messages.empty()) continue;
+      auto snapshot = updated ? std::make_shared<const SlidingWindowPoseGraph>(engine.graph()) : nullptr;
+      {
+        std::lock_guard<std::mutex> lock(shared.mutex);
+        if (snapshot) {
+          shared.snapshot = std::move(snapshot);
+          shared.trajectory = engine.trajectory();
+        }
+        shared.graph_counters = engine.graph().counters();
+        shared.engine_counters = engine.counters();
+        shared.last_update_s = engine.graph().counters().last_update_s;
+        shared.memory_bytes = engine.memoryBytes();
+        for (auto& m : messages) shared.messages.push_back(std::move(m));
+      }
+      notifyLoop();
+    }
+  });
+
+  auto snapshot = [&] {
+    std::lock_guard<std::mutex> lock(shared.mutex);
+    return shared.snapshot;
+  };
+
+  // ---- DDS: the newest correction, reliable, keep-last 1, transient-local ----------------------
+  std::unique_ptr<sss::transport::dds::Participant> participant;
+  std::unique_ptr<sss::transport::dds::Topic<sss_dds_NavigationCorrection>> topic;
+  std::unique_ptr<sss::transport::dds::Writer<sss_dds_NavigationCorrection>> writer;
+  if (options.dds_enabled) {
+    participant = std::make_unique<sss::transport::dds::Participant>(
+        static_cast<uint32_t>(options.dds_domain_id),
+        options.dds_loopback_only ? sss::transport::dds::loopbackConfigXml() : std::string());
+    if (participant->good()) {
+      topic = std::make_unique<sss::transport::dds::Topic<sss_dds_NavigationCorrection>>(
+          *participant, &sss_dds_NavigationCorrection_desc, options.dds_topic);
+      if (topic->good()) writer = std::make_unique<sss::transport::dds::Writer<sss_dds_NavigationCorrection>>(*participant, *topic);
+    }
+    if (!writer || !writer->good()) {
+      spdlog::error("DDS writer for topic '{}' on domain {} could not be created ({}); corrections go on LCM only",
+                    options.dds_topic, options.dds_domain_id,
+                    participant && !participant->good() ? participant->error() : "topic or writer");
+      writer.reset();
+      health.recordError("dds", "DDS writer unavailable", sss::core::nowUtime());
+    }
+  }
+  std::optional<sss_dds_NavigationCorrection> pending_dds;
+  uint64_t dds_written = 0;
+
+  // ---- subscriptions ------------------------------------------------------------------------------
+  loop.bus().subscribe<sss_msgs::nav_t>(options.nav_channel, [&](const sss_msgs::nav_t& message) {
+    const int64_t arrival = sss::core::monotonicUtime();
+    const sss::subframe::NavInput nav = sss::subframe::fromNavMessage(message);
+    if (!nav.position_ned_m.allFinite() || !std::isfinite(nav.heading_rad) || !std::isfinite(nav.roll_rad) ||
+        !std::isfinite(nav.pitch_rad) || nav.utime_us <= 0) {
+      if (health.recordError("bad_nav", "nav sample with non-finite pose or no time", sss::core::nowUtime()))
+        spdlog::warn("nav sample rejected (non-finite pose or no time); further ones are counted in SSS_STATUS");
+      return;
+    }
+    const auto graph = snapshot();
+    const sss::optimiser::Correction correction = graph->correctionAt(nav.utime_us);
+    const auto dr = sss::optimiser::drPoseOf(nav.position_ned_m, nav.roll_rad, nav.pitch_rad, nav.heading_rad);
+    const sss_msgs::pose_t pose = sss::optimiser::toPoseMessage(nav.utime_us, dr, correction, plane);
+    loop.bus().publish(options.pose_channel, pose, arrival);
+    if (writer) pending_dds = sss::optimiser::toDdsCorrection(pose, static_cast<uint32_t>(options.vehicle_id),
+                                                              correction.accepted_closures);
+  });
+  loop.bus().subscribe<sss_msgs::subframe_t>(options.subframe_channel, [&](const sss_msgs::subframe_t& message) {
+    sss::subframe::Subframe subframe;
+    std::string error;
+    if (!sss::subframe::fromSubframeMessage(message, subframe, error)) {
+      if (health.recordError("bad_subframe", error, sss::core::nowUtime()))
+        spdlog::warn("subframe {} rejected: {}; further ones are counted in SSS_STATUS", message.subframe_id, error);
+      return;
+    }
+    subframe.image.clear();  // the optimiser keeps poses only
+    subframe.image.shrink_to_fit();
+    subframe.mask.clear();
+    subframe.mask.shrink_to_fit();
+    std::lock_guard<std::mutex> lock(shared.mutex);
+    shared.subframes.push_back(std::move(subframe));
+    shared.wake.notify_one();
+  });
+  loop.bus().subscribe<sss_msgs::loop_closure_t>(options.loop_channel, [&](const sss_msgs::loop_closure_t& message) {
+    sss::matcher::LoopClosure closure;
+    std::string error;
+    if (!sss::matcher::fromLoopClosureMessage(message, closure, error)) {
+      if (health.recordError("bad_loop_closure", error, sss::core::nowUtime()))
+        spdlog::warn("loop closure rejected: {}; further ones are counted in SSS_STATUS", error);
+      return;
+    }
+    std::lock_guard<std::mutex> lock(shared.mutex);
+    shared.closures.push_back(std::move(closure));
+    shared.wake.notify_one();
+  });
+
+  loop.addFileDescriptor(results_fd, [&] {
+    uint64_t count = 0;
+    if (read(results_fd, &count, sizeof count) < 0) return;
+    std::optional<std::vector<sss::matcher::TrajectoryNode>> trajectory;
+    std::vector<std::string> messages;
+    sss::optimiser::PoseGraphCounters graph_counters;
+    sss::optimiser::OptimiserEngineCounters engine_counters;
+    size_t memory_bytes = 0;
+    {
+      std::lock_guard<std::mutex> lock(shared.mutex);
+      trajectory.swap(shared.trajectory);
+      messages.swap(shared.messages);
+      graph_counters = shared.graph_counters;
+      engine_counters = shared.engine_counters;
+      memory_bytes = shared.memory_bytes;
+    }
+    for (const auto& m : messages) spdlog::info("{}", m);
+    if (trajectory && !trajectory->empty()) {
+      loop.bus().publish(options.trajectory_channel, sss::matcher::toTrajectoryMessage(*trajectory, sss::core::nowUtime()));
+    }
+    health.setCounter("nodes", static_cast<double>(graph_counters.nodes_added));
+    health.setCounter("nodes_marginalised", static_cast<double>(graph_counters.nodes_marginalised));
+    health.setCounter("closures_received", static_cast<double>(graph_counters.closures_received));
+    health.setCounter("closures_accepted", static_cast<double>(graph_counters.closures_accepted));
+    health.setCounter("closures_rejected",
+                      static_cast<double>(graph_counters.closures_rejected_gate +
+                                          graph_counters.closures_rejected_inconsistent +
+                                          graph_counters.closures_rejected_no_support));
+    health.setCounter("closures_refused", static_cast<double>(engine_counters.closures_refused));
+    health.setCounter("closures_waiting", static_cast<double>(engine_counters.closures_waiting));
+    health.setCounter("subframes_refused", static_cast<double>(engine_counters.subframes_refused));
+    health.setCounter("updates", static_cast<double>(graph_counters.updates));
+    health.setCounter("solver_failures", static_cast<double>(graph_counters.solver_failures));
+    health.setCounter("last_update_ms", 1e3 * graph_counters.last_update_s);
+    health.setCounter("memory_mb", static_cast<double>(memory_bytes) / 1e6);
+  });
+
+  if (writer) {
+    loop.addTimer(1.0 / options.dds_rate_hz, [&] {
+      if (!pending_dds) return;
+      if (writer->write(*pending_dds)) {
+        ++dds_written;
+        health.setCounter("dds_corrections", static_cast<double>(dds_written));
+      } else if (health.recordError("dds_write", "DDS write failed", sss::core::nowUtime())) {
+        spdlog::warn("DDS write failed; further failures are counted in SSS_STATUS");
+      }
+      pending_dds.reset();
+    });
+  }
+  std::signal(SIGUSR1, onSigusr1);
+  loop.addTimer(0.5, [&] {
+    if (!g_products_requested.exchange(false)) return;
+    spdlog::info("products requested (SIGUSR1): full smoothing");
+    std::lock_guard<std::mutex> lock(shared.mutex);
+    shared.products_requested = true;
+    shared.wake.notify_one();
+  });
+
+  const int exit_code = loop.run();
+  {
+    std::lock_guard<std::mutex> lock(shared.mutex);
+    shared.stop = true;
+    shared.wake.notify_one();
+  }
+  worker.join();
+  close(results_fd);
+  // End of mission: whatever arrived last, full smoothing, products and a final checkpoint.
+  for (const auto& subframe : shared.subframes) engine.addSubframe(subframe);
+  for (const auto& closure : shared.closures) engine.addLoopClosure(closure);
+  if (engine.graph().numNodes() > 0) {
+    engine.finish();
+    std::vector<std::string> messages;
+    if (!options.products_directory.empty()) writeProducts(engine, options.products_directory, messages);
+    if (!checkpoint_path.empty()) {
+      const auto saved = engine.saveCheckpoint(checkpoint_path);
+      if (!saved.ok) messages.push_back("checkpoint: " + saved.message);
+    }
+    for (const auto& m : messages) spdlog::info("{}", m);
+  }
+  return exit_code;
+}

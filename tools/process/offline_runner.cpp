@@ -1,0 +1,731 @@
+// sss-process's engine: inputs in time order through the chain's libraries, then the outputs.
+// See offline_runner.hpp.
+#include "tools/process/offline_runner.hpp"
+
+#include <strings.h>
+#include <sys/resource.h>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <algorithm>
+#include <cstring>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "drivers/edgetech/ping_message.hpp"
+#include "drivers/edgetech/sonar_driver.hpp"
+#include "drivers/ins/ins_bridge.hpp"
+#include "drivers/ins/nav_message.hpp"
+#include "drivers/xtf/xtf_reader.hpp"
+#include "pipeline/core/config.hpp"
+#include "pipeline/core/geodesy.hpp"
+#include "pipeline/matcher/matcher_engine.hpp"
+#include "pipeline/optimiser/optimiser_engine.hpp"
+#include "pipeline/subframe/pictures.hpp"
+#include "pipeline/subframe/subframe_buffer.hpp"
+#include "pipeline/subframe/subframe_message.hpp"
+
+namespace sss::offline {
+
+namespace {
+
+namespace fs = std::filesystem;
+using sss::core::Pose;
+using sss::subframe::NavInput;
+using sss::subframe::PingInput;
+
+double wallSeconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+double peakRssMib() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB on Linux
+}
+
+bool hasExtension(const std::string& path, const char* extension) {
+  const size_t n = std::strlen(extension);
+  return path.size() > n && strcasecmp(path.c_str() + path.size() - n, extension) == 0;
+}
+
+struct Options {
+  double origin_latitude_deg = 59.35;
+  double origin_longitude_deg = 18.07;
+  sss::edgetech::SonarDriverOptions sonar;
+  sss::xtf::XtfReaderOptions xtf;
+  sss::ins::InsBridgeOptions ins;
+  sss::subframe::SubframeBufferOptions buffer;
+  sss::matcher::MatcherEngineOptions matcher;
+  sss::optimiser::OptimiserEngineOptions optimiser;
+  sss::subframe::PictureOptions pictures;
+};
+
+// The library keys of each process's section; keys only a live process uses (ports, channels)
+// are left alone here: each process's --check-config validates the whole file.
+bool readOptions(const std::string& path, Options& options, std::string& error) {
+  if (!path.empty()) {
+    using namespace sss::core;
+    Config config = Config::fromFile(path);
+    ConfigSection mission = config.section("mission");
+    mission.optional("origin_latitude_deg", options.origin_latitude_deg, {inRange(-90.0, 90.0)});
+    mission.optional("origin_longitude_deg", options.origin_longitude_deg, {inRange(-180.0, 180.0)});
+    ConfigSection sonar = config.section("sonar_driver");
+    sss::edgetech::readSonarDriverOptions(sonar, options.sonar);
+    sonar.optional("xtf_pair_index", options.xtf.pair_index, {inRange(0, 7)});
+    ConfigSection ins = config.section("ins_bridge");
+    sss::ins::readInsBridgeOptions(ins, options.ins);
+    ConfigSection buffer = config.section("subframe_buffer");
+    sss::subframe::readSubframeBufferOptions(buffer, options.buffer);
+    ConfigSection matcher = config.section("matcher");
+    sss::matcher::readMatcherEngineOptions(matcher, options.matcher);
+    ConfigSection optimiser = config.section("optimiser");
+    sss::optimiser::readOptimiserEngineOptions(optimiser, options.optimiser);
+    if (!config.ok()) {
+      error = "invalid configuration " + path + ": " + config.problemReport();
+      return false;
+    }
+  }
+  options.ins.origin_latitude_deg = options.origin_latitude_deg;
+  options.ins.origin_longitude_deg = options.origin_longitude_deg;
+  // Files carry the ping time of the sonar's clock; a recording has no live clock to compare with.
+  options.sonar.time_source = sss::edgetech::TimeSource::kSonarClock;
+  options.sonar.recorder.directory.clear();
+  // Deterministic: no wall-clock limit anywhere.
+  options.matcher.pair.pose.time_limit_s = 0.0;
+  options.optimiser.graph.max_solver_time_s = 0.0;
+  std::vector<std::string> problems = sss::matcher::validateMatcherEngineOptions(options.matcher);
+  for (const std::string& problem : sss::optimiser::validateOptimiserEngineOptions(options.optimiser)) {
+    problems.push_back(problem);
+  }
+  if (!problems.empty()) {
+    error = "invalid configuration " + path + ": " + problems.front();
+    return false;
+  }
+  return true;
+}
+
+// ---- inputs in time order ----------------------------------------------------------------------
+
+// One source of pings and one of nav samples, each in file order; the runner merges them by time.
+class PingSource {
+ public:
+  virtual ~PingSource() = default;
+  // Appends what the next read gives (possibly nothing); false at the end of the input.
+  virtual bool read(std::deque<sss::edgetech::DriverPing>& out) = 0;
+  virtual double fractionRead() const = 0;
+  virtual uint64_t faults() const = 0;
+};
+
+class JsfSource : public PingSource {
+ public:
+  JsfSource(const std::string& path, const sss::edgetech::SonarDriverOptions& options)
+      : file_(path, std::ios::binary), driver_(options) {
+    std::error_code ec;
+    size_ = fs::file_size(path, ec);
+  }
+  bool good() const { return file_.good(); }
+  bool read(std::deque<sss::edgetech::DriverPing>& out) override {
+    if (finished_) return false;
+    std::vector<char> chunk(1 << 20);
+    file_.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+    const std::streamsize n = file_.gcount();
+    read_ += static_cast<uint64_t>(std::max<std::streamsize>(n, 0));
+    std::vector<sss::edgetech::DriverPing> pings;
+    if (n > 0) driver_.onBytes(reinterpret_cast<const uint8_t*>(chunk.data()), static_cast<size_t>(n), 0, 0, pings);
+    if (n <= 0 || !file_) {
+      driver_.finish(0, 0, pings);
+      finished_ = true;
+    }
+    for (auto& ping : pings) out.push_back(std::move(ping));
+    return !finished_ || !pings.empty();
+  }
+  double fractionRead() const override { return size_ > 0 ? static_cast<double>(read_) / static_cast<double>(size_) : 0.0; }
+  uint64_t faults() const override {
+    const auto& c = driver_.parserCounters();
+    return c.bad_headers + c.truncated_messages + driver_.sonarDecodeErrors();
+  }
+
+ private:
+  std::ifstream file_;
+  sss::edgetech::SonarDriver driver_;
+  uint64_t size_ = 0;
+  uint64_t read_ = 0;
+  bool finished_ = false;
+};
+
+class XtfSource : public PingSource {
+ public:
+  XtfSource(const std::string& path, const sss::xtf::XtfReaderOptions& options) : reader_(path, options) {
+    std::error_code ec;
+    size_ = fs::file_size(path, ec);
+  }
+  const sss::xtf::XtfReader& reader() const { return reader_; }
+  bool read(std::deque<sss::edgetech::DriverPing>& out) override {
+    sss::edgetech::DriverPing ping;
+    if (!reader_.next(ping)) return false;
+    out.push_back(std::move(ping));
+    return true;
+  }
+  double fractionRead() const override {
+    return size_ > 0 ? static_cast<double>(reader_.bytesRead()) / static_cast<double>(size_) : 0.0;
+  }
+  uint64_t faults() const override { return reader_.counters().corruptRecords(); }
+
+ private:
+  sss::xtf::XtfReader reader_;
+  uint64_t size_ = 0;
+};
+
+class InsFileSource {
+ public:
+  InsFileSource(const std::string& path, const sss::ins::InsBridgeOptions& options)
+      : file_(path, std::ios::binary), bridge_(options) {}
+  bool good() const { return file_.good(); }
+  bool read(std::deque<NavInput>& out) {
+    if (finished_) return false;
+    std::vector<char> chunk(256 * 1024);
+    file_.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+    const std::streamsize n = file_.gcount();
+    std::vector<sss::ins::NavSample> samples;
+    // Host time 0 throughout: staleness is a live-link notion, not one of a recorded file.
+    if (n > 0) {
+      bridge_.onBytes(reinterpret_cast<const uint8_t*>(chunk.data()), static_cast<size_t>(n), 0, samples);
+      bridge_.onChunkEnd(0, samples);
+    }
+    if (n <= 0 || !file_) {
+      bridge_.finish(0, samples);
+      finished_ = true;
+    }
+    // Through the SSS_NAV message, exactly as the live chain does.
+    for (const auto& sample : samples) out.push_back(sss::subframe::fromNavMessage(sss::ins::toNavMessage(sample)));
+    return !finished_ || !samples.empty();
+  }
+  uint64_t faults() const {
+    const auto& c = bridge_.streamCounters();
+    return static_cast<uint64_t>(c.bad_checksum + c.missing_checksum + c.overlong + c.bad_character + c.truncated);
+  }
+
+ private:
+  std::ifstream file_;
+  sss::ins::InsBridge bridge_;
+  bool finished_ = false;
+};
+
+// Navigation from a sonar ping's header (JSF type 80 and XTF carry position, attitude, altitude).
+class EmbeddedNavigation {
+ public:
+  EmbeddedNavigation(double latitude_deg, double longitude_deg) : plane_(latitude_deg, longitude_deg) {}
+  std::optional<NavInput> fromPing(const sss::edgetech::DriverPing& driver_ping) {
+    const auto& side = driver_ping.ping.port ? *driver_ping.ping.port : *driver_ping.ping.starboard;
+    if (!(side.validity & sss::edgetech::kValidLatLon) && side.latitude_deg == 0.0 && side.longitude_deg == 0.0) {
+      return std::nullopt;  // no position in this file
+    }
+    NavInput nav;
+    nav.utime_us = driver_ping.utime_us;
+    nav.position_ned_m = plane_.toNed({side.latitude_deg, side.longitude_deg, side.depth_m});
+    nav.roll_rad = side.roll_rad;
+    nav.pitch_rad = side.pitch_rad;
+    nav.heading_rad = side.heading_rad;
+    nav.altitude_m = side.altitude_m;
+    nav.altitude_valid = (side.validity & sss::edgetech::kValidAltitude) != 0 && side.altitude_m > 0.0;
+    if (last_) distance_m_ += (nav.position_ned_m - *last_).head<2>().norm();
+    last_ = nav.position_ned_m;
+    nav.distance_travelled_m = distance_m_;
+    return nav;
+  }
+
+ private:
+  sss::core::LocalTangentPlane plane_;
+  std::optional<Eigen::Vector3d> last_;
+  double distance_m_ = 0.0;
+};
+
+// ---- outputs -----------------------------------------------------------------------------------
+
+bool writeTum(const std::string& path, const std::vector<sss::optimiser::StampedPose>& poses, const std::string& comment,
+              std::string& error) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) {
+    error = "cannot write " + path;
+    return false;
+  }
+  std::fprintf(f, "# %s\n# timestamp_s north_m east_m down_m qx qy qz qw (T_world_body, local NED of the mission origin)\n",
+               comment.c_str());
+  for (const auto& p : poses) {
+    const auto& q = p.T_world_body.rotation;
+    const auto& t = p.T_world_body.translation;
+    std::fprintf(f, "%lld.%06lld %.4f %.4f %.4f %.9f %.9f %.9f %.9f\n", static_cast<long long>(p.utime_us / 1000000),
+                 static_cast<long long>(p.utime_us % 1000000), t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+  }
+  const bool ok = std::fclose(f) == 0;
+  if (!ok) error = "cannot write " + path;
+  return ok;
+}
+
+const char* statusName(sss::optimiser::ClosureStatus status) {
+  switch (status) {
+    case sss::optimiser::ClosureStatus::kAccepted: return "accepted";
+    case sss::optimiser::ClosureStatus::kRejected: return "rejected";
+    case sss::optimiser::ClosureStatus::kSuperseded: return "superseded";
+    case sss::optimiser::ClosureStatus::kPending: return "pending";
+  }
+  return "unknown";
+}
+
+const char* rejectionName(sss::optimiser::ClosureRejection rejection) {
+  switch (rejection) {
+    case sss::optimiser::ClosureRejection::kNone: return "none";
+    case sss::optimiser::ClosureRejection::kChiSquareGate: return "chi_square_gate";
+    case sss::optimiser::ClosureRejection::kInconsistent: return "inconsistent";
+    case sss::optimiser::ClosureRejection::kNoSupport: return "no_support";
+  }
+  return "unknown";
+}
+
+bool writeClosuresCsv(const std::string& path, const sss::optimiser::OptimiserEngine& engine, std::string& error) {
+  std::map<int64_t, int64_t> utime_of;
+  for (const auto& node : engine.graph().nodes()) utime_of[node.subframe_id] = node.utime_us;
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) {
+    error = "cannot write " + path;
+    return false;
+  }
+  std::fprintf(f, "# loop closures from the matcher and the optimiser's decision; T_a_b maps B's centre body frame into A's;\n"
+                  "# north/east: the two subframe centres under the final SLAM estimate (local NED, m)\n");
+  std::fprintf(f, "subframe_id_a,subframe_id_b,utime_a_us,utime_b_us,round,status,rejection,dx_m,dy_m,dz_m,droll_rad,"
+                  "dpitch_rad,dheading_rad,num_inliers,mean_zncc,north_a_m,east_a_m,north_b_m,east_b_m\n");
+  for (const auto& summary : engine.closureSummaries()) {
+    const auto& c = summary.record.closure;
+    const sss::core::EulerAngles euler = sss::core::eulerFromQuaternion(c.T_a_b.rotation);
+    std::fprintf(f, "%lld,%lld,%lld,%lld,%d,%s,%s,%.4f,%.4f,%.4f,%.6f,%.6f,%.6f,%d,%.4f,%.3f,%.3f,%.3f,%.3f\n",
+                 static_cast<long long>(c.subframe_id_a), static_cast<long long>(c.subframe_id_b),
+                 static_cast<long long>(utime_of[c.subframe_id_a]), static_cast<long long>(utime_of[c.subframe_id_b]),
+                 c.association_round, statusName(summary.record.status), rejectionName(summary.record.rejection),
+                 c.T_a_b.translation.x(), c.T_a_b.translation.y(), c.T_a_b.translation.z(), euler.roll_rad,
+                 euler.pitch_rad, euler.heading_rad, c.num_inliers, summary.mean_zncc, summary.centre_a_ned_m.x(),
+                 summary.centre_a_ned_m.y(), summary.centre_b_ned_m.x(), summary.centre_b_ned_m.y());
+  }
+  const bool ok = std::fclose(f) == 0;
+  if (!ok) error = "cannot write " + path;
+  return ok;
+}
+
+bool writeSummaryJson(const std::string& path, const OfflineRequest& request, const OfflineSummary& s,
+                      std::string& error) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) {
+    error = "cannot write " + path;
+    return false;
+  }
+  auto quoted = [](const std::string& text) {
+    std::string out = "\"";
+    for (char c : text) {
+      if (c == '"' || c == '\\') out += '\\';
+      out += c;
+    }
+    return out + "\"";
+  };
+  std::fprintf(f, "{\n  \"schema\": \"sss-process/1\",\n");
+  std::fprintf(f, "  \"inputs\": {\"sonar\": %s, \"ins\": %s, \"lcm_log\": %s, \"config\": %s},\n",
+               quoted(request.sonar_path).c_str(), quoted(request.ins_path).c_str(), quoted(request.lcm_log_path).c_str(),
+               quoted(request.config_path).c_str());
+  std::fprintf(f,
+               "  \"nav_samples\": %llu,\n  \"pings\": %llu,\n  \"pings_with_pose\": %llu,\n  \"subframes\": %llu,\n"
+               "  \"pairs_attempted\": %llu,\n  \"matcher_closures\": %llu,\n  \"closures_accepted\": %llu,\n"
+               "  \"closures_rejected\": %llu,\n  \"closures_superseded\": %llu,\n  \"seabed_points\": %llu,\n"
+               "  \"input_faults\": %llu,\n  \"mission_s\": %.3f,\n  \"wall_s\": %.3f,\n  \"matcher_s\": %.3f,\n"
+               "  \"optimiser_s\": %.3f,\n  \"real_time_factor\": %.2f,\n  \"peak_rss_mib\": %.1f\n}\n",
+               static_cast<unsigned long long>(s.nav_samples), static_cast<unsigned long long>(s.pings),
+               static_cast<unsigned long long>(s.pings_with_pose), static_cast<unsigned long long>(s.subframes),
+               static_cast<unsigned long long>(s.pairs_attempted), static_cast<unsigned long long>(s.matcher_closures),
+               static_cast<unsigned long long>(s.closures_accepted), static_cast<unsigned long long>(s.closures_rejected),
+               static_cast<unsigned long long>(s.closures_superseded), static_cast<unsigned long long>(s.seabed_points),
+               static_cast<unsigned long long>(s.input_faults), s.mission_s, s.wall_s, s.matcher_s, s.optimiser_s,
+               s.real_time_factor, s.peak_rss_mib);
+  const bool ok = std::fclose(f) == 0;
+  if (!ok) error = "cannot write " + path;
+  return ok;
+}
+
+// A copy of a subframe with `factor` bins averaged into one (masked if any is masked): mosaics
+// are drawn at ~0.5 m, so a long mission's mosaics need not keep full-resolution images.
+sss::subframe::Subframe decimateForMosaic(const sss::subframe::Subframe& s, int factor) {
+  sss::subframe::Subframe out;
+  out.id = s.id;
+  out.line_id = s.line_id;
+  out.centre_ping_index = s.centre_ping_index;
+  out.pings = s.pings;
+  out.geometry = s.geometry;
+  const int bins = s.geometry.bins_per_side / factor;
+  out.geometry.bins_per_side = bins;
+  out.geometry.bin_size_m = s.geometry.bin_size_m * factor;
+  out.geometry.first_bin_range_m = s.geometry.first_bin_range_m + 0.5 * (factor - 1) * s.geometry.bin_size_m;
+  const int cols = out.geometry.columns();
+  out.image.assign(static_cast<size_t>(s.rows()) * cols, 0.0f);
+  out.mask.assign(out.image.size(), sss::subframe::kMaskValid);
+  const int source_bins = s.geometry.bins_per_side;
+  for (int row = 0; row < s.rows(); ++row) {
+    for (int bin = 0; bin < bins; ++bin) {
+      for (int side = 0; side < 2; ++side) {  // 0 port, 1 starboard
+        float sum = 0.0f;
+        uint8_t mask = sss::subframe::kMaskValid;
+        for (int k = 0; k < factor; ++k) {
+          const int source_bin = bin * factor + k;
+          const int column = side == 0 ? source_bins - 1 - source_bin : source_bins + source_bin;
+          const size_t i = static_cast<size_t>(row) * s.cols() + column;
+          sum += s.image[i];
+          if (s.mask[i] != sss::subframe::kMaskValid) mask = s.mask[i];
+        }
+        const int column = side == 0 ? bins - 1 - bin : bins + bin;
+        out.image[static_cast<size_t>(row) * cols + column] = sum / static_cast<float>(factor);
+        out.mask[static_cast<size_t>(row) * cols + column] = mask;
+      }
+    }
+  }
+  return out;
+}
+
+// ---- the run -----------------------------------------------------------------------------------
+
+class Runner {
+ public:
+  Runner(const OfflineRequest& request, const Options& options)
+      : request_(request),
+        options_(options),
+        buffer_(options.buffer),
+        matcher_(options.matcher),
+        optimiser_(options.optimiser) {
+    buffer_.setFusedPingObserver([this](const sss::subframe::FusedPing& fused) {
+      dr_per_ping_.push_back({fused.ping.utime_us, fused.T_world_body});
+    });
+    mosaic_factor_ = std::max(1, static_cast<int>(std::floor(options.pictures.mosaic_resolution_m /
+                                                              (2.0 * options.buffer.canonical.bin_size_m))));
+  }
+
+  void addNav(const NavInput& nav) {
+    ++summary_.nav_samples;
+    buffer_.addNav(nav, subframes_);
+    handleSubframes();
+  }
+  void addPing(PingInput ping) {
+    ++summary_.pings;
+    if (first_ping_us_ < 0) first_ping_us_ = ping.utime_us;
+    last_ping_us_ = std::max(last_ping_us_, ping.utime_us);
+    buffer_.addPing(std::move(ping), subframes_);
+    handleSubframes();
+  }
+
+  void finish() {
+    buffer_.finish(subframes_);
+    handleSubframes();
+    const double start = wallSeconds();
+    optimiser_.finish();
+    summary_.optimiser_s += wallSeconds() - start;
+    // One more association round with the smoothed poses (the paper's last iteration), then the
+    // final smoothing with whatever it found.
+    if (addOutcomes(timedMatch([&] { return matcher_.updateTrajectory(optimiser_.trajectory()); }))) {
+      const double again = wallSeconds();
+      optimiser_.finish();
+      summary_.optimiser_s += wallSeconds() - again;
+    }
+  }
+
+  void progress(double fraction, bool force) {
+    if (!request_.progress) return;
+    const double now = wallSeconds();
+    if (!force && now - last_progress_s_ < request_.progress_period_s) return;
+    last_progress_s_ = now;
+    const double elapsed = now - start_s_;
+    const double mission_s = first_ping_us_ >= 0 ? 1e-6 * static_cast<double>(last_ping_us_ - first_ping_us_) : 0.0;
+    const double eta = fraction > 0.01 ? elapsed * (1.0 - fraction) / fraction : 0.0;
+    std::fprintf(request_.progress,
+                 "sss-process: %5.1f %% | pings %llu | subframes %llu | closures %llu | mission %.0f s | %.1fx real time"
+                 " | ETA %.0f s\n",
+                 100.0 * fraction, static_cast<unsigned long long>(summary_.pings),
+                 static_cast<unsigned long long>(summary_.subframes),
+                 static_cast<unsigned long long>(summary_.matcher_closures), mission_s,
+                 elapsed > 0 ? mission_s / elapsed : 0.0, eta);
+    std::fflush(request_.progress);
+  }
+
+  bool writeOutputs(std::string& error);
+  OfflineSummary& summary() { return summary_; }
+  double startSeconds() const { return start_s_; }
+  double missionSeconds() const {
+    return first_ping_us_ >= 0 ? 1e-6 * static_cast<double>(last_ping_us_ - first_ping_us_) : 0.0;
+  }
+
+ private:
+  template <typename F>
+  std::vector<sss::matcher::PairOutcome> timedMatch(F&& call) {
+    const double start = wallSeconds();
+    auto outcomes = call();
+    summary_.matcher_s += wallSeconds() - start;
+    return outcomes;
+  }
+
+  // Closures into the optimiser; true when any was added.
+  bool addOutcomes(const std::vector<sss::matcher::PairOutcome>& outcomes) {
+    bool added = false;
+    for (const auto& outcome : outcomes) {
+      ++summary_.pairs_attempted;
+      if (!outcome.accepted) continue;
+      ++summary_.matcher_closures;
+      added = optimiser_.addLoopClosure(outcome.closure).ok || added;
+    }
+    return added;
+  }
+
+  void update() {
+    const double start = wallSeconds();
+    optimiser_.update();
+    summary_.optimiser_s += wallSeconds() - start;
+  }
+
+  // Each new subframe: node, matches, update; then the optimised poses go back to the matcher
+  // (re-association, new overlaps) and what that finds is optimised at once, as the live chain
+  // does asynchronously.
+  void handleSubframes() {
+    for (sss::subframe::Subframe& subframe : subframes_) {
+      ++summary_.subframes;
+      optimiser_.addSubframe(subframe);
+      if (request_.write_mosaics) mosaic_subframes_.push_back(decimateForMosaic(subframe, mosaic_factor_));
+      addOutcomes(timedMatch([&] { return matcher_.addSubframe(std::move(subframe)); }));
+      update();
+      if (addOutcomes(timedMatch([&] { return matcher_.updateTrajectory(optimiser_.trajectory()); }))) update();
+    }
+    subframes_.clear();
+  }
+
+  const OfflineRequest& request_;
+  Options options_;
+  sss::subframe::SubframeBuffer buffer_;
+  sss::matcher::MatcherEngine matcher_;
+  sss::optimiser::OptimiserEngine optimiser_;
+  std::vector<sss::subframe::Subframe> subframes_;  // reused
+  std::vector<sss::subframe::Subframe> mosaic_subframes_;
+  std::vector<sss::optimiser::StampedPose> dr_per_ping_;
+  int mosaic_factor_ = 1;
+  OfflineSummary summary_;
+  int64_t first_ping_us_ = -1;
+  int64_t last_ping_us_ = 0;
+  double start_s_ = wallSeconds();
+  double last_progress_s_ = 0.0;
+};
+
+bool Runner::writeOutputs(std::string& error) {
+  const std::string dir = request_.out_dir;
+  // Per-ping trajectories: DR as fused, SLAM = the correction at the ping time applied to it.
+  std::vector<sss::optimiser::StampedPose> slam;
+  slam.reserve(dr_per_ping_.size());
+  for (const auto& p : dr_per_ping_) {
+    slam.push_back({p.utime_us, optimiser_.correctionAt(p.utime_us).T_corrected_dr * p.T_world_body});
+  }
+  summary_.pings_with_pose = dr_per_ping_.size();
+  if (!writeTum(dir + "/dead_reckoning.tum", dr_per_ping_, "sss-process: dead reckoning at every ping", error)) return false;
+  if (!writeTum(dir + "/slam.tum", slam, "sss-process: SLAM-corrected pose at every ping", error)) return false;
+  if (!writeClosuresCsv(dir + "/loop_closures.csv", optimiser_, error)) return false;
+
+  const auto& counters = optimiser_.graph().counters();
+  summary_.closures_accepted = counters.closures_accepted;
+  summary_.closures_rejected = counters.closures_rejected_gate + counters.closures_rejected_inconsistent +
+                               counters.closures_rejected_no_support;
+  summary_.closures_superseded = counters.closures_superseded;
+
+  // Bathymetry: SLAM poses (the product) and DR poses (the baseline the map error is compared to).
+  const auto& bathymetry = options_.optimiser.bathymetry;
+  const std::vector<sss::optimiser::SeabedPoint> points = optimiser_.seabedPoints(false);
+  const std::vector<sss::optimiser::SeabedPoint> points_dr = optimiser_.seabedPoints(true);
+  summary_.seabed_points = points.size();
+  if (!sss::optimiser::writeSeabedPly(dir + "/bathymetry.ply", points, error)) return false;
+  if (!sss::optimiser::writeSeabedPly(dir + "/bathymetry_dr.ply", points_dr, error)) return false;
+  if (!points.empty() &&
+      !sss::optimiser::writeHeightmapFiles(dir + "/heightmap.yaml", sss::optimiser::gridSeabedPoints(points, bathymetry),
+                                           "sss-process: seabed re-triangulated with the SLAM poses", error)) {
+    return false;
+  }
+  if (!points_dr.empty() &&
+      !sss::optimiser::writeHeightmapFiles(dir + "/heightmap_dr.yaml",
+                                           sss::optimiser::gridSeabedPoints(points_dr, bathymetry),
+                                           "sss-process: seabed triangulated with the DR poses", error)) {
+    return false;
+  }
+
+  if (request_.write_mosaics && !mosaic_subframes_.empty()) {
+    std::map<int64_t, std::vector<Pose>> slam_poses;
+    for (const auto& s : mosaic_subframes_) {
+      std::vector<Pose>& poses = slam_poses[s.id];
+      for (const auto& ping : s.pings) {
+        poses.push_back(optimiser_.correctionAt(ping.utime_us).T_corrected_dr * ping.T_world_body);
+      }
+    }
+    if (!sss::subframe::writeMosaic(mosaic_subframes_, {}, dir + "/mosaic_dr.png", options_.pictures, error)) return false;
+    if (!sss::subframe::writeMosaic(mosaic_subframes_, slam_poses, dir + "/mosaic_slam.png", options_.pictures, error)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+OfflineResult runOffline(const OfflineRequest& request) {
+  OfflineResult result;
+  result.exit_code = 2;
+  const bool from_log = !request.lcm_log_path.empty();
+  if (from_log == !request.sonar_path.empty()) {
+    result.error = "give either a sonar file (--sonar) or an LCM log (--lcm-log)";
+    return result;
+  }
+  if (request.out_dir.empty()) {
+    result.error = "no output folder (--out)";
+    return result;
+  }
+  Options options;
+  if (!readOptions(request.config_path, options, result.error)) return result;
+  for (const std::string& path : {request.sonar_path, request.ins_path, request.lcm_log_path}) {
+    if (path.empty()) continue;
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec)) {
+      result.error = "cannot read " + path + ": no such file";
+      return result;
+    }
+  }
+  std::error_code ec;
+  fs::create_directories(request.out_dir, ec);
+  if (ec || !fs::is_directory(request.out_dir)) {
+    result.error = "cannot create the output folder " + request.out_dir + (ec ? ": " + ec.message() : "");
+    result.exit_code = 1;
+    return result;
+  }
+
+  Runner runner(request, options);
+  uint64_t faults = 0;
+  if (from_log) {
+    lcm::LogFile log(request.lcm_log_path, "r");
+    if (!log.good()) {
+      result.error = "cannot read the LCM log " + request.lcm_log_path;
+      return result;
+    }
+    const uint64_t size = fs::file_size(request.lcm_log_path, ec);
+    uint64_t events = 0;
+    for (const lcm::LogEvent* event = log.readNextEvent(); event; event = log.readNextEvent()) {
+      if (event->channel == request.nav_channel) {
+        sss_msgs::nav_t message;
+        if (message.decode(event->data, 0, event->datalen) < 0) {
+          ++faults;
+          continue;
+        }
+        runner.addNav(sss::subframe::fromNavMessage(message));
+      } else if (event->channel == request.ping_channel) {
+        sss_msgs::ping_t message;
+        if (message.decode(event->data, 0, event->datalen) < 0) {
+          ++faults;
+          continue;
+        }
+        runner.addPing(sss::subframe::fromPingMessage(message));
+      }
+      if (++events % 256 == 0 && size > 0) {
+        runner.progress(static_cast<double>(std::ftell(log.getFilePtr())) / static_cast<double>(size), false);
+      }
+    }
+    if (runner.summary().pings == 0) {
+      result.error = "the LCM log " + request.lcm_log_path + " has no " + request.ping_channel + " messages";
+      return result;
+    }
+  } else {
+    std::unique_ptr<PingSource> pings;
+    if (hasExtension(request.sonar_path, ".xtf")) {
+      auto xtf = std::make_unique<XtfSource>(request.sonar_path, options.xtf);
+      if (!xtf->reader().isOpen()) {
+        result.error = "cannot read " + request.sonar_path + ": " + xtf->reader().error();
+        return result;
+      }
+      pings = std::move(xtf);
+    } else if (hasExtension(request.sonar_path, ".jsf")) {
+      auto jsf = std::make_unique<JsfSource>(request.sonar_path, options.sonar);
+      if (!jsf->good()) {
+        result.error = "cannot read " + request.sonar_path;
+        return result;
+      }
+      pings = std::move(jsf);
+    } else {
+      result.error = "unknown sonar file type " + request.sonar_path + " (expected .jsf or .xtf)";
+      return result;
+    }
+    std::unique_ptr<InsFileSource> ins;
+    std::optional<EmbeddedNavigation> embedded;
+    if (!request.ins_path.empty()) {
+      ins = std::make_unique<InsFileSource>(request.ins_path, options.ins);
+      if (!ins->good()) {
+        result.error = "cannot read " + request.ins_path;
+        return result;
+      }
+    } else {
+      embedded.emplace(options.origin_latitude_deg, options.origin_longitude_deg);
+    }
+    // Merge by time: nav before a ping of the same time, so the ping finds its bracketing nav.
+    std::deque<sss::edgetech::DriverPing> ping_queue;
+    std::deque<NavInput> nav_queue;
+    bool pings_left = true, nav_left = ins != nullptr;
+    uint64_t without_nav = 0;
+    for (;;) {
+      while (pings_left && ping_queue.empty()) pings_left = pings->read(ping_queue);
+      while (nav_left && nav_queue.empty()) nav_left = ins->read(nav_queue);
+      if (ping_queue.empty() && nav_queue.empty()) break;
+      const bool nav_first =
+          !nav_queue.empty() && (ping_queue.empty() || nav_queue.front().utime_us <= ping_queue.front().utime_us);
+      if (nav_first) {
+        runner.addNav(nav_queue.front());
+        nav_queue.pop_front();
+        continue;
+      }
+      sss::edgetech::DriverPing ping = std::move(ping_queue.front());
+      ping_queue.pop_front();
+      if (embedded) {
+        if (auto nav = embedded->fromPing(ping)) {
+          runner.addNav(*nav);
+        } else {
+          ++without_nav;
+        }
+      }
+      // Through the SSS_PING message, exactly as the live chain does.
+      runner.addPing(sss::subframe::fromPingMessage(sss::edgetech::toPingMessage(ping)));
+      runner.progress(pings->fractionRead(), false);
+    }
+    faults += pings->faults() + (ins ? ins->faults() : 0);
+    if (runner.summary().pings == 0) {
+      result.error = "no usable pings in " + request.sonar_path;
+      return result;
+    }
+    if (embedded && without_nav == runner.summary().pings) {
+      result.error = request.sonar_path + " carries no navigation in its ping headers; give an INS file with --ins";
+      return result;
+    }
+  }
+  runner.progress(1.0, true);
+  runner.finish();
+  OfflineSummary& summary = runner.summary();
+  summary.input_faults = faults;
+  result.exit_code = 1;
+  if (!runner.writeOutputs(result.error)) return result;
+  summary.wall_s = wallSeconds() - runner.startSeconds();
+  summary.mission_s = runner.missionSeconds();
+  summary.real_time_factor = summary.wall_s > 0.0 ? summary.mission_s / summary.wall_s : 0.0;
+  summary.peak_rss_mib = peakRssMib();
+  result.summary = summary;
+  if (!writeSummaryJson(request.out_dir + "/summary.json", request, summary, result.error)) return result;
+  result.ok = true;
+  result.exit_code = 0;
+  return result;
+}
+
+}  // namespace sss::offline

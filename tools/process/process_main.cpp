@@ -1,0 +1,69 @@
+// sss-process: post-processes a survey offline with the live chain's libraries, deterministically.
+//   sss-process --sonar FILE.jsf|FILE.xtf [--ins FILE.nmea] [--config FILE] --out DIR
+//   sss-process --lcm-log FILE [--config FILE] --out DIR
+// Without --ins the navigation in the sonar file's ping headers is used. Exit 0 ok, 2 bad input.
+#include <cstdio>
+#include <cstring>
+#include <string>
+
+#include "tools/process/offline_runner.hpp"
+
+namespace {
+void usage(std::FILE* out) {
+  std::fprintf(out,
+               "usage: sss-process --sonar FILE.jsf|FILE.xtf [--ins FILE.nmea] [--config FILE] --out DIR [--quiet]\n"
+               "       sss-process --lcm-log FILE [--ping-channel C] [--nav-channel C] [--config FILE] --out DIR\n"
+               "                   [--no-mosaics] [--quiet]\n"
+               "Writes to DIR: dead_reckoning.tum, slam.tum (every ping, TUM, local NED of the mission origin),\n"
+               "loop_closures.csv, bathymetry.ply (+ bathymetry_dr.ply), heightmap.yaml/.png (+ heightmap_dr),\n"
+               "mosaic_dr.png, mosaic_slam.png (+ .yaml geo-references) and summary.json.\n");
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  sss::offline::OfflineRequest request;
+  request.progress = stderr;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    auto value = [&](std::string& target) {
+      if (i + 1 >= argc) return false;
+      target = argv[++i];
+      return true;
+    };
+    bool ok = true;
+    if (arg == "--sonar") ok = value(request.sonar_path);
+    else if (arg == "--ins") ok = value(request.ins_path);
+    else if (arg == "--lcm-log") ok = value(request.lcm_log_path);
+    else if (arg == "--config") ok = value(request.config_path);
+    else if (arg == "--out") ok = value(request.out_dir);
+    else if (arg == "--ping-channel") ok = value(request.ping_channel);
+    else if (arg == "--nav-channel") ok = value(request.nav_channel);
+    else if (arg == "--no-mosaics") request.write_mosaics = false;
+    else if (arg == "--quiet") request.progress = nullptr;
+    else if (arg == "--help" || arg == "-h") {
+      usage(stdout);
+      return 0;
+    } else {
+      ok = false;
+    }
+    if (!ok) {
+      std::fprintf(stderr, "sss-process: bad argument '%s'\n", arg.c_str());
+      usage(stderr);
+      return 2;
+    }
+  }
+  const sss::offline::OfflineResult result = sss::offline::runOffline(request);
+  if (!result.ok) {
+    std::fprintf(stderr, "sss-process: %s\n", result.error.c_str());
+    return result.exit_code;
+  }
+  const auto& s = result.summary;
+  std::printf("sss-process: %llu pings, %llu subframes, %llu pairs, %llu closures (%llu accepted, %llu rejected), "
+              "%llu seabed points; mission %.0f s in %.1f s (%.1fx real time), peak %.0f MiB -> %s\n",
+              static_cast<unsigned long long>(s.pings), static_cast<unsigned long long>(s.subframes),
+              static_cast<unsigned long long>(s.pairs_attempted), static_cast<unsigned long long>(s.matcher_closures),
+              static_cast<unsigned long long>(s.closures_accepted), static_cast<unsigned long long>(s.closures_rejected),
+              static_cast<unsigned long long>(s.seabed_points), s.mission_s, s.wall_s, s.real_time_factor, s.peak_rss_mib,
+              request.out_dir.c_str());
+  return 0;
+}
