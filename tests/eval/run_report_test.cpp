@@ -1,0 +1,287 @@
+// sss-report end to end: a short simulated mission and a run folder fabricated from it with known
+// errors (SLAM 0.1 m north of the truth, heightmaps 0.05 m and 0.3 m too deep, 3 + 1 closures) ->
+// exit code, files, metrics.json numbers, the verdict; missing required and optional inputs.
+#include "tools/eval/heightmap_metrics.hpp"
+#include "tools/eval/trajectory_io.hpp"
+#include "tools/sim/mission.hpp"
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#ifndef SSS_REPORT_PATH
+#error "SSS_REPORT_PATH must name the sss-report executable"
+#endif
+
+namespace sss::eval {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ProgramRun {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+std::string slurp(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+const std::vector<std::string> kFigures = {"trajectories.png",    "error_over_time.png",   "loop_closures.png",
+                                           "mosaics_dr_slam.png", "heightmap_slam.png",    "heightmap_error_dr.png",
+                                           "heightmap_error_slam.png"};
+
+class RunReport : public ::testing::Test {
+ protected:
+  // One mission for every test: 2 lines of 120 m (both long enough to count as survey lines),
+  // few samples; DR drift x10 so DR's error (metres) dwarfs the 0.1 m given to SLAM.
+  static void SetUpTestSuite() {
+    mission_dir_ = fs::temp_directory_path() / ("sss_run_report_mission_" + std::to_string(::getpid()));
+    fs::remove_all(mission_dir_);
+    sim::SimOptions options;
+    options.seed = 4;
+    options.trajectory.lines = 2;
+    options.trajectory.line_length_m = 120.0;
+    options.trajectory.line_spacing_m = 40.0;
+    options.sonar.samples_per_side = 500;
+    options.waterfall_bins_per_side = 250;
+    options.seabed.resolution_m = 0.3;
+    options.dead_reckoning.drift_scale = 10.0;
+    sim::MissionReport report;
+    std::string error;
+    ASSERT_TRUE(sim::writeMission(sim::Mission(options), mission_dir_.string(), report, error)) << error;
+  }
+  static void TearDownTestSuite() { fs::remove_all(mission_dir_); }
+
+  void SetUp() override {
+    ASSERT_TRUE(fs::exists(mission_dir_ / "ground_truth.tum"));
+    dir_ = fs::temp_directory_path() / ("sss_run_report_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(run_dir());
+    fabricateRun(0.1);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  fs::path run_dir() const { return dir_ / "run"; }
+  fs::path out_dir() const { return dir_ / "report"; }
+
+  // The run folder sss-process would write, with known errors.
+  void fabricateRun(double slam_north_offset_m) {
+    std::string error;
+    fs::copy_file(mission_dir_ / "dead_reckoning.tum", run_dir() / "dead_reckoning.tum", fs::copy_options::overwrite_existing);
+    const TumReadResult truth = readTum((mission_dir_ / "ground_truth.tum").string());
+    ASSERT_TRUE(truth.ok) << truth.error;
+    Trajectory slam = truth.poses;
+    for (StampedPose& p : slam) p.T_world_body.translation.x() += slam_north_offset_m;
+    ASSERT_TRUE(writeTum((run_dir() / "slam.tum").string(), slam, error)) << error;
+
+    // Heightmaps on every other seabed cell (cell centres coincide, so bilinear sampling is exact).
+    HeightmapRaster seabed;
+    ASSERT_TRUE(readHeightmap((mission_dir_ / "seabed.yaml").string(), seabed, error)) << error;
+    HeightmapRaster coarse;
+    coarse.rows = seabed.rows / 2;
+    coarse.cols = seabed.cols / 2;
+    coarse.resolution_m = 2.0 * seabed.resolution_m;
+    coarse.north_min_m = seabed.north_min_m;
+    coarse.east_min_m = seabed.east_min_m;
+    for (int r = 0; r < coarse.rows; ++r) {
+      for (int c = 0; c < coarse.cols; ++c) coarse.depth_m.push_back(seabed.at(2 * r, 2 * c));
+    }
+    for (const auto& [name, offset_m] : {std::pair{"heightmap", 0.05f}, std::pair{"heightmap_dr", 0.3f}}) {
+      HeightmapRaster estimate = coarse;
+      for (float& depth : estimate.depth_m) depth += offset_m;
+      ASSERT_TRUE(writeHeightmap((run_dir() / name).string(), estimate, error)) << error;
+    }
+    for (const char* name : {"mosaic_dr", "mosaic_slam"}) {
+      fs::copy_file(mission_dir_ / "mosaic.png", run_dir() / (std::string(name) + ".png"), fs::copy_options::overwrite_existing);
+      fs::copy_file(mission_dir_ / "mosaic.yaml", run_dir() / (std::string(name) + ".yaml"), fs::copy_options::overwrite_existing);
+    }
+
+    // Closures between subframe centres on the two lines (line 0 at east 0, line 1 at east 40).
+    std::ofstream csv(run_dir() / "loop_closures.csv");
+    csv << "# fabricated by run_report_test\n"
+           "subframe_id_a,subframe_id_b,utime_a_us,utime_b_us,round,status,rejection,dx_m,dy_m,dz_m,droll_rad,"
+           "dpitch_rad,dheading_rad,num_inliers,mean_zncc,north_a_m,east_a_m,north_b_m,east_b_m\n"
+           "0,3,1780300800000000,1780300900000000,0,accepted,none,0.1,0,0,0,0,0,900,0.6,25,0,95,40\n"
+           "1,2,1780300850000000,1780300870000000,0,accepted,none,0.1,0,0,0,0,0,800,0.6,75,0,45,40\n"
+           "1,3,1780300850000000,1780300900000000,1,accepted,none,0.1,0,0,0,0,0,700,0.6,75,0,95,40\n"
+           "0,2,1780300800000000,1780300870000000,0,rejected,chi_square_gate,3,0,0,0,0,0,90,0.3,25,0,45,40\n";
+    csv.close();
+    std::ofstream summary(run_dir() / "summary.json");
+    summary << "{\"pings\": " << truth.poses.size()
+            << ", \"subframes\": 4, \"pairs_attempted\": 6, \"closures_accepted\": 3, \"closures_rejected\": 1,\n"
+               " \"wall_s\": 12.5, \"mission_s\": 150.0, \"real_time_factor\": 12.0, \"peak_rss_mib\": 321.5}\n";
+  }
+
+  ProgramRun run(const std::string& arguments) const {
+    const std::string command = std::string(SSS_REPORT_PATH) + " " + arguments + " >" + (dir_ / "stdout.txt").string() +
+                                " 2>" + (dir_ / "stderr.txt").string();
+    const int status = std::system(command.c_str());
+    ProgramRun result;
+    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    result.out = slurp(dir_ / "stdout.txt");
+    result.err = slurp(dir_ / "stderr.txt");
+    return result;
+  }
+  ProgramRun report() const {
+    return run("--mission " + mission_dir_.string() + " --run " + run_dir().string() + " --out " + out_dir().string());
+  }
+
+  static fs::path mission_dir_;
+  fs::path dir_;
+};
+
+fs::path RunReport::mission_dir_;
+
+TEST_F(RunReport, WritesEveryFigureAndMetricsMatchTheKnownErrors) {
+  const ProgramRun result = report();
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("SLAM reduced the horizontal position error RMSE"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find((out_dir() / "index.html").string()), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("3 closures accepted, 1 rejected"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("real-time factor"), std::string::npos) << result.out;
+
+  const YAML::Node json = YAML::LoadFile((out_dir() / "metrics.json").string());  // JSON is YAML
+  EXPECT_EQ(json["schema"].as<std::string>(), "sss-report/1");
+  EXPECT_EQ(json["notes"].size(), 0u) << json["notes"];
+
+  // Every listed file exists; the PNGs decode and have a readable size.
+  std::set<std::string> listed;
+  for (const YAML::Node& file : json["files"]) {
+    const fs::path path = file.as<std::string>();
+    listed.insert(path.filename().string());
+    ASSERT_TRUE(fs::exists(path)) << path;
+    if (path.extension() != ".png") continue;
+    const cv::Mat image = cv::imread(path.string(), cv::IMREAD_UNCHANGED);
+    ASSERT_FALSE(image.empty()) << path;
+    EXPECT_GE(image.cols, 600) << path;
+    EXPECT_LE(image.cols, 1600) << path;
+    EXPECT_GE(image.rows, 300) << path;
+    EXPECT_LE(image.rows, 1600) << path;
+  }
+  for (const char* name : {"index.html", "report.md", "metrics.json"}) EXPECT_TRUE(listed.count(name)) << name;
+  const std::string html = slurp(out_dir() / "index.html");
+  const std::string markdown = slurp(out_dir() / "report.md");
+  for (const std::string& figure : kFigures) {
+    EXPECT_TRUE(listed.count(figure)) << figure;
+    EXPECT_NE(html.find("<img src=\"" + figure + "\""), std::string::npos) << figure;
+    EXPECT_NE(markdown.find("](" + figure + ")"), std::string::npos) << figure;
+  }
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+  EXPECT_EQ(html.find("http"), std::string::npos);  // no network
+
+  // SLAM is the truth shifted 0.1 m north: raw error 0.1 m everywhere, none after alignment.
+  const YAML::Node trajectory = json["trajectory"];
+  EXPECT_NEAR(trajectory["slam"]["ate_horizontal_m"]["rmse"].as<double>(), 0.1, 0.01);
+  EXPECT_NEAR(trajectory["slam"]["ate_horizontal_m"]["max"].as<double>(), 0.1, 0.01);
+  EXPECT_NEAR(trajectory["slam"]["ate_aligned_horizontal_m"]["rmse"].as<double>(), 0.0, 0.01);
+  const double dr_rmse = trajectory["dr"]["ate_horizontal_m"]["rmse"].as<double>();
+  EXPECT_GT(dr_rmse, 0.3);  // 10x the default drift over ~300 m
+  EXPECT_NEAR(trajectory["ate_horizontal_rmse_improvement_percent"].as<double>(),
+              100.0 * (dr_rmse - trajectory["slam"]["ate_horizontal_m"]["rmse"].as<double>()) / dr_rmse, 1e-6);
+  EXPECT_EQ(trajectory["lines"].size(), 2u);
+  EXPECT_EQ(trajectory["slam"]["lines"].size(), 2u);
+  EXPECT_DOUBLE_EQ(trajectory["rpe_window_m"].as<double>(), 100.0);
+  EXPECT_EQ(trajectory["slam"]["matched"].as<size_t>(), trajectory["truth_poses"].as<size_t>());
+
+  // Heightmaps: constant offsets, compared at cell centres of the seabed (float rounding only).
+  const YAML::Node heightmap = json["heightmap"];
+  EXPECT_NEAR(heightmap["slam"]["mae_m"].as<double>(), 0.05, 1e-4);
+  EXPECT_NEAR(heightmap["dr"]["mae_m"].as<double>(), 0.3, 1e-4);
+  EXPECT_NEAR(heightmap["slam"]["bias_m"].as<double>(), 0.05, 1e-4);
+  EXPECT_NEAR(heightmap["mae_improvement_percent"].as<double>(), 100.0 * (0.3 - 0.05) / 0.3, 0.05);
+
+  const YAML::Node closures = json["closures"];
+  EXPECT_EQ(closures["accepted"].as<int>(), 3);
+  EXPECT_EQ(closures["rejected"].as<int>(), 1);
+  EXPECT_EQ(closures["total"].as<int>(), 4);
+  EXPECT_EQ(closures["rejection_reasons"]["chi_square_gate"].as<int>(), 1);
+  EXPECT_DOUBLE_EQ(json["run"]["real_time_factor"].as<double>(), 12.0);
+  EXPECT_DOUBLE_EQ(json["run"]["peak_rss_mib"].as<double>(), 321.5);
+
+  EXPECT_EQ(json["outcome"].as<std::string>(), "better");
+  const std::string verdict = json["verdict"].as<std::string>();
+  EXPECT_EQ(verdict.rfind("SLAM reduced the horizontal position error RMSE from ", 0), 0u) << verdict;
+  EXPECT_NE(verdict.find("3 closures accepted, 1 rejected"), std::string::npos) << verdict;
+  EXPECT_NE(verdict.find("heightmap error (MAE) fell from 0.300 m to 0.050 m"), std::string::npos) << verdict;
+  EXPECT_NE(html.find(verdict.substr(0, 40)), std::string::npos);
+}
+
+TEST_F(RunReport, MissingSlamTrajectoryExitsTwoNamingTheFile) {
+  fs::remove(run_dir() / "slam.tum");
+  ProgramRun result = report();
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.err.find((run_dir() / "slam.tum").string() + ": missing"), std::string::npos) << result.err;
+  EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;  // one line
+  EXPECT_FALSE(fs::exists(out_dir() / "index.html"));
+
+  result = run("--mission " + (dir_ / "nowhere").string() + " --run " + run_dir().string() + " --out " +
+               out_dir().string());
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.err.find("nowhere"), std::string::npos) << result.err;
+  EXPECT_EQ(run("--mission " + mission_dir_.string() + " --out " + out_dir().string()).exit_code, 2);  // no --run
+  EXPECT_EQ(run("--help").exit_code, 0);
+}
+
+TEST_F(RunReport, MissingOptionalInputsLeaveTheirSectionsOutWithNotes) {
+  for (const char* name : {"heightmap.yaml", "heightmap_dr.yaml", "summary.json", "mosaic_slam.yaml"}) {
+    fs::remove(run_dir() / name);
+  }
+  {
+    std::ofstream bad(run_dir() / "loop_closures.csv", std::ios::app);
+    bad << "4,5,1,2,0,maybe,none,0,0,0,0,0,0,1,0.1,0,0,1,1\n";  // line 7: unknown status
+  }
+  const ProgramRun result = report();
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.err.find("note:"), std::string::npos) << result.err;
+  const YAML::Node json = YAML::LoadFile((out_dir() / "metrics.json").string());
+  EXPECT_TRUE(json["heightmap"].IsNull());
+  EXPECT_TRUE(json["closures"].IsNull());
+  EXPECT_TRUE(json["run"].IsNull());
+  std::string notes;
+  for (const YAML::Node& note : json["notes"]) notes += note.as<std::string>() + "\n";
+  EXPECT_NE(notes.find("no SLAM heightmap"), std::string::npos) << notes;
+  EXPECT_NE(notes.find("no DR heightmap"), std::string::npos) << notes;
+  EXPECT_NE(notes.find("summary.json"), std::string::npos) << notes;
+  EXPECT_NE(notes.find("mosaic_slam.yaml"), std::string::npos) << notes;
+  EXPECT_NE(notes.find((run_dir() / "loop_closures.csv").string() + ":7: status 'maybe'"), std::string::npos) << notes;
+  const std::string html = slurp(out_dir() / "index.html");
+  EXPECT_NE(html.find("no SLAM heightmap"), std::string::npos);
+  EXPECT_NE(html.find("trajectories.png"), std::string::npos);
+  EXPECT_NE(html.find("error_over_time.png"), std::string::npos);
+  for (const char* absent : {"loop_closures.png", "mosaics_dr_slam.png", "heightmap_slam.png", "heightmap_error_dr.png"}) {
+    EXPECT_EQ(html.find(absent), std::string::npos) << absent;
+    EXPECT_FALSE(fs::exists(out_dir() / absent)) << absent;
+  }
+  EXPECT_EQ(json["outcome"].as<std::string>(), "better");
+}
+
+TEST_F(RunReport, SaysPlainlyWhenSlamIsWorseThanDeadReckoning) {
+  fabricateRun(20.0);  // far beyond the DR drift
+  const ProgramRun result = report();
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const YAML::Node json = YAML::LoadFile((out_dir() / "metrics.json").string());
+  EXPECT_EQ(json["outcome"].as<std::string>(), "worse");
+  const std::string verdict = json["verdict"].as<std::string>();
+  EXPECT_EQ(verdict.rfind("SLAM is worse than dead reckoning", 0), 0u) << verdict;
+  EXPECT_LT(json["trajectory"]["ate_horizontal_rmse_improvement_percent"].as<double>(), 0.0);
+  EXPECT_NE(slurp(out_dir() / "index.html").find("class=\"verdict worse\""), std::string::npos);
+}
+
+}  // namespace
+}  // namespace sss::eval
