@@ -114,12 +114,12 @@ bool writeMosaic(const std::vector<Subframe>& subframes,
     sum.at<double>(row, col) += p.value;
     count.at<int>(row, col) += 1;
   }
-  cv::Mat image(rows, cols, CV_8UC3, cv::Scalar(60, 0, 0));
+  cv::Mat image(rows, cols, CV_8UC3, cv::Scalar(0, 0, 0));  // black = no data (data is 1..255)
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < cols; ++c) {
       const int n = count.at<int>(r, c);
       if (n == 0) continue;
-      const double v = std::clamp(sum.at<double>(r, c) / n / options.display_max_intensity, 0.0, 1.0) * 255.0;
+      const double v = 1.0 + std::clamp(sum.at<double>(r, c) / n / options.display_max_intensity, 0.0, 1.0) * 254.0;
       image.at<cv::Vec3b>(r, c) = cv::Vec3b(static_cast<uint8_t>(v), static_cast<uint8_t>(v), static_cast<uint8_t>(v));
     }
   }

@@ -24,7 +24,7 @@ std::vector<std::string> writeWaterfalls(const std::vector<Subframe>& subframes,
                                          const PictureOptions& options, std::string& error);
 
 // Writes a north-up mosaic: mean normalised intensity per cell of every valid pixel geo-referenced
-// with the given poses per subframe id (DR when a subframe has none there). Its geo-reference goes
+// with the given poses per subframe id (DR when a subframe has none there); black = no data. Its geo-reference goes
 // beside it as the same name with .yaml (keys resolution_m, north_max_m, east_min_m, rows, cols).
 bool writeMosaic(const std::vector<Subframe>& subframes,
                  const std::map<int64_t, std::vector<sss::core::Pose>>& poses_by_subframe, const std::string& path,

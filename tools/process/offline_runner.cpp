@@ -189,7 +189,7 @@ class InsFileSource {
   InsFileSource(const std::string& path, const sss::ins::InsBridgeOptions& options)
       : file_(path, std::ios::binary), bridge_(options) {}
   bool good() const { return file_.good(); }
-  bool read(std::deque<NavInput>& out) {
+  bool read(std::deque<sss_msgs::nav_t>& out) {
     if (finished_) return false;
     std::vector<char> chunk(256 * 1024);
     file_.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
@@ -204,8 +204,7 @@ class InsFileSource {
       bridge_.finish(0, samples);
       finished_ = true;
     }
-    // Through the SSS_NAV message, exactly as the live chain does.
-    for (const auto& sample : samples) out.push_back(sss::subframe::fromNavMessage(sss::ins::toNavMessage(sample)));
+    for (const auto& sample : samples) out.push_back(sss::ins::toNavMessage(sample));
     return !finished_ || !samples.empty();
   }
   uint64_t faults() const {
@@ -673,8 +672,31 @@ OfflineResult runOffline(const OfflineRequest& request) {
       embedded.emplace(options.origin_latitude_deg, options.origin_longitude_deg);
     }
     // Merge by time: nav before a ping of the same time, so the ping finds its bracketing nav.
+    // Everything goes through the SSS_PING and SSS_NAV messages, exactly as in the live chain.
+    std::unique_ptr<lcm::LogFile> recording;
+    if (!request.record_lcm_log_path.empty()) {
+      recording = std::make_unique<lcm::LogFile>(request.record_lcm_log_path, "w");
+      if (!recording->good()) {
+        result.error = "cannot write the LCM log " + request.record_lcm_log_path;
+        result.exit_code = 1;
+        return result;
+      }
+    }
+    int64_t event_number = 0;
+    auto record = [&](const std::string& channel, const auto& message, int64_t utime_us) {
+      if (!recording) return;
+      std::vector<uint8_t> bytes(static_cast<size_t>(message.getEncodedSize()));
+      message.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+      lcm::LogEvent event;
+      event.eventnum = event_number++;
+      event.timestamp = utime_us;
+      event.channel = channel;
+      event.datalen = static_cast<int32_t>(bytes.size());
+      event.data = bytes.data();
+      recording->writeEvent(&event);
+    };
     std::deque<sss::edgetech::DriverPing> ping_queue;
-    std::deque<NavInput> nav_queue;
+    std::deque<sss_msgs::nav_t> nav_queue;
     bool pings_left = true, nav_left = ins != nullptr;
     uint64_t without_nav = 0;
     for (;;) {
@@ -682,9 +704,10 @@ OfflineResult runOffline(const OfflineRequest& request) {
       while (nav_left && nav_queue.empty()) nav_left = ins->read(nav_queue);
       if (ping_queue.empty() && nav_queue.empty()) break;
       const bool nav_first =
-          !nav_queue.empty() && (ping_queue.empty() || nav_queue.front().utime_us <= ping_queue.front().utime_us);
+          !nav_queue.empty() && (ping_queue.empty() || nav_queue.front().utime <= ping_queue.front().utime_us);
       if (nav_first) {
-        runner.addNav(nav_queue.front());
+        record(request.nav_channel, nav_queue.front(), nav_queue.front().utime);
+        runner.addNav(sss::subframe::fromNavMessage(nav_queue.front()));
         nav_queue.pop_front();
         continue;
       }
@@ -697,8 +720,9 @@ OfflineResult runOffline(const OfflineRequest& request) {
           ++without_nav;
         }
       }
-      // Through the SSS_PING message, exactly as the live chain does.
-      runner.addPing(sss::subframe::fromPingMessage(sss::edgetech::toPingMessage(ping)));
+      const sss_msgs::ping_t message = sss::edgetech::toPingMessage(ping);
+      record(request.ping_channel, message, message.utime);
+      runner.addPing(sss::subframe::fromPingMessage(message));
       runner.progress(pings->fractionRead(), false);
     }
     faults += pings->faults() + (ins ? ins->faults() : 0);

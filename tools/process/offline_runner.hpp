@@ -21,6 +21,10 @@ struct OfflineRequest {
   std::string config_path;   // deployment YAML (sections mission, sonar_driver, ins_bridge,
                              // subframe_buffer, matcher, optimiser); empty: defaults
   std::string out_dir;
+  // Non-empty (sonar file input): also write the SSS_PING and SSS_NAV messages fed to the chain
+  // into this LCM log, for lcm-logplayer into the live chain or a later --lcm-log run. Messages
+  // made from the sonar's embedded navigation are not in it (give --ins for a complete log).
+  std::string record_lcm_log_path;
   bool write_mosaics = true;
   std::FILE* progress = nullptr;  // progress lines every progress_period_s of wall time; null: quiet
   double progress_period_s = 2.0;
