@@ -405,6 +405,16 @@ int main(int argc, char** argv) {
     shared.wake.notify_one();
   });
 
+  // A restored graph: its trajectory and counters go out at once (the matcher re-associates with
+  // them), not only after the next update.
+  if (engine.graph().numNodes() > 0) {
+    std::lock_guard<std::mutex> lock(shared.mutex);
+    shared.trajectory = engine.trajectory();
+    shared.graph_counters = engine.graph().counters();
+    shared.engine_counters = engine.counters();
+    shared.memory_bytes = engine.memoryBytes();
+    notifyLoop();
+  }
   const int exit_code = loop.run();
   {
     std::lock_guard<std::mutex> lock(shared.mutex);
