@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace sss::optimiser {
 
@@ -28,6 +29,26 @@ std::vector<std::string> validateOptimiserEngineOptions(const OptimiserEngineOpt
   if (options.max_pending_closures < 0) errors.push_back("max_pending_closures must be >= 0");
   if (options.max_stored_subframes < 1) errors.push_back("max_stored_subframes must be >= 1");
   return errors;
+}
+
+bool writeTum(const std::string& path, const std::vector<StampedPose>& poses, const std::string& comment,
+              std::string& error) {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) {
+    error = "cannot write " + path;
+    return false;
+  }
+  std::fprintf(f, "# %s\n# timestamp_s north_m east_m down_m qx qy qz qw (T_world_body, local NED of the mission origin)\n",
+               comment.c_str());
+  for (const StampedPose& p : poses) {
+    const auto& q = p.T_world_body.rotation;
+    const auto& t = p.T_world_body.translation;
+    std::fprintf(f, "%lld.%06lld %.4f %.4f %.4f %.9f %.9f %.9f %.9f\n", static_cast<long long>(p.utime_us / 1000000),
+                 static_cast<long long>(p.utime_us % 1000000), t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+  }
+  const bool ok = std::fclose(f) == 0;
+  if (!ok) error = "cannot write " + path;
+  return ok;
 }
 
 OptimiserEngine::OptimiserEngine(const OptimiserEngineOptions& options) : options_(options), graph_(options.graph) {}

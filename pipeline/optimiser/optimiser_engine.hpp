@@ -51,6 +51,10 @@ struct StampedPose {
   sss::core::Pose T_world_body;
 };
 
+// Writes poses as TUM (timestamp_s north east down qx qy qz qw, local NED) with a comment line.
+bool writeTum(const std::string& path, const std::vector<StampedPose>& poses, const std::string& comment,
+              std::string& error);
+
 // One closure for the loop_closures.csv table: the graph's record and the two centres under the
 // current estimate.
 struct ClosureSummary {

@@ -89,19 +89,11 @@ bool writeProducts(OptimiserEngine& engine, const std::string& directory, std::v
   fs::create_directories(directory, ec);
   std::string error;
   const auto trajectory = engine.pingTrajectory(true);
-  std::FILE* f = std::fopen((directory + "/slam.tum").c_str(), "w");
-  if (!f) {
-    messages.push_back("cannot write " + directory + "/slam.tum");
+  if (!sss::optimiser::writeTum(directory + "/slam.tum", trajectory,
+                                "sss-optimiser: optimised pose of every ping of the subframes", error)) {
+    messages.push_back(error);
     return false;
   }
-  std::fprintf(f, "# sss-optimiser: optimised pose of every ping of the subframes (TUM, local NED)\n");
-  for (const auto& p : trajectory) {
-    const auto& q = p.T_world_body.rotation;
-    const auto& t = p.T_world_body.translation;
-    std::fprintf(f, "%lld.%06lld %.4f %.4f %.4f %.9f %.9f %.9f %.9f\n", static_cast<long long>(p.utime_us / 1000000),
-                 static_cast<long long>(p.utime_us % 1000000), t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
-  }
-  std::fclose(f);
   const auto points = engine.seabedPoints(false);
   bool ok = sss::optimiser::writeSeabedPly(directory + "/bathymetry.ply", points, error);
   if (ok && !points.empty()) {

@@ -249,26 +249,6 @@ class EmbeddedNavigation {
 
 // ---- outputs -----------------------------------------------------------------------------------
 
-bool writeTum(const std::string& path, const std::vector<sss::optimiser::StampedPose>& poses, const std::string& comment,
-              std::string& error) {
-  std::FILE* f = std::fopen(path.c_str(), "w");
-  if (!f) {
-    error = "cannot write " + path;
-    return false;
-  }
-  std::fprintf(f, "# %s\n# timestamp_s north_m east_m down_m qx qy qz qw (T_world_body, local NED of the mission origin)\n",
-               comment.c_str());
-  for (const auto& p : poses) {
-    const auto& q = p.T_world_body.rotation;
-    const auto& t = p.T_world_body.translation;
-    std::fprintf(f, "%lld.%06lld %.4f %.4f %.4f %.9f %.9f %.9f %.9f\n", static_cast<long long>(p.utime_us / 1000000),
-                 static_cast<long long>(p.utime_us % 1000000), t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
-  }
-  const bool ok = std::fclose(f) == 0;
-  if (!ok) error = "cannot write " + path;
-  return ok;
-}
-
 const char* statusName(sss::optimiser::ClosureStatus status) {
   switch (status) {
     case sss::optimiser::ClosureStatus::kAccepted: return "accepted";
@@ -529,8 +509,8 @@ bool Runner::writeOutputs(std::string& error) {
     slam.push_back({p.utime_us, optimiser_.correctionAt(p.utime_us).T_corrected_dr * p.T_world_body});
   }
   summary_.pings_with_pose = dr_per_ping_.size();
-  if (!writeTum(dir + "/dead_reckoning.tum", dr_per_ping_, "sss-process: dead reckoning at every ping", error)) return false;
-  if (!writeTum(dir + "/slam.tum", slam, "sss-process: SLAM-corrected pose at every ping", error)) return false;
+  if (!sss::optimiser::writeTum(dir + "/dead_reckoning.tum", dr_per_ping_, "sss-process: dead reckoning at every ping", error)) return false;
+  if (!sss::optimiser::writeTum(dir + "/slam.tum", slam, "sss-process: SLAM-corrected pose at every ping", error)) return false;
   if (!writeClosuresCsv(dir + "/loop_closures.csv", optimiser_, error)) return false;
 
   const auto& counters = optimiser_.graph().counters();
