@@ -147,6 +147,7 @@ int main(int argc, char** argv) {
   }
 
   options.process.process_name = "sss-sonar-driver";
+  std::string config_problems;  // empty: valid (or no file: the defaults)
   if (!config_path.empty()) {
     sss::core::Config config = sss::core::Config::fromFile(config_path);
     sss::core::ConfigSection section = config.section("sonar_driver");
@@ -162,14 +163,10 @@ int main(int argc, char** argv) {
     if (!speed_given) section.optional("replay_speed", options.replay_speed, {sss::core::inRange(0.0, 1000.0)});
     section.optional("xtf_pair_index", options.xtf_pair_index, {sss::core::inRange(0, 7)});
     section.rejectUnknownKeys();
-    if (!config.ok()) {
-      std::fprintf(stderr, "sss-sonar-driver: invalid configuration:\n%s", config.problemReport().c_str());
-      return 2;
-    }
+    config_problems = config.problemReport();
   }
-  if (check_config_only) {
-    std::printf("%s: configuration '%s' is valid\n", "sss-sonar-driver", config_path.c_str());
-    return 0;
+  if (const int code = sss::transport::configVerdict("sss-sonar-driver", config_problems, config_path, check_config_only); code >= 0) {
+    return code;
   }
   if (!lcm_url_override.empty()) options.process.lcm_url = lcm_url_override;
   // A file carries the sonar's own clock; there is no arrival time to compare it with.

@@ -111,6 +111,7 @@ int main(int argc, char** argv) {
     }
   }
   options.process.process_name = "sss-ins-bridge";
+  std::string config_problems;  // empty: valid (or no file: the defaults)
   if (!config_path.empty()) {
     using namespace sss::core;
     Config config = Config::fromFile(config_path);
@@ -136,14 +137,10 @@ int main(int argc, char** argv) {
     if (!speed_given) section.optional("replay_speed", options.replay_speed, {inRange(0.0, 1000.0)});
     section.optional("nav_channel", options.nav_channel, {nonEmpty()});
     section.rejectUnknownKeys();
-    if (!config.ok()) {
-      std::fprintf(stderr, "sss-ins-bridge: invalid configuration:\n%s", config.problemReport().c_str());
-      return 2;
-    }
+    config_problems = config.problemReport();
   }
-  if (check_config_only) {
-    std::printf("%s: configuration '%s' is valid\n", "sss-ins-bridge", config_path.c_str());
-    return 0;
+  if (const int code = sss::transport::configVerdict("sss-ins-bridge", config_problems, config_path, check_config_only); code >= 0) {
+    return code;
   }
   if (!lcm_url_override.empty()) options.process.lcm_url = lcm_url_override;
 

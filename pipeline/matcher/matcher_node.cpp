@@ -64,6 +64,7 @@ int main(int argc, char** argv) {
   const std::string& config_path = arguments.config_path;
   NodeOptions options;
   options.process.process_name = "sss-matcher";
+  std::string config_problems;  // empty: valid (or no file: the defaults)
   if (!config_path.empty()) {
     using namespace sss::core;
     Config config = Config::fromFile(config_path);
@@ -78,14 +79,10 @@ int main(int argc, char** argv) {
     for (const std::string& problem : sss::matcher::validateMatcherEngineOptions(options.engine)) {
       section.addProblem("matcher", "", problem);
     }
-    if (!config.ok()) {
-      std::fprintf(stderr, "sss-matcher: invalid configuration:\n%s", config.problemReport().c_str());
-      return 2;
-    }
+    config_problems = config.problemReport();
   }
-  if (arguments.check_config_only) {
-    std::printf("sss-matcher: configuration '%s' is valid\n", config_path.c_str());
-    return 0;
+  if (const int code = sss::transport::configVerdict("sss-matcher", config_problems, config_path, arguments.check_config_only); code >= 0) {
+    return code;
   }
   if (!arguments.lcm_url_override.empty()) options.process.lcm_url = arguments.lcm_url_override;
 

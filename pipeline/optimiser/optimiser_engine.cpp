@@ -4,10 +4,16 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <set>
 
 namespace sss::optimiser {
 
 using sss::core::Pose;
+
+namespace {
+// A subframe pair in either order: (older id, newer id).
+std::pair<int64_t, int64_t> pairKey(int64_t a, int64_t b) { return {std::min(a, b), std::max(a, b)}; }
+}  // namespace
 
 void readOptimiserEngineOptions(sss::core::ConfigSection& section, OptimiserEngineOptions& options) {
   using sss::core::inRange;
@@ -92,7 +98,6 @@ Status OptimiserEngine::addSubframe(const sss::subframe::Subframe& subframe) {
     }
   }
   waiting_ = std::move(still_waiting);
-  counters_.closures_waiting = waiting_.size();
   return Status::success();
 }
 
@@ -106,7 +111,6 @@ Status OptimiserEngine::addLoopClosure(const sss::matcher::LoopClosure& closure)
       waiting_.pop_front();
       ++counters_.closures_refused;
     }
-    counters_.closures_waiting = waiting_.size();
     return Status::success();
   }
   return addToGraph(closure);
@@ -128,8 +132,7 @@ Status OptimiserEngine::addToGraph(const sss::matcher::LoopClosure& closure) {
   }
   new_input_ = true;
   // The correspondences of the newest association round of the pair, thinned evenly.
-  const auto key = std::make_pair(std::min(closure.subframe_id_a, closure.subframe_id_b),
-                                  std::max(closure.subframe_id_a, closure.subframe_id_b));
+  const auto key = pairKey(closure.subframe_id_a, closure.subframe_id_b);
   auto existing = correspondences_.find(key);
   if (existing != correspondences_.end() && existing->second.association_round > closure.association_round) {
     return added;
@@ -171,7 +174,6 @@ UpdateReport OptimiserEngine::finish() {
   // Closures still waiting can no longer be resolved.
   counters_.closures_refused += waiting_.size();
   waiting_.clear();
-  counters_.closures_waiting = 0;
   graph_.optimize();
   return graph_.fullSmoothing();
 }
@@ -211,11 +213,10 @@ Pose OptimiserEngine::subframeCorrection(int64_t id, const StoredSubframe& store
 
 std::vector<SeabedPoint> OptimiserEngine::seabedPoints(bool use_dr) const {
   // Accepted closures only: a rejected one may pair unrelated seabed.
-  std::map<std::pair<int64_t, int64_t>, bool> accepted;
+  std::set<std::pair<int64_t, int64_t>> accepted;
   for (const ClosureRecord& record : graph_.closures()) {
     if (record.status != ClosureStatus::kAccepted) continue;
-    accepted[{std::min(record.closure.subframe_id_a, record.closure.subframe_id_b),
-              std::max(record.closure.subframe_id_a, record.closure.subframe_id_b)}] = true;
+    accepted.insert(pairKey(record.closure.subframe_id_a, record.closure.subframe_id_b));
   }
   std::vector<SeabedPoint> points;
   for (const auto& [key, stored] : correspondences_) {
@@ -258,8 +259,7 @@ std::vector<ClosureSummary> OptimiserEngine::closureSummaries() const {
     summary.record = record;
     if (auto a = graph_.estimate(record.closure.subframe_id_a)) summary.centre_a_ned_m = a->translation;
     if (auto b = graph_.estimate(record.closure.subframe_id_b)) summary.centre_b_ned_m = b->translation;
-    const auto key = std::make_pair(std::min(record.closure.subframe_id_a, record.closure.subframe_id_b),
-                                    std::max(record.closure.subframe_id_a, record.closure.subframe_id_b));
+    const auto key = pairKey(record.closure.subframe_id_a, record.closure.subframe_id_b);
     if (auto found = correspondences_.find(key); found != correspondences_.end()) summary.mean_zncc = found->second.mean_zncc;
     out.push_back(summary);
   }

@@ -41,7 +41,7 @@ struct OptimiserEngineCounters {
   uint64_t subframes_refused = 0;      // malformed, duplicate or out of order
   uint64_t closures_in = 0;
   uint64_t closures_refused = 0;       // refused by the graph (see its counters) or never resolved
-  uint64_t closures_waiting = 0;       // now waiting for their subframe
+  uint64_t closures_waiting = 0;       // now waiting for their subframe (filled by counters())
   uint64_t subframes_forgotten = 0;    // ping poses dropped beyond max_stored_subframes
 };
 
@@ -101,7 +101,11 @@ class OptimiserEngine {
   // are not in it: after a restart, the products cover the subframes seen since.
   Status saveCheckpoint(const std::string& path) const { return graph_.saveCheckpoint(path); }
   Status loadCheckpoint(const std::string& path);
-  const OptimiserEngineCounters& counters() const { return counters_; }
+  OptimiserEngineCounters counters() const {
+    OptimiserEngineCounters counters = counters_;
+    counters.closures_waiting = waiting_.size();
+    return counters;
+  }
   const OptimiserEngineOptions& options() const { return options_; }
   size_t memoryBytes() const;
 

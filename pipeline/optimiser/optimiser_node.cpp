@@ -115,6 +115,7 @@ int main(int argc, char** argv) {
   const std::string& config_path = arguments.config_path;
   NodeOptions options;
   options.process.process_name = "sss-optimiser";
+  std::string config_problems;  // empty: valid (or no file: the defaults)
   if (!config_path.empty()) {
     using namespace sss::core;
     Config config = Config::fromFile(config_path);
@@ -144,14 +145,10 @@ int main(int argc, char** argv) {
     for (const std::string& problem : sss::optimiser::validateOptimiserEngineOptions(options.engine)) {
       section.addProblem("optimiser", "", problem);
     }
-    if (!config.ok()) {
-      std::fprintf(stderr, "sss-optimiser: invalid configuration:\n%s", config.problemReport().c_str());
-      return 2;
-    }
+    config_problems = config.problemReport();
   }
-  if (arguments.check_config_only) {
-    std::printf("sss-optimiser: configuration '%s' is valid\n", config_path.c_str());
-    return 0;
+  if (const int code = sss::transport::configVerdict("sss-optimiser", config_problems, config_path, arguments.check_config_only); code >= 0) {
+    return code;
   }
   if (!arguments.lcm_url_override.empty()) options.process.lcm_url = arguments.lcm_url_override;
   if (options.state_directory.empty()) {
@@ -304,7 +301,7 @@ int main(int argc, char** argv) {
     }
     const auto graph = snapshot();
     const sss::optimiser::Correction correction = graph->correctionAt(nav.utime_us);
-    const auto dr = sss::optimiser::drPoseOf(nav.position_ned_m, nav.roll_rad, nav.pitch_rad, nav.heading_rad);
+    const auto dr = sss::subframe::poseOf(nav);
     const sss_msgs::pose_t pose = sss::optimiser::toPoseMessage(nav.utime_us, dr, correction, plane);
     loop.bus().publish(options.pose_channel, pose, arrival);
     if (writer) pending_dds = sss::optimiser::toDdsCorrection(pose, static_cast<uint32_t>(options.vehicle_id),

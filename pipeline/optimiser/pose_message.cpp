@@ -7,10 +7,6 @@ namespace sss::optimiser {
 
 using sss::core::Pose;
 
-Pose drPoseOf(const Eigen::Vector3d& position_ned_m, double roll_rad, double pitch_rad, double heading_rad) {
-  return Pose(sss::core::quaternionFromEuler(roll_rad, pitch_rad, heading_rad), position_ned_m);
-}
-
 sss_msgs::pose_t toPoseMessage(int64_t utime_us, const Pose& T_world_body_dr, const Correction& correction,
                                const sss::core::LocalTangentPlane& plane) {
   sss_msgs::pose_t message{};

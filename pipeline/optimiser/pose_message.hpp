@@ -12,9 +12,6 @@
 
 namespace sss::optimiser {
 
-// The DR pose of an SSS_NAV sample: T_world_body from its local NED position and attitude.
-sss::core::Pose drPoseOf(const Eigen::Vector3d& position_ned_m, double roll_rad, double pitch_rad, double heading_rad);
-
 // corrected = correction.T_corrected_dr * T_world_body_dr, for the nav sample at utime_us.
 sss_msgs::pose_t toPoseMessage(int64_t utime_us, const sss::core::Pose& T_world_body_dr, const Correction& correction,
                                const sss::core::LocalTangentPlane& plane);

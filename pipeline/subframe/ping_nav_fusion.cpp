@@ -14,6 +14,10 @@ sss::core::Pose PingNavFusionOptions::T_body_sonar() const {
               sonar_position_body_m);
 }
 
+Pose poseOf(const NavInput& nav) {
+  return Pose(sss::core::quaternionFromEuler(nav.roll_rad, nav.pitch_rad, nav.heading_rad), nav.position_ned_m);
+}
+
 void readPingNavFusionOptions(sss::core::ConfigSection& section, PingNavFusionOptions& options) {
   using namespace sss::core;
   std::vector<double> lever{options.sonar_position_body_m.x(), options.sonar_position_body_m.y(),
@@ -116,8 +120,8 @@ bool PingNavFusion::resolve(PingInput&& ping, std::vector<FusedPing>& out) {
     return false;
   }
   const double alpha = b == a ? 0.0 : static_cast<double>(t - a->utime_us) / static_cast<double>(b->utime_us - a->utime_us);
-  const Pose pose_a(sss::core::quaternionFromEuler(a->roll_rad, a->pitch_rad, a->heading_rad), a->position_ned_m);
-  const Pose pose_b(sss::core::quaternionFromEuler(b->roll_rad, b->pitch_rad, b->heading_rad), b->position_ned_m);
+  const Pose pose_a = poseOf(*a);
+  const Pose pose_b = poseOf(*b);
 
   FusedPing fused;
   fused.T_world_body = sss::core::interpolate(pose_a, pose_b, alpha);  // slerp for attitude

@@ -24,6 +24,9 @@ struct NavInput {
   double distance_travelled_m = 0.0;
 };
 
+// The DR pose of a nav sample: T_world_body from its local NED position and attitude.
+sss::core::Pose poseOf(const NavInput& nav);
+
 // One side-scan ping (SSS_PING without the middleware).
 struct PingInput {
   int64_t utime_us = 0;

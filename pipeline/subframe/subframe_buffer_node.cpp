@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
   const std::string& config_path = arguments.config_path;
   NodeOptions options;
   options.process.process_name = "sss-subframe-buffer";
+  std::string config_problems;  // empty: valid (or no file: the defaults)
   if (!config_path.empty()) {
     using namespace sss::core;
     Config config = Config::fromFile(config_path);
@@ -53,14 +54,10 @@ int main(int argc, char** argv) {
     section.optional("vertical_beam_width_rad", options.vertical_beam_width_rad, {inRange(0.0, 3.2)});
     section.optional("idle_flush_s", options.idle_flush_s, {inRange(0.1, 3600.0)});
     section.rejectUnknownKeys();
-    if (!config.ok()) {
-      std::fprintf(stderr, "sss-subframe-buffer: invalid configuration:\n%s", config.problemReport().c_str());
-      return 2;
-    }
+    config_problems = config.problemReport();
   }
-  if (arguments.check_config_only) {
-    std::printf("sss-subframe-buffer: configuration '%s' is valid\n", config_path.c_str());
-    return 0;
+  if (const int code = sss::transport::configVerdict("sss-subframe-buffer", config_problems, config_path, arguments.check_config_only); code >= 0) {
+    return code;
   }
   if (!arguments.lcm_url_override.empty()) options.process.lcm_url = arguments.lcm_url_override;
 

@@ -37,4 +37,17 @@ int parseNodeArguments(int argc, char** argv, NodeArguments& arguments) {
   return -1;
 }
 
+int configVerdict(const std::string& process_name, const std::string& problems, const std::string& config_path,
+                  bool check_config_only) {
+  if (!problems.empty()) {
+    std::fprintf(stderr, "%s: invalid configuration:\n%s", process_name.c_str(), problems.c_str());
+    return 2;
+  }
+  if (check_config_only) {
+    std::printf("%s: configuration '%s' is valid\n", process_name.c_str(), config_path.c_str());
+    return 0;
+  }
+  return -1;
+}
+
 }  // namespace sss::transport

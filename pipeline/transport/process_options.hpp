@@ -34,4 +34,10 @@ struct NodeArguments {
 // -1 to go on; otherwise the exit code to return (usage printed: 0 for --help, 2 for bad flags).
 int parseNodeArguments(int argc, char** argv, NodeArguments& arguments);
 
+// The end of every process's configuration step. problems: Config::problemReport() (empty when
+// valid). Prints them and returns 2 when there are any; with --check-config says the file is valid
+// and returns 0; otherwise -1 (go on and run).
+int configVerdict(const std::string& process_name, const std::string& problems, const std::string& config_path,
+                  bool check_config_only);
+
 }  // namespace sss::transport

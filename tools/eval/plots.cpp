@@ -121,14 +121,8 @@ struct LegendEntry {
   bool dashed = false;
 };
 
-// Legend box in the corner of `area` with the fewest data points under it.
-void drawLegend(cv::Mat& image, const cv::Rect& area, const std::vector<LegendEntry>& entries,
-                const std::vector<cv::Point2d>& data_points) {
-  if (entries.empty()) return;
-  int width = 0;
-  for (const LegendEntry& e : entries) width = std::max(width, textSize(e.label).width);
-  const int line_height = 20;
-  const cv::Size box(width + 54, static_cast<int>(entries.size()) * line_height + 10);
+// The box placed 8 px inside one corner of area: the corner with the fewest points under it.
+cv::Rect emptiestCorner(const cv::Rect& area, const cv::Size& box, const std::vector<cv::Point2d>& points) {
   const std::array<cv::Point, 4> corners = {
       cv::Point(area.x + 8, area.y + 8), cv::Point(area.x + area.width - box.width - 8, area.y + 8),
       cv::Point(area.x + 8, area.y + area.height - box.height - 8),
@@ -137,13 +131,24 @@ void drawLegend(cv::Mat& image, const cv::Rect& area, const std::vector<LegendEn
   for (size_t k = 0; k < corners.size(); ++k) {
     const cv::Rect rect(corners[k], box);
     size_t count = 0;
-    for (const cv::Point2d& p : data_points) count += rect.contains(cv::Point(static_cast<int>(p.x), static_cast<int>(p.y)));
+    for (const cv::Point2d& p : points) count += rect.contains(cv::Point(static_cast<int>(p.x), static_cast<int>(p.y)));
     if (count < best_count) {
       best_count = count;
       best = k;
     }
   }
-  const cv::Rect rect(corners[best], box);
+  return cv::Rect(corners[best], box);
+}
+
+// Legend box in the corner of `area` with the fewest data points under it.
+void drawLegend(cv::Mat& image, const cv::Rect& area, const std::vector<LegendEntry>& entries,
+                const std::vector<cv::Point2d>& data_points) {
+  if (entries.empty()) return;
+  int width = 0;
+  for (const LegendEntry& e : entries) width = std::max(width, textSize(e.label).width);
+  const int line_height = 20;
+  const cv::Size box(width + 54, static_cast<int>(entries.size()) * line_height + 10);
+  const cv::Rect rect = emptiestCorner(area, box, data_points);
   cv::rectangle(image, rect, kWhite, cv::FILLED);
   cv::rectangle(image, rect, kAxis, 1);
   for (size_t i = 0; i < entries.size(); ++i) {
@@ -612,21 +617,7 @@ void drawMapLegend(cv::Mat& image, const cv::Rect& area, const std::vector<MapLe
   for (const MapLegendEntry& e : entries) width = std::max(width, textSize(e.label).width);
   const int line_height = 22;
   const cv::Size box(width + 60, static_cast<int>(entries.size()) * line_height + 10);
-  const std::array<cv::Point, 4> corners = {
-      cv::Point(area.x + 8, area.y + 8), cv::Point(area.x + area.width - box.width - 8, area.y + 8),
-      cv::Point(area.x + 8, area.y + area.height - box.height - 8),
-      cv::Point(area.x + area.width - box.width - 8, area.y + area.height - box.height - 8)};
-  size_t best = 0, best_count = SIZE_MAX;
-  for (size_t k = 0; k < corners.size(); ++k) {
-    const cv::Rect rect(corners[k], box);
-    size_t count = 0;
-    for (const cv::Point2d& p : points) count += rect.contains(cv::Point(static_cast<int>(p.x), static_cast<int>(p.y)));
-    if (count < best_count) {
-      best_count = count;
-      best = k;
-    }
-  }
-  const cv::Rect rect(corners[best], box);
+  const cv::Rect rect = emptiestCorner(area, box, points);
   cv::rectangle(image, rect, kWhite, cv::FILLED);
   cv::rectangle(image, rect, kAxis, 1);
   for (size_t i = 0; i < entries.size(); ++i) {

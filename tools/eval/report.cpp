@@ -18,42 +18,12 @@ std::string defaultLabel(const EvalInput& input) {
   return std::filesystem::path(input.path).stem().string();
 }
 
-void writeStats(JsonWriter& json, const std::string& key, const ErrorStatistics& stats) {
-  json.key(key).beginObject();
-  json.key("count").value(static_cast<uint64_t>(stats.count));
-  json.key("rmse").value(stats.rmse);
-  json.key("mean").value(stats.mean);
-  json.key("median").value(stats.median);
-  json.key("max").value(stats.max);
-  json.endObject();
-}
-
 // printf-style cell: fixed decimals, "-" for NaN.
 std::string cell(double value, int decimals) {
   if (!std::isfinite(value)) return "-";
   char text[48];
   std::snprintf(text, sizeof text, "%.*f", decimals, value);
   return text;
-}
-
-// Renders rows of cells as columns: first column left-aligned, others right-aligned.
-std::string columns(const std::vector<std::vector<std::string>>& rows) {
-  std::vector<size_t> width;
-  for (const auto& row : rows) {
-    if (width.size() < row.size()) width.resize(row.size(), 0);
-    for (size_t c = 0; c < row.size(); ++c) width[c] = std::max(width[c], row[c].size());
-  }
-  std::string out;
-  for (const auto& row : rows) {
-    std::string line;
-    for (size_t c = 0; c < row.size(); ++c) {
-      const std::string padding(width[c] - row[c].size(), ' ');
-      line += c == 0 ? row[c] + padding : "  " + padding + row[c];
-    }
-    while (!line.empty() && line.back() == ' ') line.pop_back();
-    out += line + "\n";
-  }
-  return out;
 }
 
 size_t tableRpeIndex(const EvalReport& report) {
@@ -238,7 +208,7 @@ std::string formatTable(const EvalReport& report) {
                       rpe ? cell(rpe->translation_percent.mean, 3) : "-", rpe ? cell(rpe->rotation_deg.mean, 3) : "-",
                       std::isfinite(e.improvement_vs_first_percent) ? cell(e.improvement_vs_first_percent, 1) : "-"});
     }
-    out << "\n" << columns(rows);
+    out << "\n" << formatColumns(rows);
     if (!report.lines.empty()) {
       out << "\nhorizontal ATE RMSE per survey line (m, raw)\n";
       std::vector<std::vector<std::string>> line_rows(1);
@@ -257,7 +227,7 @@ std::string formatTable(const EvalReport& report) {
         }
         line_rows.push_back(row);
       }
-      out << columns(line_rows);
+      out << formatColumns(line_rows);
     }
   }
   if (!report.heightmaps.empty()) {
@@ -270,7 +240,7 @@ std::string formatTable(const EvalReport& report) {
                       cell(r.abs_error_m.mean, 3), cell(r.abs_error_m.rmse, 3), cell(r.abs_error_m.median, 3),
                       cell(r.abs_error_m.max, 3), cell(r.mean_signed_error_m, 3)});
     }
-    out << "\n" << columns(rows);
+    out << "\n" << formatColumns(rows);
   }
   return out.str();
 }
@@ -330,12 +300,12 @@ std::string reportJson(const EvalReport& report) {
     json.key("unmatched").value(static_cast<uint64_t>(ev.association.unmatched));
 
     json.key("ate").beginObject();
-    writeStats(json, "position_m", ev.ate.position_m);
-    writeStats(json, "horizontal_m", ev.ate.horizontal_m);
-    writeStats(json, "vertical_m", ev.ate.vertical_m);
-    writeStats(json, "rotation_deg", ev.ate.rotation_deg);
-    writeStats(json, "aligned_position_m", ev.ate.aligned_position_m);
-    writeStats(json, "aligned_horizontal_m", ev.ate.aligned_horizontal_m);
+    writeErrorStatistics(json, "position_m", ev.ate.position_m);
+    writeErrorStatistics(json, "horizontal_m", ev.ate.horizontal_m);
+    writeErrorStatistics(json, "vertical_m", ev.ate.vertical_m);
+    writeErrorStatistics(json, "rotation_deg", ev.ate.rotation_deg);
+    writeErrorStatistics(json, "aligned_position_m", ev.ate.aligned_position_m);
+    writeErrorStatistics(json, "aligned_horizontal_m", ev.ate.aligned_horizontal_m);
     json.key("alignment").beginObject();
     const Eigen::Vector3d& t = ev.ate.T_truth_estimate.translation;
     const Eigen::Quaterniond& q = ev.ate.T_truth_estimate.rotation;
@@ -350,9 +320,9 @@ std::string reportJson(const EvalReport& report) {
     for (const RpeResult& rpe : ev.rpe) {
       json.beginObject();
       json.key("window_m").value(rpe.window_m);
-      writeStats(json, "translation_percent", rpe.translation_percent);
-      writeStats(json, "translation_m", rpe.translation_m);
-      writeStats(json, "rotation_deg", rpe.rotation_deg);
+      writeErrorStatistics(json, "translation_percent", rpe.translation_percent);
+      writeErrorStatistics(json, "translation_m", rpe.translation_m);
+      writeErrorStatistics(json, "rotation_deg", rpe.rotation_deg);
       json.endObject();
     }
     json.endArray();
@@ -361,9 +331,9 @@ std::string reportJson(const EvalReport& report) {
     for (const LineError& line : ev.lines) {
       json.beginObject();
       json.key("index").value(line.line);
-      writeStats(json, "horizontal_m", line.horizontal_m);
-      writeStats(json, "position_m", line.position_m);
-      writeStats(json, "aligned_horizontal_m", line.aligned_horizontal_m);
+      writeErrorStatistics(json, "horizontal_m", line.horizontal_m);
+      writeErrorStatistics(json, "position_m", line.position_m);
+      writeErrorStatistics(json, "aligned_horizontal_m", line.aligned_horizontal_m);
       json.endObject();
     }
     json.endArray();
@@ -406,7 +376,7 @@ std::string reportJson(const EvalReport& report) {
     json.key("compared_cells").value(static_cast<uint64_t>(r.compared_cells));
     json.key("coverage_fraction").value(r.coverage_fraction);
     json.key("covered_area_m2").value(r.covered_area_m2);
-    writeStats(json, "abs_error_m", r.abs_error_m);
+    writeErrorStatistics(json, "abs_error_m", r.abs_error_m);
     json.key("mean_signed_error_m").value(r.mean_signed_error_m);
     if (h.error_map_yaml.empty()) json.key("error_map_yaml").null();
     else json.key("error_map_yaml").value(h.error_map_yaml);
@@ -424,6 +394,35 @@ std::string reportJson(const EvalReport& report) {
   json.endObject();
   json.endObject();
   return json.str();
+}
+
+std::string formatColumns(const std::vector<std::vector<std::string>>& rows) {
+  std::vector<size_t> width;
+  for (const auto& row : rows) {
+    if (width.size() < row.size()) width.resize(row.size(), 0);
+    for (size_t c = 0; c < row.size(); ++c) width[c] = std::max(width[c], row[c].size());
+  }
+  std::string out;
+  for (const auto& row : rows) {
+    std::string line;
+    for (size_t c = 0; c < row.size(); ++c) {
+      const std::string padding(width[c] - row[c].size(), ' ');
+      line += c == 0 ? row[c] + padding : "  " + padding + row[c];
+    }
+    while (!line.empty() && line.back() == ' ') line.pop_back();
+    out += line + "\n";
+  }
+  return out;
+}
+
+void writeErrorStatistics(JsonWriter& json, const std::string& key, const ErrorStatistics& stats) {
+  json.key(key).beginObject();
+  json.key("count").value(static_cast<uint64_t>(stats.count));
+  json.key("rmse").value(stats.rmse);
+  json.key("mean").value(stats.mean);
+  json.key("median").value(stats.median);
+  json.key("max").value(stats.max);
+  json.endObject();
 }
 
 }  // namespace sss::eval

@@ -31,6 +31,7 @@
 #pragma once
 
 #include "tools/eval/heightmap_metrics.hpp"
+#include "tools/eval/json_writer.hpp"
 #include "tools/eval/plots.hpp"
 #include "tools/eval/trajectory_io.hpp"
 #include "tools/eval/trajectory_metrics.hpp"
@@ -105,5 +106,10 @@ std::string reportJson(const EvalReport& report);
 
 // A label usable in a file name: [A-Za-z0-9._-], others replaced by '_'.
 std::string fileSafeLabel(const std::string& label);
+
+// Rows of cells as aligned text columns: first column left-aligned, the others right-aligned.
+std::string formatColumns(const std::vector<std::vector<std::string>>& rows);
+// {"count", "rmse", "mean", "median", "max"} under key (NaN as null).
+void writeErrorStatistics(JsonWriter& json, const std::string& key, const ErrorStatistics& stats);
 
 }  // namespace sss::eval

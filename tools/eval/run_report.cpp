@@ -4,6 +4,7 @@
 
 #include "tools/eval/json_writer.hpp"
 #include "tools/eval/plots.hpp"
+#include "tools/eval/report.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -111,26 +112,6 @@ std::string markdownEscape(const std::string& text) {
   for (char c : text) {
     if (c == '|' || c == '*' || c == '_' || c == '`' || c == '[' || c == ']' || c == '<' || c == '>') out += '\\';
     out += c;
-  }
-  return out;
-}
-
-// Rows of cells as aligned columns: first column left-aligned, the others right-aligned.
-std::string columns(const std::vector<std::vector<std::string>>& rows) {
-  std::vector<size_t> width;
-  for (const auto& row : rows) {
-    if (width.size() < row.size()) width.resize(row.size(), 0);
-    for (size_t c = 0; c < row.size(); ++c) width[c] = std::max(width[c], row[c].size());
-  }
-  std::string out;
-  for (const auto& row : rows) {
-    std::string line;
-    for (size_t c = 0; c < row.size(); ++c) {
-      const std::string padding(width[c] - row[c].size(), ' ');
-      line += c == 0 ? row[c] + padding : "  " + padding + row[c];
-    }
-    while (!line.empty() && line.back() == ' ') line.pop_back();
-    out += line + "\n";
   }
   return out;
 }
@@ -817,16 +798,6 @@ bool writeText(const std::string& path, const std::string& text, std::string& er
   return true;
 }
 
-void writeStats(JsonWriter& json, const std::string& key, const ErrorStatistics& stats) {
-  json.key(key).beginObject();
-  json.key("count").value(static_cast<uint64_t>(stats.count));
-  json.key("rmse").value(stats.rmse);
-  json.key("mean").value(stats.mean);
-  json.key("median").value(stats.median);
-  json.key("max").value(stats.max);
-  json.endObject();
-}
-
 }  // namespace
 
 // ---- loop closures and summary -----------------------------------------------------------
@@ -1091,7 +1062,7 @@ std::string formatRunTable(const RunReport& report) {
   rows.push_back({"heightmap MAE", report.heightmap_dr.present ? metres(report.heightmap_dr.error.abs_error_m.mean) : "-",
                   report.heightmap_slam.present ? metres(report.heightmap_slam.error.abs_error_m.mean) : "-",
                   percent(report.heightmap_improvement_percent, true)});
-  std::string out = report.title + "\n" + report.verdict + "\n\n" + columns(rows);
+  std::string out = report.title + "\n" + report.verdict + "\n\n" + formatColumns(rows);
   // Free-text rows under the table, their values starting at its second column.
   const size_t indent = std::string("horizontal ATE RMSE").size() + 2;
   const auto line = [&](const std::string& label, const std::string& value) {
@@ -1135,9 +1106,9 @@ std::string runReportJson(const RunReport& report, const RunReportRequest& reque
     json.key("path").value(path);
     json.key("poses").value(static_cast<uint64_t>(evaluation->estimate_poses));
     json.key("matched").value(static_cast<uint64_t>(evaluation->association.pairs.size()));
-    writeStats(json, "ate_horizontal_m", evaluation->ate.horizontal_m);
-    writeStats(json, "ate_aligned_horizontal_m", evaluation->ate.aligned_horizontal_m);
-    writeStats(json, "ate_position_m", evaluation->ate.position_m);
+    writeErrorStatistics(json, "ate_horizontal_m", evaluation->ate.horizontal_m);
+    writeErrorStatistics(json, "ate_aligned_horizontal_m", evaluation->ate.aligned_horizontal_m);
+    writeErrorStatistics(json, "ate_position_m", evaluation->ate.position_m);
     const bool has_rpe = report.rpe_index < evaluation->rpe.size();
     json.key("rpe_translation_percent").value(has_rpe ? evaluation->rpe[report.rpe_index].translation_percent.mean : kNaN);
     json.key("rpe_rotation_deg").value(has_rpe ? evaluation->rpe[report.rpe_index].rotation_deg.mean : kNaN);
