@@ -80,6 +80,7 @@ TEST_F(OfflineRunnerTest, SonarAndInsFilesGiveEveryOutputAndBeatDeadReckoning) {
   EXPECT_EQ(s.closures_rejected, 0u) << "no closure of a clean survey should be rejected";
   EXPECT_GT(s.seabed_points, 1000u);
   EXPECT_GT(s.real_time_factor, 1.0);
+  EXPECT_EQ(s.input_faults, 0u) << "clean simulator files: no sentence or message may be lost";
 
   // Every ping in both trajectories, the same times.
   const auto dr = sss::eval::readTum(r.out_dir + "/dead_reckoning.tum");

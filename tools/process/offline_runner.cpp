@@ -31,6 +31,7 @@
 #include "pipeline/subframe/pictures.hpp"
 #include "pipeline/subframe/subframe_buffer.hpp"
 #include "pipeline/subframe/subframe_message.hpp"
+#include "tools/eval/json_writer.hpp"
 
 namespace sss::offline {
 
@@ -196,10 +197,9 @@ class InsFileSource {
     const std::streamsize n = file_.gcount();
     std::vector<sss::ins::NavSample> samples;
     // Host time 0 throughout: staleness is a live-link notion, not one of a recorded file.
-    if (n > 0) {
-      bridge_.onBytes(reinterpret_cast<const uint8_t*>(chunk.data()), static_cast<size_t>(n), 0, samples);
-      bridge_.onChunkEnd(0, samples);
-    }
+    // A chunk is not a datagram: a sentence may run on into the next chunk, so only the end of
+    // the file (finish) ends one.
+    if (n > 0) bridge_.onBytes(reinterpret_cast<const uint8_t*>(chunk.data()), static_cast<size_t>(n), 0, samples);
     if (n <= 0 || !file_) {
       bridge_.finish(0, samples);
       finished_ = true;
@@ -299,39 +299,36 @@ bool writeClosuresCsv(const std::string& path, const sss::optimiser::OptimiserEn
 
 bool writeSummaryJson(const std::string& path, const OfflineRequest& request, const OfflineSummary& s,
                       std::string& error) {
-  std::FILE* f = std::fopen(path.c_str(), "w");
-  if (!f) {
+  sss::eval::JsonWriter json;
+  json.beginObject();
+  json.key("schema").value("sss-process/1");
+  json.key("inputs").beginObject();
+  json.key("sonar").value(request.sonar_path);
+  json.key("ins").value(request.ins_path);
+  json.key("lcm_log").value(request.lcm_log_path);
+  json.key("config").value(request.config_path);
+  json.endObject();
+  const std::pair<const char*, uint64_t> counts[] = {
+      {"nav_samples", s.nav_samples},         {"pings", s.pings},
+      {"pings_with_pose", s.pings_with_pose}, {"subframes", s.subframes},
+      {"pairs_attempted", s.pairs_attempted}, {"matcher_closures", s.matcher_closures},
+      {"closures_accepted", s.closures_accepted}, {"closures_rejected", s.closures_rejected},
+      {"closures_superseded", s.closures_superseded}, {"seabed_points", s.seabed_points},
+      {"input_faults", s.input_faults}};
+  for (const auto& [name, value] : counts) json.key(name).value(value);
+  const std::pair<const char*, double> figures[] = {
+      {"mission_s", s.mission_s},     {"wall_s", s.wall_s},
+      {"matcher_s", s.matcher_s},     {"optimiser_s", s.optimiser_s},
+      {"real_time_factor", s.real_time_factor}, {"peak_rss_mib", s.peak_rss_mib}};
+  for (const auto& [name, value] : figures) json.key(name).value(value, 6);
+  json.endObject();
+  std::ofstream out(path);
+  out << json.str() << "\n";
+  if (!out) {
     error = "cannot write " + path;
     return false;
   }
-  auto quoted = [](const std::string& text) {
-    std::string out = "\"";
-    for (char c : text) {
-      if (c == '"' || c == '\\') out += '\\';
-      out += c;
-    }
-    return out + "\"";
-  };
-  std::fprintf(f, "{\n  \"schema\": \"sss-process/1\",\n");
-  std::fprintf(f, "  \"inputs\": {\"sonar\": %s, \"ins\": %s, \"lcm_log\": %s, \"config\": %s},\n",
-               quoted(request.sonar_path).c_str(), quoted(request.ins_path).c_str(), quoted(request.lcm_log_path).c_str(),
-               quoted(request.config_path).c_str());
-  std::fprintf(f,
-               "  \"nav_samples\": %llu,\n  \"pings\": %llu,\n  \"pings_with_pose\": %llu,\n  \"subframes\": %llu,\n"
-               "  \"pairs_attempted\": %llu,\n  \"matcher_closures\": %llu,\n  \"closures_accepted\": %llu,\n"
-               "  \"closures_rejected\": %llu,\n  \"closures_superseded\": %llu,\n  \"seabed_points\": %llu,\n"
-               "  \"input_faults\": %llu,\n  \"mission_s\": %.3f,\n  \"wall_s\": %.3f,\n  \"matcher_s\": %.3f,\n"
-               "  \"optimiser_s\": %.3f,\n  \"real_time_factor\": %.2f,\n  \"peak_rss_mib\": %.1f\n}\n",
-               static_cast<unsigned long long>(s.nav_samples), static_cast<unsigned long long>(s.pings),
-               static_cast<unsigned long long>(s.pings_with_pose), static_cast<unsigned long long>(s.subframes),
-               static_cast<unsigned long long>(s.pairs_attempted), static_cast<unsigned long long>(s.matcher_closures),
-               static_cast<unsigned long long>(s.closures_accepted), static_cast<unsigned long long>(s.closures_rejected),
-               static_cast<unsigned long long>(s.closures_superseded), static_cast<unsigned long long>(s.seabed_points),
-               static_cast<unsigned long long>(s.input_faults), s.mission_s, s.wall_s, s.matcher_s, s.optimiser_s,
-               s.real_time_factor, s.peak_rss_mib);
-  const bool ok = std::fclose(f) == 0;
-  if (!ok) error = "cannot write " + path;
-  return ok;
+  return true;
 }
 
 // A copy of a subframe with `factor` bins averaged into one (masked if any is masked): mosaics
