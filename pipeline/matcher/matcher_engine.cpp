@@ -30,6 +30,7 @@ void readMatcherEngineOptions(sss::core::ConfigSection& section, MatcherEngineOp
   section.optional("max_association_rounds", options.max_association_rounds, {inRange(0, 10)});
   section.optional("reassociation_translation_m", options.reassociation_translation_m, {inRange(0.0, 1000.0)});
   section.optional("reassociation_rotation_rad", options.reassociation_rotation_rad, {inRange(0.0, 3.2)});
+  section.optional("max_closure_correspondences", options.max_closure_correspondences, {inRange(0, 100000)});
 }
 
 std::vector<std::string> validateMatcherEngineOptions(const MatcherEngineOptions& o) {
@@ -39,6 +40,7 @@ std::vector<std::string> validateMatcherEngineOptions(const MatcherEngineOptions
   if (o.max_association_rounds < 0) problems.push_back("max_association_rounds must be >= 0");
   if (!(o.reassociation_translation_m >= 0.0)) problems.push_back("reassociation_translation_m must be >= 0");
   if (!(o.reassociation_rotation_rad >= 0.0)) problems.push_back("reassociation_rotation_rad must be >= 0");
+  if (o.max_closure_correspondences < 0) problems.push_back("max_closure_correspondences must be >= 0");
   return problems;
 }
 
@@ -104,8 +106,12 @@ PairOutcome MatcherEngine::matchStored(const PairKey& key, int round) {
   c.total_cost = match.pose.total_cost;
   c.mean_zncc = static_cast<float>(match.mean_zncc);
   const auto& geometry = a.subframe.geometry;
-  for (size_t i = 0; i < match.pose.inlier_indices.size(); ++i) {
-    const Correspondence& m = match.matches[match.pose.inlier_indices[i]];
+  const std::vector<int>& inliers = match.pose.all_inlier_indices;
+  const size_t published = std::min(inliers.size(), static_cast<size_t>(options_.max_closure_correspondences));
+  c.correspondences.reserve(published);
+  for (size_t k = 0; k < published; ++k) {
+    const size_t i = k * inliers.size() / published;  // evenly thinned
+    const Correspondence& m = match.matches[inliers[i]];
     ClosureCorrespondence cc;
     cc.ping_index_a = std::clamp(static_cast<int>(std::lround(m.row_a)), 0, a.subframe.rows() - 1);
     cc.column_a = static_cast<int>(std::lround(m.col_a));
@@ -115,7 +121,7 @@ PairOutcome MatcherEngine::matchStored(const PairKey& key, int round) {
         std::hypot(geometry.signedGroundRangeM(m.col_a), a.subframe.pings[cc.ping_index_a].altitude_m));
     cc.slant_range_b_m = static_cast<float>(
         std::hypot(b.subframe.geometry.signedGroundRangeM(m.col_b), b.subframe.pings[cc.ping_index_b].altitude_m));
-    if (i < match.pose.landmarks_a.size()) cc.landmark_a_m = match.pose.landmarks_a[i].cast<float>();
+    cc.landmark_a_m = match.pose.all_inlier_landmarks_a[i].cast<float>();
     c.correspondences.push_back(cc);
   }
   return outcome;

@@ -31,6 +31,9 @@ struct MatcherEngineOptions {
   // more than this since they were last matched.
   double reassociation_translation_m = 0.5;
   double reassociation_rotation_rad = 0.005;
+  // Inlier correspondences sent with a closure for the optimiser's bathymetric point cloud
+  // (evenly thinned beyond this; ~28 bytes each on the wire).
+  int max_closure_correspondences = 3000;
 };
 
 void readMatcherEngineOptions(sss::core::ConfigSection& section, MatcherEngineOptions& options);

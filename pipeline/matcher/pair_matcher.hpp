@@ -39,7 +39,7 @@ struct PairMatcherOptions {
   // drifts 0.1-0.5 % of distance; 1 % keeps the prior weak, so the sonar decides.
   double dr_horizontal_sigma_fixed_m = 1.0;
   double dr_horizontal_sigma_per_m = 0.01;
-  double dr_depth_sigma_m = 0.5;              // pressure depth: absolute, small
+  double dr_depth_sigma_m = 0.05;             // pressure depth: absolute, a few cm
   double dr_heading_sigma_fixed_rad = 0.005;
   double dr_heading_sigma_per_m = 2e-5;
   double dr_roll_pitch_sigma_rad = 0.005;     // measured absolutely by the INS

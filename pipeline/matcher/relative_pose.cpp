@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
 #include <random>
@@ -254,6 +255,7 @@ struct Score {
   double range_cost = 0.0;  // sum of squared whitened range residuals, truncated at the threshold
   double plane_cost = 0.0;  // the same for the plane residuals
   std::vector<int> inliers;
+  std::vector<Eigen::Vector3d> landmarks;  // parallel to inliers: the fitted landmark (frame a)
 };
 
 struct BinInA {
@@ -299,7 +301,10 @@ Score scoreHypothesis(const std::vector<Measurement>& measurements, const std::v
     evaluate();
     const bool same_side = (x - bins[1].sonar).dot(bins[1].starboard) * m.b.side > 0.0;
     const double cost = r.head(rows).squaredNorm();
-    if (same_side && cost < threshold2) score.inliers.push_back(k);
+    if (same_side && cost < threshold2) {
+      score.inliers.push_back(k);
+      score.landmarks.push_back(x);
+    }
     if (skip && (*skip)[k]) continue;
     score.range_cost += same_side ? std::min(r(0) * r(0) + r(2) * r(2), threshold2) : threshold2;
     score.plane_cost += same_side ? std::min(r(1) * r(1) + r(3) * r(3), threshold2) : threshold2;
@@ -441,7 +446,8 @@ RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const Re
   }
   if (!best_pose) return reject("no RANSAC hypothesis converged");
   Pose pose = *best_pose;
-  std::vector<int> inliers = scoreHypothesis(measurements, all, pose, options, nullptr).inliers;
+  Score final_score = scoreHypothesis(measurements, all, pose, options, nullptr);
+  std::vector<int> inliers = final_score.inliers;
   const int needed = std::max(options.min_inliers, options.ransac_subset);
   if (static_cast<int>(inliers.size()) < needed) {
     std::ostringstream text;
@@ -475,7 +481,20 @@ RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const Re
     result.inlier_indices.clear();
     for (int k : used) result.inlier_indices.push_back(match_index[k]);
     result.landmarks_a = refined.landmarks;
-    inliers = scoreHypothesis(measurements, all, pose, options, nullptr).inliers;
+    final_score = scoreHypothesis(measurements, all, pose, options, nullptr);
+    inliers = final_score.inliers;
+  }
+  // Every inlier for the point cloud; the refined ones keep their jointly optimised landmark.
+  std::map<int, Eigen::Vector3d> refined_landmark;
+  for (size_t i = 0; i < result.inlier_indices.size() && i < result.landmarks_a.size(); ++i)
+    refined_landmark[result.inlier_indices[i]] = result.landmarks_a[i];
+  result.all_inlier_indices.reserve(inliers.size());
+  result.all_inlier_landmarks_a.reserve(inliers.size());
+  for (size_t i = 0; i < inliers.size(); ++i) {
+    const int match = match_index[inliers[i]];
+    const auto found = refined_landmark.find(match);
+    result.all_inlier_indices.push_back(match);
+    result.all_inlier_landmarks_a.push_back(found != refined_landmark.end() ? found->second : final_score.landmarks[i]);
   }
 
   result.T_a_b = pose;

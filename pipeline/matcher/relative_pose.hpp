@@ -71,6 +71,11 @@ struct RelativePoseResult {
   double total_cost = 0.0;                  // Ceres final cost of the refinement (0.5 sum r^2)
   std::vector<int> inlier_indices;          // into matches: the refined ones (<= max_correspondences)
   std::vector<Eigen::Vector3d> landmarks_a; // parallel to inlier_indices, in A's centre body frame
+  // Every match consistent with the final pose (num_inliers of them), for the bathymetric point
+  // cloud, with a landmark start for each: the refined landmark where there is one, else the
+  // landmark fitted to the final pose (the inlier test's own Gauss-Newton), in A's centre frame.
+  std::vector<int> all_inlier_indices;
+  std::vector<Eigen::Vector3d> all_inlier_landmarks_a;
   int ransac_iterations_run = 0;
   double seconds = 0.0;
 };

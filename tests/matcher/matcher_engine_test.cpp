@@ -53,7 +53,10 @@ Check checkAgainstTruth(const std::vector<PairOutcome>& outcomes, const sss::sim
                 (long long)o.subframe_id_a, (long long)o.subframe_id_b, a.line_id, b.line_id, a.rows(), b.rows(),
                 o.association_round, o.closure.num_inliers, o.closure.num_matches, error.x(), error.y(), error.z(),
                 std::sqrt(o.closure.covariance(0, 0)), std::sqrt(o.closure.covariance(1, 1)), nees, o.seconds);
-    EXPECT_GT(o.closure.correspondences.size(), 30u);
+    // Every inlier up to the cap goes to the optimiser's point cloud.
+    EXPECT_EQ(o.closure.correspondences.size(),
+              std::min<size_t>(o.closure.num_inliers, MatcherEngineOptions{}.max_closure_correspondences));
+    for (const ClosureCorrespondence& c : o.closure.correspondences) EXPECT_TRUE(c.landmark_a_m.allFinite());
   }
   return check;
 }

@@ -150,6 +150,15 @@ void expectRecoversDrError(bool anti_parallel) {
   // 80 % of 1000 matches are true; a few noisy ones fall outside 3 sigma.
   EXPECT_GT(result.num_inliers, 700);
   EXPECT_LT(result.num_inliers, 850);
+  // Every inlier goes to the point cloud, not only the (sampled) refined ones, each with a
+  // landmark on the seabed: A is level at kAltitudeM above it, and the relief is kReliefSigmaM.
+  ASSERT_EQ(result.all_inlier_indices.size(), static_cast<size_t>(result.num_inliers));
+  ASSERT_EQ(result.all_inlier_landmarks_a.size(), result.all_inlier_indices.size());
+  EXPECT_LT(result.inlier_indices.size(), result.all_inlier_indices.size());
+  int off_seabed = 0;
+  for (const Eigen::Vector3d& landmark : result.all_inlier_landmarks_a)
+    off_seabed += !(std::abs(landmark.z() - kAltitudeM) < 5.0 * kReliefSigmaM);
+  EXPECT_LT(off_seabed, result.num_inliers / 50) << "landmarks more than 5 relief sigmas off the seabed";
 }
 
 TEST(RelativePose, RecoversAlongTrackAndLateralDrErrorParallel) { expectRecoversDrError(false); }
