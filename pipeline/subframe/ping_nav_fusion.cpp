@@ -36,7 +36,12 @@ void readPingNavFusionOptions(sss::core::ConfigSection& section, PingNavFusionOp
   section.optional("max_pending_pings", options.max_pending_pings, {inRange(1, 100000)});
   section.optional("heading_rate_window_s", options.heading_rate_window_s, {inRange(0.0, 30.0)});
   section.optional("min_altitude_m", options.min_altitude_m, {inRange(0.0, 1000.0)});
+  section.optional("pose_heading_from_fit", options.pose_heading_from_fit);
   section.optional("duplicate_memory_pings", options.duplicate_memory_pings, {inRange(1, 100000)});
+  // A ping waits for nav half a heading-rate window past it: a shorter wait drops every ping.
+  if (options.max_ping_wait_s <= 0.5 * options.heading_rate_window_s)
+    section.addProblem("max_ping_wait_s", std::to_string(options.max_ping_wait_s),
+                       "must exceed half of heading_rate_window_s (pings wait that long for nav)");
 }
 
 PingNavFusion::PingNavFusion(const PingNavFusionOptions& options)
@@ -130,7 +135,11 @@ bool PingNavFusion::resolve(PingInput&& ping, std::vector<FusedPing>& out) {
   fused.distance_travelled_m = a->distance_travelled_m + alpha * (b->distance_travelled_m - a->distance_travelled_m);
 
   // Heading rate over heading_rate_window_s centred on the ping (a one-sided window would lag
-  // the start of a turn by half a window and put its first pings into the line).
+  // the start of a turn by half a window and put its first pings into the line): the
+  // least-squares slope of the unwrapped heading over every nav sample in the window, so that
+  // INS heading noise (the paper's study adds up to 0.05 rad) does not read as a turn. The fitted
+  // heading at the ping is the steady heading the line segmentation compares.
+  fused.steady_heading_rad = fused.heading_rad;
   const int64_t half_window_us = static_cast<int64_t>(0.5 * options_.heading_rate_window_s * 1e6);
   auto w0 = std::lower_bound(history_.begin(), a, t - half_window_us,
                              [](const NavInput& n, int64_t time) { return n.utime_us < time; });
@@ -138,8 +147,32 @@ bool PingNavFusion::resolve(PingInput&& ping, std::vector<FusedPing>& out) {
                              [](const NavInput& n, int64_t time) { return n.utime_us < time; });
   if (w1 == history_.end()) w1 = std::prev(history_.end());
   if (w1->utime_us > w0->utime_us) {
-    fused.heading_rate_rad_s = sss::core::wrapAngle(w1->heading_rad - w0->heading_rad) /
-                               (static_cast<double>(w1->utime_us - w0->utime_us) * 1e-6);
+    double n = 0.0, sum_t = 0.0, sum_h = 0.0, sum_tt = 0.0, sum_th = 0.0;
+    double unwrapped = 0.0;
+    for (auto it = w0; it != std::next(w1); ++it) {
+      if (it != w0) unwrapped += sss::core::wrapAngle(it->heading_rad - std::prev(it)->heading_rad);
+      const double dt_s = static_cast<double>(it->utime_us - t) * 1e-6;
+      n += 1.0;
+      sum_t += dt_s;
+      sum_h += unwrapped;
+      sum_tt += dt_s * dt_s;
+      sum_th += dt_s * unwrapped;
+    }
+    const double denominator = n * sum_tt - sum_t * sum_t;
+    if (denominator > 0.0) {
+      const double slope = (n * sum_th - sum_t * sum_h) / denominator;
+      const double at_ping = (sum_h - slope * sum_t) / n;  // fitted unwrapped heading at t
+      fused.heading_rate_rad_s = slope;
+      fused.steady_heading_rad = sss::core::wrapAngle(w0->heading_rad + at_ping);
+    }
+  }
+  if (options_.pose_heading_from_fit) {
+    // The sonar's fan turns with the vehicle, which does not turn as fast as INS heading noise:
+    // the fitted heading geo-references the ping and frames the subframe (a single noisy centre
+    // heading would rotate every relative pose built on it).
+    const sss::core::EulerAngles euler = sss::core::eulerFromQuaternion(fused.T_world_body.rotation);
+    fused.T_world_body.rotation = sss::core::quaternionFromEuler(euler.roll_rad, euler.pitch_rad, fused.steady_heading_rad);
+    fused.heading_rad = fused.steady_heading_rad;
   }
 
   // Altitude of the sonar: DVL altitude of the body, shifted by the lever arm's vertical

@@ -50,7 +50,8 @@ struct FusedPing {
   bool altitude_from_ping = false;   // nav altitude was invalid or stale
   double heading_rad = 0.0;
   double roll_rad = 0.0;
-  double heading_rate_rad_s = 0.0;   // over heading_rate_window_s centred on the ping
+  double heading_rate_rad_s = 0.0;   // over heading_rate_window_s centred on the ping (LS slope)
+  double steady_heading_rad = 0.0;   // the LS fit's heading at the ping: noise averaged out
   double distance_travelled_m = 0.0;
 };
 
@@ -60,10 +61,15 @@ struct PingNavFusionOptions {
   Eigen::Vector3d sonar_rpy_body_rad = Eigen::Vector3d::Zero();
   double nav_history_s = 60.0;        // nav kept behind the newest sample
   double max_nav_gap_s = 0.5;         // bracketing nav samples further apart: the ping is dropped
-  double max_ping_wait_s = 3.0;       // a ping waits this long (in ping time) for its nav, then drops
-  int max_pending_pings = 64;         // waiting pings beyond this: the oldest is dropped
-  double heading_rate_window_s = 1.0; // heading rate over this span centred on the ping; pings wait
-                                      // for nav half of it past them (latency)
+  double max_ping_wait_s = 6.0;       // a ping waits this long (in ping time) for its nav, then drops
+  int max_pending_pings = 256;        // waiting pings beyond this: the oldest is dropped
+  // Heading rate (turn detection) over this span centred on the ping; pings wait for nav half of
+  // it past them (latency). 8 s keeps 0.05 rad of INS heading noise below the turn threshold
+  // (slope sigma ~0.004 rad/s) and still flags a 0.05 rad/s survey turn within ~2 s.
+  double heading_rate_window_s = 8.0;
+  // The ping's pose takes the fitted (steady) heading of that window instead of the interpolated
+  // INS heading: INS heading noise then neither smears the image nor rotates subframe frames.
+  bool pose_heading_from_fit = true;
   double min_altitude_m = 0.5;        // altitudes below this are treated as invalid
   int duplicate_memory_pings = 256;   // recent ping numbers remembered to catch duplicates
 

@@ -56,7 +56,7 @@ void SubframeBuilder::addPing(CanonicalPing ping, std::vector<Subframe>& out) {
     return;
   }
   if (line_open_) {
-    if (!deviates(ping.fused.heading_rad)) {
+    if (!deviates(ping.fused.steady_heading_rad)) {
       appendToLine(std::move(ping), out);
       return;
     }
@@ -64,7 +64,7 @@ void SubframeBuilder::addPing(CanonicalPing ping, std::vector<Subframe>& out) {
   }
   // Hysteresis: a line opens only after min_steady_pings steady pings with one heading.
   if (!candidate_.empty() &&
-      std::abs(sss::core::wrapAngle(ping.fused.heading_rad - candidate_.front().fused.heading_rad)) >
+      std::abs(sss::core::wrapAngle(ping.fused.steady_heading_rad - candidate_.front().fused.steady_heading_rad)) >
           line_options_.max_heading_deviation_rad) {
     counters_.turn_pings += candidate_.size();
     candidate_.clear();
@@ -82,8 +82,8 @@ void SubframeBuilder::addPing(CanonicalPing ping, std::vector<Subframe>& out) {
 }
 
 void SubframeBuilder::appendToLine(CanonicalPing&& ping, std::vector<Subframe>& out) {
-  line_sin_sum_ += std::sin(ping.fused.heading_rad);
-  line_cos_sum_ += std::cos(ping.fused.heading_rad);
+  line_sin_sum_ += std::sin(ping.fused.steady_heading_rad);
+  line_cos_sum_ += std::cos(ping.fused.steady_heading_rad);
   current_.push_back(std::move(ping));
   if (static_cast<int>(current_.size()) >= options_.pings_per_subframe) emit(out);
 }

@@ -23,6 +23,7 @@ struct Rows {
       row.fused.ping.utime_us = utime_us;
       utime_us += 250000;
       row.fused.heading_rad = heading_rad;
+      row.fused.steady_heading_rad = heading_rad;
       row.turn = turn;
       row.intensity.assign(8, static_cast<float>(row.fused.ping.ping_number));
       row.mask.assign(8, turn ? kMaskTurn : kMaskValid);
