@@ -1,5 +1,6 @@
 // The emulators deliver every message, in order, byte for byte, at the requested pace, over TCP
-// and UDP; a client that disconnects and comes back gets the rest.
+// and UDP; a client that disconnects and comes back gets the rest; a pause is a stall (sent late)
+// or an outage (never sent).
 #include "tools/emulators/stream_server.hpp"
 
 #include <arpa/inet.h>
@@ -9,7 +10,9 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <thread>
+#include <vector>
 
 #include "pipeline/core/time.hpp"
 
@@ -150,6 +153,56 @@ TEST(UdpStreamSender, SendsOneDatagramPerChunkInOrder) {
     EXPECT_EQ(buffer[0], chunk.bytes[0]);
   }
   ::close(receiver);
+}
+
+// One pause of 0.1 s after the 40th of 70 chunks (50 ms apart, at 10x: 5 ms): as a stall every
+// chunk comes, 0.1 s late; as an outage the ~20 chunks that fell due meanwhile never come and the
+// rest keep their schedule.
+TEST(UdpStreamSender, APauseIsAStallOrAnOutage) {
+  for (const bool outage : {false, true}) {
+    const int receiver = ::socket(AF_INET, SOCK_DGRAM, 0);
+    sockaddr_in address{};
+    address.sin_family = AF_INET;
+    address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ASSERT_EQ(::bind(receiver, reinterpret_cast<sockaddr*>(&address), sizeof(address)), 0);
+    socklen_t length = sizeof(address);
+    ::getsockname(receiver, reinterpret_cast<sockaddr*>(&address), &length);
+    const std::vector<TimedChunk> chunks = makeChunks(70, 50'000);
+    StreamServerOptions options;
+    options.port = ntohs(address.sin_port);
+    options.speed = 10.0;
+    options.faults.pause_every = 40;  // after chunk 39 only
+    options.faults.pause_s = 0.1;
+    options.faults.pause_skips = outage;
+    UdpStreamSender sender(options, chunks);
+    std::atomic<bool> stop{false};
+    std::string error;
+    const int64_t start = sss::core::monotonicUtime();
+    ASSERT_TRUE(sender.run(stop, error)) << error;
+    const double elapsed_ms = static_cast<double>(sss::core::monotonicUtime() - start) * 1e-3;
+    std::vector<int> received;
+    uint8_t buffer[4096];
+    while (::recv(receiver, buffer, sizeof(buffer), MSG_DONTWAIT) > 0) received.push_back(buffer[0]);
+    ::close(receiver);
+    const StreamStats& stats = sender.stats();
+    EXPECT_EQ(stats.pauses, 1u);
+    ASSERT_EQ(received.size(), stats.chunks_sent);
+    ASSERT_GE(received.size(), 41u);
+    EXPECT_TRUE(std::is_sorted(received.begin(), received.end()));
+    for (int i = 0; i < 40; ++i) EXPECT_EQ(received[static_cast<size_t>(i)], i);
+    EXPECT_EQ(received.back(), 69);
+    if (!outage) {
+      EXPECT_EQ(stats.chunks_skipped, 0u);
+      EXPECT_EQ(received.size(), chunks.size());
+      EXPECT_NEAR(elapsed_ms, 69 * 5.0 + 100.0, 60.0) << "a stall shifts the rest";
+    } else {
+      // Chunks 40-58 (due 200-290 ms) fell due during the pause (195-295 ms); 59 is borderline.
+      EXPECT_GE(stats.chunks_skipped, 17u);
+      EXPECT_LE(stats.chunks_skipped, 21u);
+      EXPECT_EQ(received.size() + stats.chunks_skipped, chunks.size());
+      EXPECT_NEAR(elapsed_ms, 69 * 5.0, 60.0) << "an outage keeps the schedule";
+    }
+  }
 }
 
 }  // namespace

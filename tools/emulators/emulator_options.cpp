@@ -48,6 +48,8 @@ bool parseStreamOption(int argc, char** argv, int& i, StreamServerOptions& optio
     if (value(v)) options.faults.pause_every = static_cast<int>(v);
   } else if (arg == "--pause-s") {
     if (value(v)) options.faults.pause_s = v;
+  } else if (arg == "--pause-skip") {
+    options.faults.pause_skips = true;
   } else if (arg == "--seed") {
     if (value(v)) options.faults.seed = static_cast<uint32_t>(v);
   } else {
@@ -62,7 +64,8 @@ const char* streamOptionsHelp() {
          "  --flip-every K      flip a byte inside every Kth message\n"
          "  --truncate-every K  send only the first half of every Kth message\n"
          "  --drop-every K      close the connection after every Kth message (TCP)\n"
-         "  --pause-every K     pause --pause-s seconds after every Kth message\n"
+         "  --pause-every K     pause --pause-s seconds after every Kth message (then send what fell due)\n"
+         "  --pause-skip        a pause is an outage: what falls due meanwhile is never sent\n"
          "  --seed N            seed of the fault randomness\n";
 }
 

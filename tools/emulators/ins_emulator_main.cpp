@@ -51,6 +51,7 @@ int main(int argc, char** argv) {
   std::printf("sss-ins-emulator: %zu bursts from %s %s %s:%d at speed %g\n", chunks.size(), file.c_str(),
               tcp ? "served on" : "sent to", options.bind_address.c_str(), options.port, options.speed);
   std::fflush(stdout);
+  sss::emulators::StreamStats stats;
   if (tcp) {
     sss::emulators::TcpStreamServer server(options, std::move(chunks));
     if (!server.listen(error)) {
@@ -58,12 +59,21 @@ int main(int argc, char** argv) {
       return 1;
     }
     server.run(g_stop);
+    stats = server.stats();
   } else {
     sss::emulators::UdpStreamSender sender(options, std::move(chunks));
     if (!sender.run(g_stop, error)) {
       std::fprintf(stderr, "sss-ins-emulator: %s\n", error.c_str());
       return 1;
     }
+    stats = sender.stats();
   }
+  // What was injected, for the fault tests' logs (tools/run-chain).
+  std::printf("sss-ins-emulator: sent %llu whole, %llu faulted, %llu garbage runs, %llu connections, %llu drops, "
+              "%llu pauses, %llu skipped\n",
+              static_cast<unsigned long long>(stats.chunks_sent), static_cast<unsigned long long>(stats.chunks_faulted),
+              static_cast<unsigned long long>(stats.garbage_runs), static_cast<unsigned long long>(stats.connections),
+              static_cast<unsigned long long>(stats.drops), static_cast<unsigned long long>(stats.pauses),
+              static_cast<unsigned long long>(stats.chunks_skipped));
   return 0;
 }

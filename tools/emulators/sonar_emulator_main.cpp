@@ -55,10 +55,12 @@ int main(int argc, char** argv) {
     std::fflush(stdout);
     server.run(g_stop);
     const auto& s = server.stats();
-    std::printf("sss-sonar-emulator: sent %llu whole, %llu faulted, %llu garbage runs, %llu connections, %llu drops\n",
+    std::printf("sss-sonar-emulator: sent %llu whole, %llu faulted, %llu garbage runs, %llu connections, %llu drops, "
+                "%llu pauses, %llu skipped\n",
                 static_cast<unsigned long long>(s.chunks_sent), static_cast<unsigned long long>(s.chunks_faulted),
                 static_cast<unsigned long long>(s.garbage_runs), static_cast<unsigned long long>(s.connections),
-                static_cast<unsigned long long>(s.drops));
+                static_cast<unsigned long long>(s.drops), static_cast<unsigned long long>(s.pauses),
+                static_cast<unsigned long long>(s.chunks_skipped));
     std::fflush(stdout);
   } while (repeat && !g_stop);
   return 0;

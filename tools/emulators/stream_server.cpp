@@ -41,7 +41,7 @@ class Pacer {
   bool waitFor(int64_t chunk_time_us, const std::atomic<bool>& stop) {
     if (speed_ <= 0.0) return !stop;
     if (start_us_ < 0) start_us_ = sss::core::monotonicUtime();
-    const int64_t due = start_us_ + static_cast<int64_t>(static_cast<double>(chunk_time_us - first_time_us_) / speed_);
+    const int64_t due = dueUs(chunk_time_us);
     for (;;) {
       if (stop) return false;
       const int64_t wait = due - sss::core::monotonicUtime();
@@ -49,14 +49,23 @@ class Pacer {
       std::this_thread::sleep_for(std::chrono::microseconds(std::min<int64_t>(wait, 50'000)));
     }
   }
-  // A pause shifts the whole schedule, like a sensor that stalls and then carries on.
-  void pause(double seconds, const std::atomic<bool>& stop) {
+  // A stall shifts the whole schedule, like a sensor that stops and then carries on where it
+  // was; an outage keeps it, like a sensor that goes silent and comes back with live data.
+  void pause(double seconds, bool shift, const std::atomic<bool>& stop) {
     const int64_t end = sss::core::monotonicUtime() + static_cast<int64_t>(seconds * 1e6);
     while (!stop && sss::core::monotonicUtime() < end) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    if (start_us_ >= 0) start_us_ += static_cast<int64_t>(seconds * 1e6);
+    if (shift && start_us_ >= 0) start_us_ += static_cast<int64_t>(seconds * 1e6);
+  }
+  // The chunk fell due before now (after an outage).
+  bool overdue(int64_t chunk_time_us) const {
+    return speed_ > 0.0 && start_us_ >= 0 && dueUs(chunk_time_us) < sss::core::monotonicUtime();
   }
 
  private:
+  int64_t dueUs(int64_t chunk_time_us) const {
+    return start_us_ + static_cast<int64_t>(static_cast<double>(chunk_time_us - first_time_us_) / speed_);
+  }
+
   double speed_;
   int64_t first_time_us_;
   int64_t start_us_ = -1;
@@ -150,7 +159,11 @@ void TcpStreamServer::run(const std::atomic<bool>& stop) {
     if (on_chunk_sent_) on_chunk_sent_(i, sss::core::monotonicUtime());
     if (every(options_.faults.pause_every, i)) {
       ++stats_.pauses;
-      pacer.pause(options_.faults.pause_s, stop);
+      pacer.pause(options_.faults.pause_s, !options_.faults.pause_skips, stop);
+      while (options_.faults.pause_skips && i + 1 < chunks_.size() && pacer.overdue(chunks_[i + 1].time_us)) {
+        ++i;
+        ++stats_.chunks_skipped;
+      }
     }
     if (every(options_.faults.drop_connection_every, i) && i + 1 < chunks_.size()) {
       ++stats_.drops;
@@ -188,7 +201,11 @@ bool UdpStreamSender::run(const std::atomic<bool>& stop, std::string& error) {
     damaged ? ++stats_.chunks_faulted : ++stats_.chunks_sent;
     if (every(options_.faults.pause_every, i)) {
       ++stats_.pauses;
-      pacer.pause(options_.faults.pause_s, stop);
+      pacer.pause(options_.faults.pause_s, !options_.faults.pause_skips, stop);
+      while (options_.faults.pause_skips && i + 1 < chunks_.size() && pacer.overdue(chunks_[i + 1].time_us)) {
+        ++i;
+        ++stats_.chunks_skipped;
+      }
     }
     // As fast as possible over UDP would overrun any receiver: yield a little every datagram.
     if (options_.speed <= 0.0) std::this_thread::sleep_for(std::chrono::microseconds(50));

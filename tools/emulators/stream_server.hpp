@@ -24,6 +24,9 @@ struct FaultPlan {
   int drop_connection_every = 0;  // TCP: close the connection after every Kth chunk
   int pause_every = 0;          // every Kth chunk: stop sending for pause_s
   double pause_s = 0.0;
+  // false: a stall, the chunks are sent late (the schedule shifts by pause_s); true: an outage,
+  // the chunks that fell due during the pause are never sent and the schedule carries on.
+  bool pause_skips = false;
   uint32_t seed = 1;
 };
 
@@ -41,6 +44,7 @@ struct StreamStats {
   uint64_t connections = 0;
   uint64_t drops = 0;
   uint64_t pauses = 0;
+  uint64_t chunks_skipped = 0;  // never sent: fell due during an outage (pause_skips)
 };
 
 class TcpStreamServer {
