@@ -111,6 +111,12 @@ std::vector<std::string> SonarDriver::takeNewFaultMessages() {
   return faults;
 }
 
+std::string resolveRecordDirectory(const std::string& configured, const char* logs_directory_env) {
+  if (!configured.empty() || logs_directory_env == nullptr) return configured;
+  const std::string logs(logs_directory_env);
+  return logs.substr(0, logs.find(':'));
+}
+
 void readSonarDriverOptions(sss::core::ConfigSection& section, SonarDriverOptions& options) {
   using namespace sss::core;
   int subsystem = options.assembler.subsystem;

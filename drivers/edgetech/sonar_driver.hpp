@@ -35,6 +35,11 @@ struct DriverPing {
   int64_t sonar_utime_us = 0;
 };
 
+// Where raw JSF from the sonar is recorded: the configured directory; when that is empty,
+// systemd's LogsDirectory= as passed in $LOGS_DIRECTORY (its first entry: systemd joins several
+// with ':'); when both are empty, nowhere (recording off). logs_directory_env may be null.
+std::string resolveRecordDirectory(const std::string& configured, const char* logs_directory_env);
+
 class SonarDriver {
  public:
   explicit SonarDriver(SonarDriverOptions options);

@@ -171,11 +171,18 @@ int main(int argc, char** argv) {
   if (!lcm_url_override.empty()) options.process.lcm_url = lcm_url_override;
   // A file carries the sonar's own clock; there is no arrival time to compare it with.
   if (!options.replay_file.empty()) options.driver.time_source = sss::edgetech::TimeSource::kSonarClock;
+  // Under systemd the sonar's raw bytes go to the unit's LogsDirectory= unless the config says
+  // where; a file being replayed is already on disk.
+  if (options.replay_file.empty()) {
+    options.driver.recorder.directory =
+        sss::edgetech::resolveRecordDirectory(options.driver.recorder.directory, std::getenv("LOGS_DIRECTORY"));
+  }
 
   sss::transport::initLogging(options.process.process_name, options.process.log_level);
   sss::transport::ProcessLoop loop(options.process);
   sss::core::HealthMonitor& health = loop.health();
   sss::edgetech::SonarDriver driver(options.driver);
+  if (driver.recorder().enabled()) spdlog::info("recording the raw JSF stream to {}", options.driver.recorder.directory);
 
   auto publish = [&](const sss::edgetech::DriverPing& ping) {
     loop.bus().publish(options.ping_channel, sss::edgetech::toPingMessage(ping), ping.ping.last_arrival_us);

@@ -1,15 +1,19 @@
 // sss-sonar-driver as a process, fed by the sonar emulator over TCP with corrupt bytes,
 // truncated messages, dropped connections and pauses: it keeps running, publishes every good
 // ping on LCM (counted against the file), says what was dropped, and stops cleanly on SIGTERM.
+// The config names no record directory: the raw bytes go to $LOGS_DIRECTORY, as under systemd.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <filesystem>
 #include <fstream>
 #include <map>
+#include <string>
 #include <thread>
+#include <vector>
 
 #include "jsf_test_data.hpp"
 #include "pipeline/core/time.hpp"
@@ -67,10 +71,20 @@ TEST(SonarDriverLink, EveryGoodPingSurvivesALinkWithFaults) {
     if (s.process == "sss-sonar-driver") last_status = s;
   });
 
+  // systemd's LogsDirectory= (sss-sonar-driver.service) arrives as $LOGS_DIRECTORY.
+  const std::string logs_directory = dir + "/link_test_logs";
+  std::filesystem::remove_all(logs_directory);
+  std::vector<std::string> environment = {"LOGS_DIRECTORY=" + logs_directory};
+  for (char** e = environ; *e != nullptr; ++e) {
+    if (std::string(*e).rfind("LOGS_DIRECTORY=", 0) != 0) environment.emplace_back(*e);
+  }
+  std::vector<char*> envp;
+  for (std::string& e : environment) envp.push_back(e.data());
+  envp.push_back(nullptr);
   pid_t driver = 0;
   char* argv[] = {const_cast<char*>(SONAR_DRIVER_PATH), const_cast<char*>("--config"),
                   const_cast<char*>(config_path.c_str()), nullptr};
-  ASSERT_EQ(posix_spawn(&driver, SONAR_DRIVER_PATH, nullptr, nullptr, argv, environ), 0);
+  ASSERT_EQ(posix_spawn(&driver, SONAR_DRIVER_PATH, nullptr, nullptr, argv, envp.data()), 0);
 
   std::atomic<bool> stop_server{false};
   std::thread server_thread([&] { server.run(stop_server); });
@@ -123,6 +137,14 @@ TEST(SonarDriverLink, EveryGoodPingSurvivesALinkWithFaults) {
   // connection into the listen backlog although the finished emulator accepts no more.
   EXPECT_GE(counters["link_connects"], static_cast<double>(sent.connections));
   EXPECT_LE(counters["link_connects"], static_cast<double>(sent.connections + 1));
+
+  // Every byte received was recorded under $LOGS_DIRECTORY: the file's size, give or take the
+  // garbage added and the halves cut by the emulator.
+  uint64_t recorded = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(logs_directory)) recorded += entry.file_size();
+  EXPECT_EQ(static_cast<double>(recorded), counters["recorded_bytes"]);
+  EXPECT_GT(recorded, std::filesystem::file_size(jsf_path) * 9 / 10);
+  EXPECT_EQ(counters["record_errors"], 0.0);
 }
 
 }  // namespace

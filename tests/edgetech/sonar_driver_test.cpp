@@ -91,6 +91,17 @@ TEST(SonarDriver, RecordsTheRawStreamExactlyWithRotation) {
   EXPECT_EQ(recorded, stream);
 }
 
+TEST(SonarDriver, RecordDirectoryFallsBackToSystemdsLogsDirectory) {
+  // The config leaves it empty: systemd's LogsDirectory= ($LOGS_DIRECTORY), its first entry.
+  EXPECT_EQ(resolveRecordDirectory("", "/var/log/sss-slam/jsf"), "/var/log/sss-slam/jsf");
+  EXPECT_EQ(resolveRecordDirectory("", "/var/log/sss-slam/jsf:/var/log/other"), "/var/log/sss-slam/jsf");
+  // The config wins; neither set (or an empty variable): recording off.
+  EXPECT_EQ(resolveRecordDirectory("/data/jsf", "/var/log/sss-slam/jsf"), "/data/jsf");
+  EXPECT_EQ(resolveRecordDirectory("/data/jsf", nullptr), "/data/jsf");
+  EXPECT_EQ(resolveRecordDirectory("", nullptr), "");
+  EXPECT_EQ(resolveRecordDirectory("", ""), "");
+}
+
 TEST(PingMessage, CarriesBothSidesNavAndMissingFlags) {
   DriverPing ping;
   ping.utime_us = 42;
