@@ -1,6 +1,8 @@
 // EdgeTech driver logic, see sonar_driver.hpp.
 #include "drivers/edgetech/sonar_driver.hpp"
 
+#include "pipeline/core/state_file.hpp"
+
 namespace sss::edgetech {
 
 SonarDriver::SonarDriver(SonarDriverOptions options)
@@ -112,9 +114,7 @@ std::vector<std::string> SonarDriver::takeNewFaultMessages() {
 }
 
 std::string resolveRecordDirectory(const std::string& configured, const char* logs_directory_env) {
-  if (!configured.empty() || logs_directory_env == nullptr) return configured;
-  const std::string logs(logs_directory_env);
-  return logs.substr(0, logs.find(':'));
+  return sss::core::resolveSystemdDirectory(configured, logs_directory_env);
 }
 
 void readSonarDriverOptions(sss::core::ConfigSection& section, SonarDriverOptions& options) {

@@ -54,11 +54,35 @@ void InsBridge::emit(const InsState& state, int64_t host_monotonic_us, std::vect
   const Eigen::Vector3d velocity_ned(state.velocity_north_m_s, state.velocity_east_m_s, state.velocity_down_m_s);
   sample.velocity_body_m_s = q_world_body.conjugate() * velocity_ned;
   if (state.validity & kValidPosition) {
-    if (last_position_ned_m_) distance_travelled_m_ += (sample.position_ned_m - *last_position_ned_m_).head<2>().norm();
+    // After a resume, the saved position counts only if it is recent (a restart, not another dive).
+    const double gap_s = static_cast<double>(state.utime_us - last_position_utime_us_) * 1e-6;
+    const bool counts = !resumed_ || (gap_s >= 0.0 && gap_s <= options_.odometer_max_bridged_gap_s);
+    if (last_position_ned_m_ && counts) distance_travelled_m_ += (sample.position_ned_m - *last_position_ned_m_).head<2>().norm();
     last_position_ned_m_ = sample.position_ned_m;
+    last_position_utime_us_ = state.utime_us;
+    resumed_ = false;
   }
   sample.distance_travelled_m = distance_travelled_m_;
   out.push_back(sample);
+}
+
+OdometerState InsBridge::odometer() const {
+  OdometerState state;
+  state.distance_travelled_m = distance_travelled_m_;
+  if (last_position_ned_m_) {
+    state.utime_us = last_position_utime_us_;
+    state.position_ned_m = *last_position_ned_m_;
+  }
+  return state;
+}
+
+void InsBridge::resumeOdometer(const OdometerState& state) {
+  distance_travelled_m_ = state.distance_travelled_m;
+  resumed_ = true;
+  if (state.utime_us > 0) {
+    last_position_ned_m_ = state.position_ned_m;
+    last_position_utime_us_ = state.utime_us;
+  }
 }
 
 uint32_t InsBridge::staleFlagsAt(int64_t host_monotonic_us) const {
@@ -116,6 +140,7 @@ void readInsBridgeOptions(sss::core::ConfigSection& section, InsBridgeOptions& o
   section.optional("velocity_timeout_s", options.assembler.velocity_timeout_s, {inRange(0.01, 600.0)});
   section.optional("altitude_timeout_s", options.assembler.altitude_timeout_s, {inRange(0.01, 600.0)});
   section.optional("altitude_std_m", options.assembler.altitude_std_m, {inRange(0.001, 100.0)});
+  section.optional("odometer_max_bridged_gap_s", options.odometer_max_bridged_gap_s, {inRange(0.0, 86400.0)});
   int max_sentence_bytes = static_cast<int>(options.stream.max_sentence_bytes);
   section.optional("max_sentence_bytes", max_sentence_bytes, {inRange(82, 4096)});
   options.stream.max_sentence_bytes = static_cast<size_t>(max_sentence_bytes);

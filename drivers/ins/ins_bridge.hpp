@@ -21,6 +21,18 @@ struct InsBridgeOptions {
   double origin_longitude_deg = 18.07;
   InsAssemblerOptions assembler;
   NmeaStreamOptions stream;
+  // A restarted bridge resumes its odometer; the path from the last saved position to the first
+  // new one counts as a straight line when they are at most this far apart in time (a restart),
+  // and adds nothing after a longer gap (another dive).
+  double odometer_max_bridged_gap_s = 60.0;
+};
+
+// Where the odometer stood: what a restarted bridge needs so that distance travelled, which the
+// optimiser's odometry uncertainty grows with, never goes back.
+struct OdometerState {
+  double distance_travelled_m = 0.0;
+  int64_t utime_us = 0;  // INS time of the last position; 0: none yet
+  Eigen::Vector3d position_ned_m = Eigen::Vector3d::Zero();
 };
 
 struct NavSample {
@@ -52,6 +64,10 @@ class InsBridge {
   const InsAssemblerCounters& assemblerCounters() const { return assembler_.counters(); }
   uint64_t epochsOutOfOrder() const { return epochs_out_of_order_; }
 
+  OdometerState odometer() const;
+  // Before the first sample: continue the odometer of an earlier run.
+  void resumeOdometer(const OdometerState& state);
+
  private:
   void assemble(std::vector<std::string>& sentences, int64_t host_monotonic_us, std::vector<NavSample>& out);
   void emit(const InsState& state, int64_t host_monotonic_us, std::vector<NavSample>& out);
@@ -63,6 +79,8 @@ class InsBridge {
   std::vector<std::string> sentences_;  // reused
   std::optional<Eigen::Vector3d> last_position_ned_m_;
   double distance_travelled_m_ = 0.0;
+  int64_t last_position_utime_us_ = 0;
+  bool resumed_ = false;  // resumeOdometer() called, no position since
   int64_t last_ins_utime_us_ = 0;
   int64_t last_epoch_host_us_ = 0;
   uint64_t epochs_out_of_order_ = 0;

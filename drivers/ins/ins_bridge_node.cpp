@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <deque>
 #include <fstream>
@@ -16,6 +17,7 @@
 
 #include "drivers/ins/ins_bridge.hpp"
 #include "drivers/ins/nav_message.hpp"
+#include "pipeline/core/state_file.hpp"
 #include "pipeline/core/time.hpp"
 #include "pipeline/transport/logging.hpp"
 #include "pipeline/transport/process_loop.hpp"
@@ -38,7 +40,45 @@ struct NodeOptions {
   std::string file;
   double replay_speed = 1.0;
   std::string nav_channel = "SSS_NAV";
+  // The odometer survives restarts here. Empty: $STATE_DIRECTORY (systemd StateDirectory=), else
+  // none (a restarted bridge counts distance travelled from 0 again).
+  std::string state_directory;
 };
+
+constexpr const char* kOdometerFormat = "sss-ins-bridge odometer 1";
+
+void loadOdometer(const std::string& path, sss::ins::InsBridge& bridge) {
+  if (access(path.c_str(), F_OK) != 0) return;
+  sss::core::StateValues values;
+  std::string error;
+  sss::ins::OdometerState state;
+  long long utime_us = 0;
+  const bool ok = sss::core::readStateFile(path, kOdometerFormat, values, error) &&
+                  sss::core::stateNumber(values, "distance_travelled_m", state.distance_travelled_m) &&
+                  sss::core::stateInteger(values, "utime_us", utime_us) &&
+                  sss::core::stateNumber(values, "north_m", state.position_ned_m.x()) &&
+                  sss::core::stateNumber(values, "east_m", state.position_ned_m.y()) &&
+                  sss::core::stateNumber(values, "down_m", state.position_ned_m.z()) && state.distance_travelled_m >= 0.0;
+  if (!ok) {
+    spdlog::error("odometer not resumed, distance travelled starts from 0 (the optimiser bridges the reset): {}",
+                  error.empty() ? path + ": a value is missing or invalid" : error);
+    return;
+  }
+  state.utime_us = utime_us;
+  bridge.resumeOdometer(state);
+  spdlog::info("resumed the odometer from {}: {:.1f} m travelled", path, state.distance_travelled_m);
+}
+
+bool saveOdometer(const std::string& path, const sss::ins::OdometerState& state, std::string& error) {
+  auto number = [](double value) { return fmt::format("{:.17g}", value); };
+  return sss::core::writeStateFile(path, kOdometerFormat,
+                                   {{"distance_travelled_m", number(state.distance_travelled_m)},
+                                    {"utime_us", std::to_string(state.utime_us)},
+                                    {"north_m", number(state.position_ned_m.x())},
+                                    {"east_m", number(state.position_ned_m.y())},
+                                    {"down_m", number(state.position_ned_m.z())}},
+                                   error);
+}
 
 speed_t baudConstant(int baud) {
   switch (baud) {
@@ -136,6 +176,7 @@ int main(int argc, char** argv) {
     if (!file_given) section.optional("file", options.file);
     if (!speed_given) section.optional("replay_speed", options.replay_speed, {inRange(0.0, 1000.0)});
     section.optional("nav_channel", options.nav_channel, {nonEmpty()});
+    section.optional("state_directory", options.state_directory);
     section.rejectUnknownKeys();
     config_problems = config.problemReport();
   }
@@ -149,6 +190,25 @@ int main(int argc, char** argv) {
   sss::core::HealthMonitor& health = loop.health();
   sss::ins::InsBridge bridge(options.bridge);
   std::vector<sss::ins::NavSample> samples;
+
+  // The odometer, saved every second while it moves. A file replay is offline: nothing kept.
+  const std::string state_directory = options.source == "file" ? std::string()
+      : sss::core::resolveSystemdDirectory(options.state_directory, std::getenv("STATE_DIRECTORY"));
+  const std::string odometer_path = state_directory.empty() ? "" : state_directory + "/odometer";
+  if (!odometer_path.empty()) loadOdometer(odometer_path, bridge);
+  int64_t saved_odometer_utime_us = -1;
+  uint64_t odometer_write_failures = 0;
+  auto saveOdometerIfMoved = [&] {
+    const sss::ins::OdometerState state = bridge.odometer();
+    if (odometer_path.empty() || state.utime_us == saved_odometer_utime_us) return;
+    std::string save_error;
+    if (saveOdometer(odometer_path, state, save_error)) {
+      saved_odometer_utime_us = state.utime_us;
+    } else if (odometer_write_failures++ == 0) {
+      spdlog::error("odometer not saved (counted from now on): {}", save_error);
+    }
+  };
+  loop.addTimer(1.0, saveOdometerIfMoved);
 
   auto publishAll = [&](int64_t since_us) {
     for (const auto& sample : samples) {
@@ -170,6 +230,8 @@ int main(int argc, char** argv) {
     health.setCounter("nmea_garbage_bytes", static_cast<double>(stream.garbage_bytes));
     health.setCounter("ins_epochs", static_cast<double>(bridge.assemblerCounters().epochs));
     health.setCounter("ins_epochs_out_of_order", static_cast<double>(bridge.epochsOutOfOrder()));
+    health.setCounter("odometer_m", bridge.odometer().distance_travelled_m);
+    health.setCounter("odometer_write_failures", static_cast<double>(odometer_write_failures));
     loop.reportFaults("ins_input", bridge.takeNewFaultMessages());
   });
 
@@ -282,6 +344,7 @@ int main(int argc, char** argv) {
     });
   }
   const int code = loop.run();
+  saveOdometerIfMoved();
   if (input_fd >= 0) ::close(input_fd);
   return code;
 }

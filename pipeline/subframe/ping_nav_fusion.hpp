@@ -61,8 +61,12 @@ struct PingNavFusionOptions {
   Eigen::Vector3d sonar_rpy_body_rad = Eigen::Vector3d::Zero();
   double nav_history_s = 60.0;        // nav kept behind the newest sample
   double max_nav_gap_s = 0.5;         // bracketing nav samples further apart: the ping is dropped
-  double max_ping_wait_s = 6.0;       // a ping waits this long (in ping time) for its nav, then drops
-  int max_pending_pings = 256;        // waiting pings beyond this: the oldest is dropped
+  // A ping waits this long (in ping time) for its nav, then drops: nav may lag the pings by this
+  // less half the heading-rate window (an INS that stalled and carries on late).
+  double max_ping_wait_s = 30.0;
+  // Waiting pings beyond this: the oldest is dropped. Bounds memory (a raw 2205 ping of 2 x 20k
+  // samples is 160 KB: 40 MB) whatever the ping rate: 64 s of pings at 4 Hz.
+  int max_pending_pings = 256;
   // Heading rate (turn detection) over this span centred on the ping; pings wait for nav half of
   // it past them (latency). 8 s keeps 0.05 rad of INS heading noise below the turn threshold
   // (slope sigma ~0.004 rad/s) and still flags a 0.05 rad/s survey turn within ~2 s.

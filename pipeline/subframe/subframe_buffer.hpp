@@ -40,6 +40,8 @@ class SubframeBuffer {
   void finish(std::vector<Subframe>& out);
 
   SubframeBufferCounters counters() const;
+  SubframeNumbering numbering() const { return builder_.numbering(); }
+  void resumeNumbering(const SubframeNumbering& numbering) { builder_.resumeNumbering(numbering); }
   const SubframeBufferOptions& options() const { return options_; }
   const SubframeGeometry& geometry() const { return geometry_; }
   // Bytes held by the buffers (nav history, waiting pings, rows of the open subframe).

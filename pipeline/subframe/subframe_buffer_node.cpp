@@ -1,11 +1,16 @@
 // sss-subframe-buffer: SSS_PING + SSS_NAV -> SSS_SUBFRAME (canonical, geo-referenced subframes),
 // with drops and latency in SSS_STATUS. Translation only; the logic is in SubframeBuffer.
 //   sss-subframe-buffer [--config FILE] [--lcm-url URL]
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
+#include <limits>
 #include <string>
 #include <vector>
 
+#include "pipeline/core/state_file.hpp"
 #include "pipeline/core/time.hpp"
 #include "pipeline/subframe/subframe_buffer.hpp"
 #include "pipeline/subframe/subframe_message.hpp"
@@ -24,7 +29,36 @@ struct NodeOptions {
   double horizontal_beam_width_rad = 0.0087;  // carried in the message for the matcher
   double vertical_beam_width_rad = 0.87;
   double idle_flush_s = 5.0;  // no ping for this long (host time): close the open line
+  // The subframe and line numbering survives restarts here. Empty: $STATE_DIRECTORY (systemd
+  // StateDirectory=), else none (a restarted buffer numbers from 0: the optimiser then refuses
+  // the new subframes as duplicates).
+  std::string state_directory;
 };
+
+constexpr const char* kNumberingFormat = "sss-subframe-buffer numbering 1";
+
+// The numbering saved by an earlier run; {0, 0} when there is none. A file that cannot be read
+// is reported (numbering from 0 may collide with the subframes the optimiser already has).
+sss::subframe::SubframeNumbering loadNumbering(const std::string& path) {
+  sss::subframe::SubframeNumbering numbering;
+  if (path.empty() || access(path.c_str(), F_OK) != 0) return numbering;
+  sss::core::StateValues values;
+  std::string error;
+  long long subframe_id = 0, line_id = 0;
+  if (!sss::core::readStateFile(path, kNumberingFormat, values, error) ||
+      !sss::core::stateInteger(values, "next_subframe_id", subframe_id) ||
+      !sss::core::stateInteger(values, "next_line_id", line_id) || subframe_id < 0 || line_id < 0 ||
+      line_id > std::numeric_limits<int>::max()) {
+    spdlog::error("subframe numbering not resumed, starting from 0 (subframes the optimiser already has will be "
+                  "refused as duplicates): {}",
+                  error.empty() ? path + ": bad next_subframe_id / next_line_id" : error);
+    return numbering;
+  }
+  numbering.next_subframe_id = subframe_id;
+  numbering.next_line_id = static_cast<int>(line_id);
+  spdlog::info("resumed the numbering from {}: next subframe {}, next line {}", path, subframe_id, line_id);
+  return numbering;
+}
 
 }  // namespace
 
@@ -53,6 +87,7 @@ int main(int argc, char** argv) {
     section.optional("horizontal_beam_width_rad", options.horizontal_beam_width_rad, {inRange(0.0, 1.0)});
     section.optional("vertical_beam_width_rad", options.vertical_beam_width_rad, {inRange(0.0, 3.2)});
     section.optional("idle_flush_s", options.idle_flush_s, {inRange(0.1, 3600.0)});
+    section.optional("state_directory", options.state_directory);
     section.rejectUnknownKeys();
     config_problems = config.problemReport();
   }
@@ -66,8 +101,29 @@ int main(int argc, char** argv) {
   sss::core::HealthMonitor& health = loop.health();
   sss::subframe::SubframeBuffer buffer(options.buffer);
   std::vector<sss::subframe::Subframe> subframes;
+  const std::string state_directory =
+      sss::core::resolveSystemdDirectory(options.state_directory, std::getenv("STATE_DIRECTORY"));
+  const std::string numbering_path = state_directory.empty() ? "" : state_directory + "/numbering";
+  if (numbering_path.empty()) {
+    spdlog::warn("no state directory (subframe_buffer.state_directory or $STATE_DIRECTORY): after a restart the "
+                 "subframe ids start from 0 again");
+  }
+  buffer.resumeNumbering(loadNumbering(numbering_path));
+  uint64_t numbering_write_failures = 0;
 
   auto publishAll = [&] {
+    // The numbering is saved before the subframes leave: a kill in between skips ids, it never
+    // reuses one.
+    if (!subframes.empty() && !numbering_path.empty()) {
+      const sss::subframe::SubframeNumbering numbering = buffer.numbering();
+      std::string error;
+      if (!sss::core::writeStateFile(numbering_path, kNumberingFormat,
+                                     {{"next_subframe_id", std::to_string(numbering.next_subframe_id)},
+                                      {"next_line_id", std::to_string(numbering.next_line_id)}},
+                                     error)) {
+        if (numbering_write_failures++ == 0) spdlog::error("subframe numbering not saved (counted from now on): {}", error);
+      }
+    }
     for (const sss::subframe::Subframe& subframe : subframes) {
       const sss_msgs::subframe_t message = sss::subframe::toSubframeMessage(
           subframe, options.buffer.subframes.intensity_bits, options.buffer.subframes.max_intensity,
@@ -124,6 +180,7 @@ int main(int argc, char** argv) {
     set("partial_subframes", c.builder.partial_subframes);
     set("dropped_short_tails", c.builder.dropped_short_tails);
     set("memory_bytes", buffer.memoryBytes());
+    set("numbering_write_failures", numbering_write_failures);
     health.setQueueDepth(options.ping_channel, false, 0);
     const int64_t now = sss::core::nowUtime();
     if (c.fusion.droppedWithoutNav() > reported_no_nav) {

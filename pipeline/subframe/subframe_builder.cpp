@@ -81,6 +81,11 @@ void SubframeBuilder::addPing(CanonicalPing ping, std::vector<Subframe>& out) {
   }
 }
 
+void SubframeBuilder::resumeNumbering(const SubframeNumbering& numbering) {
+  next_subframe_id_ = numbering.next_subframe_id;
+  line_id_ = numbering.next_line_id - 1;  // incremented when the next line opens
+}
+
 void SubframeBuilder::appendToLine(CanonicalPing&& ping, std::vector<Subframe>& out) {
   line_sin_sum_ += std::sin(ping.fused.steady_heading_rad);
   line_cos_sum_ += std::cos(ping.fused.steady_heading_rad);

@@ -74,6 +74,14 @@ struct SubframeBuilderCounters {
   uint64_t dropped_tail_pings = 0;
 };
 
+// The ids the builder gives next. A restarted subframe buffer resumes them from its state file:
+// subframe ids must stay unique within a mission (the optimiser refuses a duplicate), and a line
+// id must not name two lines (the matcher matches only subframes of different lines).
+struct SubframeNumbering {
+  int64_t next_subframe_id = 0;
+  int next_line_id = 0;
+};
+
 // Pings must come in time order (PingNavFusion releases them so). A subframe is emitted as soon
 // as its N-th ping arrives; when a line ends (turn, heading change, gap, finish()), its remaining
 // pings form a last subframe if there are at least min_pings of them (centre = middle of those
@@ -88,6 +96,11 @@ class SubframeBuilder {
 
   // Line of the newest ping; -1 while turning or before a line opened.
   int currentLineId() const { return line_open_ ? line_id_ : -1; }
+  // After the subframes emitted so far: the next subframe's id, and the id of the next line to
+  // open (the open line's pings, lost in a restart, cannot continue its id).
+  SubframeNumbering numbering() const { return {next_subframe_id_, line_id_ + 1}; }
+  // Before the first ping: continue the numbering of an earlier run.
+  void resumeNumbering(const SubframeNumbering& numbering);
   const SubframeBuilderCounters& counters() const { return counters_; }
   size_t memoryBytes() const;
 

@@ -39,6 +39,37 @@ TEST(InsBridge, GivesLocalNedBodyVelocityAndDistanceTravelled) {
   EXPECT_EQ(last.ins.utime_us, test::kStartUtime + 5'000'000);
 }
 
+// A bridge restarted mid-mission (kill -9, systemd restarts it) resumes the saved odometer; the
+// samples it never saw (saved every second, 2 s down) count as the straight line between the
+// saved position and the first new one, so distance travelled never goes back.
+TEST(InsBridge, ResumedOdometerBridgesTheRestartAndNeverGoesBack) {
+  InsBridge before(testOptions());
+  const std::vector<NavSample> seen = feedAll(before, test::eastboundStream(31));  // 0..3 s: 6 m
+  const OdometerState saved = before.odometer();
+  EXPECT_NEAR(saved.distance_travelled_m, 6.0, 0.02);
+  EXPECT_EQ(saved.utime_us, test::kStartUtime + 3'000'000);
+
+  InsBridge after(testOptions());
+  after.resumeOdometer(saved);
+  std::string stream;
+  for (int e = 51; e <= 60; ++e) stream += encodeInsState(test::eastboundState(e));  // 5.1..6 s
+  const std::vector<NavSample> resumed = feedAll(after, stream);
+  ASSERT_EQ(resumed.size(), 10u);
+  EXPECT_NEAR(resumed.front().distance_travelled_m, 10.2, 0.02);  // 6 m + the 4.2 m gap
+  EXPECT_NEAR(resumed.back().distance_travelled_m, 12.0, 0.02);   // as if never restarted
+  EXPECT_GT(resumed.front().distance_travelled_m, seen.back().distance_travelled_m);
+
+  // Saved long ago (another dive): the distance carries on, the gap adds nothing.
+  InsBridgeOptions options = testOptions();
+  options.odometer_max_bridged_gap_s = 1.0;
+  InsBridge later(options);
+  later.resumeOdometer(saved);
+  const std::vector<NavSample> next_dive = feedAll(later, stream);
+  ASSERT_EQ(next_dive.size(), 10u);
+  EXPECT_NEAR(next_dive.front().distance_travelled_m, 6.0, 0.02);
+  EXPECT_NEAR(next_dive.back().distance_travelled_m, 7.8, 0.02);
+}
+
 TEST(InsBridge, OlderOrRepeatedEpochIsDroppedAndCounted) {
   InsBridge bridge(testOptions());
   std::string stream = encodeInsState(test::eastboundState(0)) + encodeInsState(test::eastboundState(2)) +

@@ -102,6 +102,39 @@ TEST(PingNavFusion, DropsAPingWhoseNavNeverComes) {
   EXPECT_EQ(fusion.pendingPings(), 0u);
 }
 
+// An INS that stalled and then carries on late (its samples queued, delivered behind the pings
+// from then on): with the default options every ping still gets its nav, as long as the lag
+// stays under max_ping_wait_s less half the heading-rate window (30 - 4 = 26 s).
+TEST(PingNavFusion, NavLaggingThePingsByTwentySecondsLosesNoPing) {
+  PingNavFusion fusion(PingNavFusionOptions{});
+  std::vector<FusedPing> out;
+  constexpr double kLagS = 20.0;
+  constexpr int kPings = 4 * 120;  // 2 min at 4 Hz
+  int next_nav = 0;
+  for (int i = 0; i < kPings; ++i) {
+    const double t_s = 0.25 * i;
+    fusion.addPing(ping(t_s, i), out);
+    // Nav at 10 Hz, each sample arriving kLagS after its time (ping time stands for the clock).
+    for (; 0.1 * next_nav <= t_s - kLagS; ++next_nav) fusion.addNav(nav(0.1 * next_nav, 0.2 * next_nav, 0.0), out);
+  }
+  for (; 0.1 * next_nav <= 0.25 * (kPings - 1) + 5.0; ++next_nav) fusion.addNav(nav(0.1 * next_nav, 0.2 * next_nav, 0.0), out);
+  fusion.finish(out);
+  EXPECT_EQ(fusion.counters().droppedWithoutNav(), 0u);
+  ASSERT_EQ(out.size(), static_cast<size_t>(kPings));
+  EXPECT_NEAR(out.back().T_world_body.translation.x(), 2.0 * 0.25 * (kPings - 1), 1e-9);
+  // ... and a lag beyond the wait drops pings (counted) rather than holding them for ever.
+  PingNavFusion late(PingNavFusionOptions{});
+  out.clear();
+  next_nav = 0;
+  for (int i = 0; i < kPings; ++i) {
+    const double t_s = 0.25 * i;
+    late.addPing(ping(t_s, i), out);
+    for (; 0.1 * next_nav <= t_s - 40.0; ++next_nav) late.addNav(nav(0.1 * next_nav, 0.2 * next_nav, 0.0), out);
+  }
+  EXPECT_GT(late.counters().dropped_no_nav, 0u);
+  EXPECT_LE(late.pendingPings(), static_cast<size_t>(30.0 * 4 + 1));
+}
+
 TEST(PingNavFusion, DropsPingsInsideANavGapAndBeforeTheHistory) {
   PingNavFusionOptions options = immediate();
   options.max_nav_gap_s = 0.5;

@@ -220,19 +220,20 @@ TEST(SubframeBuffer, APingBurstAfterALinkStallGivesTheSameSubframesAndANavStallI
   }
 
   // Nav stall: 300 pings (75 s of pings) arrive before any of their nav. Pings wait at most
-  // max_ping_wait_s (6 s, 24 pings at 4 Hz) of ping time and max_pending_pings; the rest are
+  // max_ping_wait_s (30 s, 120 pings at 4 Hz) of ping time and max_pending_pings; the rest are
   // dropped and counted.
+  const auto waiting_pings = static_cast<uint64_t>(PingNavFusionOptions{}.max_ping_wait_s * 4.0) + 2;
   SubframeBuffer stalled({});
   std::vector<Subframe> stalled_out;
   for (const PingInput& p : pings) stalled.addPing(p, stalled_out);
   EXPECT_LE(stalled.counters().fusion.dropped_no_nav, 300u);
-  EXPECT_LE(stalled.memoryBytes(), 64u * 2u * 5000u * sizeof(float) + (1u << 20));
+  const size_t ping_bytes = (pings[0].port.size() + pings[0].starboard.size()) * sizeof(float) + sizeof(PingInput);
+  EXPECT_LE(stalled.memoryBytes(), waiting_pings * ping_bytes + (1u << 20));
   for (const NavInput& nav : m.dr_nav) stalled.addNav(nav, stalled_out);
   stalled.finish(stalled_out);
   const auto s = stalled.counters();
   EXPECT_EQ(s.fusion.pings_in, 300u);
   EXPECT_EQ(s.fusion.pings_out + s.fusion.droppedWithoutNav(), 300u);
-  const auto waiting_pings = static_cast<uint64_t>(PingNavFusionOptions{}.max_ping_wait_s * 4.0) + 2;
   EXPECT_GE(s.fusion.dropped_no_nav, 300u - waiting_pings);
   std::printf("nav stall: 300 pings before their nav: fused %llu, dropped %llu, memory %.2f MiB\n",
               (unsigned long long)s.fusion.pings_out, (unsigned long long)s.fusion.droppedWithoutNav(),

@@ -56,6 +56,36 @@ TEST(SubframeBuilder, CutsFullSubframesAndEmitsALongEnoughTailWithItsOwnCentre) 
   EXPECT_EQ(rows.builder.counters().partial_subframes, 1u);
 }
 
+// A restarted subframe buffer: the numbering saved after the last emitted subframe is resumed, so
+// ids never repeat and the line cut by the restart continues under a new line id.
+TEST(SubframeBuilder, ResumedNumberingNeverReusesASubframeOrLineId) {
+  Rows before;
+  before.add(20, 0.0, true);
+  before.add(450, 0.0);  // line 0: subframes 0, 1; 50 pings in the open subframe
+  ASSERT_EQ(before.out.size(), 2u);
+  const SubframeNumbering saved = before.builder.numbering();
+  EXPECT_EQ(saved.next_subframe_id, 2);
+  EXPECT_EQ(saved.next_line_id, 1);
+  before.add(30, 1.5);  // the process is killed here: the open line's pings are lost
+
+  Rows after;
+  after.utime_us = before.utime_us;
+  after.builder.resumeNumbering(saved);
+  after.add(450, 1.5);   // the rest of that line: a new line id
+  after.add(20, 1.5, true);
+  after.add(210, -1.5);  // the next line
+  ASSERT_EQ(after.out.size(), 4u);
+  EXPECT_EQ(after.out[0].id, 2);
+  EXPECT_EQ(after.out[0].line_id, 1);
+  EXPECT_EQ(after.out[1].id, 3);
+  EXPECT_EQ(after.out[2].id, 4);  // the line's tail of 50 pings (min_pings) at the turn
+  EXPECT_EQ(after.out[2].line_id, 1);
+  EXPECT_EQ(after.out[3].id, 5);
+  EXPECT_EQ(after.out[3].line_id, 2);
+  EXPECT_EQ(after.builder.numbering().next_subframe_id, 6);
+  EXPECT_EQ(after.builder.numbering().next_line_id, 3);
+}
+
 TEST(SubframeBuilder, ShortLinesGiveOnePartialSubframeOrAreDroppedAndCounted) {
   Rows rows;
   rows.add(150, 0.0);        // line 0: shorter than N but >= min_pings

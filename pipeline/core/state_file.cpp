@@ -1,0 +1,99 @@
+// Atomic key-value state files; see state_file.hpp.
+#include "pipeline/core/state_file.hpp"
+
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+namespace sss::core {
+
+std::string resolveSystemdDirectory(const std::string& configured, const char* env_value) {
+  if (!configured.empty() || env_value == nullptr) return configured;
+  const std::string directories(env_value);
+  return directories.substr(0, directories.find(':'));
+}
+
+bool writeStateFile(const std::string& path, const std::string& format, const StateValues& values, std::string& error) {
+  std::ostringstream text;
+  text << format << '\n';
+  for (const auto& [key, value] : values) {
+    if (key.empty() || key.find_first_of(" \n") != std::string::npos || value.find('\n') != std::string::npos) {
+      error = "state key '" + key + "' or its value cannot be written as one line";
+      return false;
+    }
+    text << key << ' ' << value << '\n';
+  }
+  const std::string temporary = path + ".tmp";
+  {
+    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+    out << text.str();
+    out.flush();
+    if (!out) {
+      error = "cannot write " + temporary + ": " + std::strerror(errno);
+      return false;
+    }
+  }
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    error = "cannot rename " + temporary + " to " + path + ": " + std::strerror(errno);
+    ::unlink(temporary.c_str());
+    return false;
+  }
+  return true;
+}
+
+bool readStateFile(const std::string& path, const std::string& format, StateValues& values, std::string& error) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    error = path + ": cannot open (" + std::strerror(errno) + ")";
+    return false;
+  }
+  std::string line;
+  if (!std::getline(in, line) || line != format) {
+    error = path + ": not a '" + format + "' file (first line '" + line.substr(0, 60) + "')";
+    return false;
+  }
+  values.clear();
+  int number = 1;
+  while (std::getline(in, line)) {
+    ++number;
+    const size_t space = line.find(' ');
+    if (space == 0 || space == std::string::npos || space + 1 >= line.size()) {
+      error = path + ": line " + std::to_string(number) + " is not 'key value'";
+      return false;
+    }
+    if (!values.emplace(line.substr(0, space), line.substr(space + 1)).second) {
+      error = path + ": line " + std::to_string(number) + " repeats key '" + line.substr(0, space) + "'";
+      return false;
+    }
+  }
+  return true;
+}
+
+bool stateNumber(const StateValues& values, const std::string& key, double& number) {
+  const auto it = values.find(key);
+  if (it == values.end()) return false;
+  char* end = nullptr;
+  const double parsed = std::strtod(it->second.c_str(), &end);
+  if (end == it->second.c_str() || *end != '\0' || !std::isfinite(parsed)) return false;
+  number = parsed;
+  return true;
+}
+
+bool stateInteger(const StateValues& values, const std::string& key, long long& number) {
+  const auto it = values.find(key);
+  if (it == values.end()) return false;
+  char* end = nullptr;
+  errno = 0;
+  const long long parsed = std::strtoll(it->second.c_str(), &end, 10);
+  if (end == it->second.c_str() || *end != '\0' || errno == ERANGE) return false;
+  number = parsed;
+  return true;
+}
+
+}  // namespace sss::core

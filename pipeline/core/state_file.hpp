@@ -1,0 +1,32 @@
+// What a process keeps across its own restarts (systemd's StateDirectory=): a small text file of
+// `key value` lines under a first line naming its format, written atomically (a temporary file
+// renamed over the old one), so a kill -9 at any moment leaves the old or the new file, never a
+// torn one. For a few counters and numbers, not for bulk data.
+#pragma once
+
+#include <map>
+#include <string>
+
+namespace sss::core {
+
+// A directory a process writes to: `configured` when set, else the one systemd passes in the
+// environment ($STATE_DIRECTORY for StateDirectory=, $LOGS_DIRECTORY for LogsDirectory=; its
+// first entry: systemd joins several with ':'), else "" (nothing written). env_value may be null
+// (the variable unset).
+std::string resolveSystemdDirectory(const std::string& configured, const char* env_value);
+
+using StateValues = std::map<std::string, std::string>;
+
+// Writes `format` then one `key value` line per entry to path (keys without spaces or newlines,
+// values without newlines). False with `error` set when it cannot; the old file is then intact.
+bool writeStateFile(const std::string& path, const std::string& format, const StateValues& values, std::string& error);
+
+// Reads a file written by writeStateFile. False with `error` when it is missing, of another
+// format, or malformed (a line without a value, a duplicate key).
+bool readStateFile(const std::string& path, const std::string& format, StateValues& values, std::string& error);
+
+// Numeric value of `key`; false when absent or not entirely a finite number / an integer.
+bool stateNumber(const StateValues& values, const std::string& key, double& number);
+bool stateInteger(const StateValues& values, const std::string& key, long long& number);
+
+}  // namespace sss::core
