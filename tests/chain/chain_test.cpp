@@ -405,4 +405,24 @@ TEST_F(LiveChainTest, SonarLinkDropsAndAnInsOutageDoNotStopTheChain) {
   EXPECT_LT(a.slam_m, a.dr_m);
 }
 
+TEST_F(LiveChainTest, AnInsStallThatLeavesTheNavLateLosesNoPing) {
+  // The INS emulator stops for 0.5 s after burst 3786 of 7571 and then carries on where it was
+  // (a stall: nothing skipped), so from mid-mission on every nav sample reaches the chain 10 s of
+  // mission time after the ping it brackets. The subframe buffer holds pings up to 30 s for
+  // their nav: none is lost.
+  const ChainRun run = runLive("ins_stall", "--ins-emulator-args \"--pause-every 3786 --pause-s 0.5\"");
+  ASSERT_EQ(run.exit_code, 0) << "see " << run.dir << "/logs";
+  expectCleanExits(run);
+  const std::string ins = readFile(run.dir + "/logs/ins-emulator.log");
+  EXPECT_NE(ins.find(", 1 pauses, 0 skipped"), std::string::npos) << ins;
+  const double pings = static_cast<double>(truth_.size());
+  EXPECT_EQ(statusCounter(run.status, "sss-subframe-buffer", "pings_dropped_without_nav"), 0.0);
+  EXPECT_EQ(statusCounter(run.status, "sss-subframe-buffer", "pings_fused"), pings);
+  EXPECT_EQ(statusCounter(run.status, "sss-subframe-buffer", "subframes_out"), 6.0);
+  const Accuracy a = accuracy(run.dir + "/optimiser/products/slam.tum");
+  std::printf("INS stall (nav 10 s late from mid-mission): horizontal ATE RMSE DR %.3f m, SLAM %.3f m (%zu poses)\n",
+              a.dr_m, a.slam_m, a.poses);
+  EXPECT_LT(a.slam_m, 0.75 * a.dr_m);
+}
+
 }  // namespace
