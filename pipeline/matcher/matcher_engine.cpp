@@ -1,5 +1,5 @@
 // The matcher stage without middleware: stored subframes, overlap search, pair matching and the
-// iterative re-association with optimised poses.
+// iterative re-association with optimised poses; its state kept in a MatcherStateStore.
 #include "pipeline/matcher/matcher_engine.hpp"
 
 #include <algorithm>
@@ -137,23 +137,42 @@ std::vector<PairOutcome> MatcherEngine::addSubframe(sss::subframe::Subframe subf
   const int64_t id = subframe.id;
   Stored& stored = stored_[id];
   stored.subframe = std::move(subframe);
+  setCorrection(stored, newSubframeCorrection(id, stored.subframe.line_id));
+  // On disk before matching: if the process dies while matching, restore() finds the subframe
+  // without a state entry and matches it then.
+  std::string error;
+  if (store_ && !store_->writeSubframe(stored.subframe, error)) recordStateError(error);
+  outcomes = matchNewSubframe(id, allFootprints());
+  evictBeyondLimit();
+  saveState();
+  return outcomes;
+}
+
+Pose MatcherEngine::newSubframeCorrection(int64_t id, int line_id) const {
   // A new subframe inherits the correction of the newest stored one of its line, else of the
   // newest stored subframe: the optimiser has not seen it yet, and DR continues from there.
   Pose correction = Pose::identity();
   for (auto it = stored_.rbegin(); it != stored_.rend(); ++it) {
     if (it->first == id) continue;
     correction = it->second.correction;
-    if (it->second.subframe.line_id == stored.subframe.line_id) break;
+    if (it->second.subframe.line_id == line_id) break;
   }
-  setCorrection(stored, correction);
+  return correction;
+}
 
+std::vector<PairOutcome> MatcherEngine::matchNewSubframe(int64_t id, const std::vector<Footprint>& others) {
+  std::vector<PairOutcome> outcomes;
   // findOverlaps skips the subframe's own footprint.
-  const std::vector<OverlapCandidate> candidates = findOverlaps(stored.footprint, allFootprints(), options_.overlap);
-  for (const OverlapCandidate& candidate : candidates) {
+  for (const OverlapCandidate& candidate : findOverlaps(stored_.at(id).footprint, others, options_.overlap)) {
     const PairKey key{std::min(candidate.subframe_id, id), std::max(candidate.subframe_id, id)};
+    if (pairs_.count(key)) continue;  // matched before a restart
     outcomes.push_back(matchStored(key, 0));
   }
-  // Bounded memory: drop the oldest subframes and their pairs.
+  return outcomes;
+}
+
+void MatcherEngine::evictBeyondLimit() {
+  // Bounded memory and disk: drop the oldest subframes, their pairs and their files.
   while (static_cast<int>(stored_.size()) > options_.max_stored_subframes) {
     const int64_t oldest = stored_.begin()->first;
     stored_.erase(stored_.begin());
@@ -161,8 +180,102 @@ std::vector<PairOutcome> MatcherEngine::addSubframe(sss::subframe::Subframe subf
       it = it->first.first == oldest || it->first.second == oldest ? pairs_.erase(it) : std::next(it);
     }
     ++counters_.subframes_evicted;
+    std::string error;
+    if (store_ && !store_->removeSubframe(oldest, error)) recordStateError(error);
   }
-  return outcomes;
+}
+
+MatcherState MatcherEngine::state() const {
+  MatcherState state;
+  state.corrections.reserve(stored_.size());
+  for (const auto& [id, stored] : stored_) state.corrections.push_back({id, stored.correction});
+  state.pairs.reserve(pairs_.size());
+  for (const auto& [key, pair] : pairs_) {
+    state.pairs.push_back({key.first, key.second, pair.rounds_done, pair.relative_at_match});
+  }
+  return state;
+}
+
+void MatcherEngine::saveState() {
+  std::string error;
+  if (store_ && !store_->writeState(state(), error)) recordStateError(error);
+}
+
+void MatcherEngine::recordStateError(const std::string& error) {
+  ++counters_.state_write_errors;
+  state_error_ = error;
+}
+
+std::string MatcherEngine::takeStateError() {
+  std::string error;
+  error.swap(state_error_);
+  return error;
+}
+
+RestoreReport MatcherEngine::restore(MatcherStateStore& store) {
+  if (store_ || !stored_.empty()) throw std::logic_error("MatcherEngine::restore: call once, on an empty engine");
+  RestoreReport report;
+  report.directory = store.directory();
+  std::string error;
+  if (!store.open(error)) {
+    ++counters_.state_write_errors;
+    report.problems.push_back(error + "; the matcher's state is not kept");
+    return report;
+  }
+  store_ = &store;
+
+  MatcherState state;
+  const StateFileStatus state_status = store.readState(state, error);
+  report.state_file_found = state_status == StateFileStatus::kOk;
+  if (state_status == StateFileStatus::kCorrupt) {
+    ++counters_.state_files_corrupt;
+    report.problems.push_back(error + "; restoring the subframes without it (no corrections, pairs matched again)");
+  }
+  std::map<int64_t, Pose> corrections;
+  for (const SubframeCorrection& c : state.corrections) corrections[c.subframe_id] = c.correction;
+
+  std::vector<int64_t> without_state;
+  for (const int64_t id : store.subframeIds()) {  // ascending: a missing correction is inherited as when it came
+    sss::subframe::Subframe subframe;
+    const StateFileStatus status = store.readSubframe(id, subframe, error);
+    if (status == StateFileStatus::kMissing) continue;
+    if (status == StateFileStatus::kCorrupt) {
+      ++counters_.state_files_corrupt;
+      // Never usable; removed so it is not reported at every start. The LCM log keeps the message.
+      std::string removal_error;
+      report.problems.push_back(error + (store.removeSubframe(id, removal_error) ? "; skipped and removed"
+                                                                                   : "; skipped; " + removal_error));
+      continue;
+    }
+    Stored& stored = stored_[id];
+    stored.subframe = std::move(subframe);
+    const auto correction = corrections.find(id);
+    if (correction == corrections.end()) without_state.push_back(id);
+    setCorrection(stored, correction != corrections.end() ? correction->second
+                                                          : newSubframeCorrection(id, stored.subframe.line_id));
+  }
+  for (const PairRecord& p : state.pairs) {
+    if (p.subframe_id_a < p.subframe_id_b && stored_.count(p.subframe_id_a) && stored_.count(p.subframe_id_b)) {
+      pairs_[{p.subframe_id_a, p.subframe_id_b}] = PairState{p.rounds_done, p.relative_at_match};
+    }
+  }
+  evictBeyondLimit();  // max_stored_subframes may be smaller than before the restart
+  counters_.subframes_restored = stored_.size();
+  counters_.pairs_restored = pairs_.size();
+
+  // Subframes stored but not (all) matched when the process died: their pairs, as addSubframe
+  // would have matched them (against the older subframes), except those already done.
+  for (const int64_t id : without_state) {
+    if (!stored_.count(id)) continue;  // evicted
+    std::vector<Footprint> older;
+    for (auto it = stored_.begin(); it != stored_.end() && it->first < id; ++it) older.push_back(it->second.footprint);
+    for (PairOutcome& outcome : matchNewSubframe(id, older)) report.outcomes.push_back(std::move(outcome));
+  }
+  saveState();
+  report.subframes = counters_.subframes_restored;
+  report.pairs = counters_.pairs_restored;
+  report.subframes_without_state = without_state.size();
+  return report;
 }
 
 std::vector<PairOutcome> MatcherEngine::updateTrajectory(const std::vector<TrajectoryNode>& nodes) {
@@ -176,7 +289,11 @@ std::vector<PairOutcome> MatcherEngine::updateTrajectory(const std::vector<Traje
     setCorrection(it->second, correction);
     moved = true;
   }
-  if (!moved || options_.max_association_rounds == 0) return outcomes;
+  if (!moved) return outcomes;
+  if (options_.max_association_rounds == 0) {
+    saveState();
+    return outcomes;
+  }
 
   // Re-association: pairs already matched whose relative pose moved (paper: n_iter rounds).
   std::vector<std::pair<PairKey, int>> jobs;
@@ -202,6 +319,7 @@ std::vector<PairOutcome> MatcherEngine::updateTrajectory(const std::vector<Traje
   std::sort(jobs.begin(), jobs.end());
   jobs.erase(std::unique(jobs.begin(), jobs.end()), jobs.end());
   for (const auto& [key, round] : jobs) outcomes.push_back(matchStored(key, round));
+  saveState();
   return outcomes;
 }
 

@@ -1,6 +1,7 @@
 // The matcher stage without middleware: keeps recent subframes, finds overlapping pairs from their
 // footprints under the latest optimised poses, matches them and returns loop closures; re-matches
-// pairs the optimiser has moved (the paper's iterative data association, n_iter rounds).
+// pairs the optimiser has moved (the paper's iterative data association, n_iter rounds). With a
+// MatcherStateStore it keeps its state on disk and a restarted engine continues from there.
 #pragma once
 
 #include <Eigen/Core>
@@ -13,6 +14,7 @@
 
 #include "pipeline/core/config.hpp"
 #include "pipeline/core/pose.hpp"
+#include "pipeline/matcher/matcher_state.hpp"
 #include "pipeline/matcher/overlap.hpp"
 #include "pipeline/matcher/pair_matcher.hpp"
 #include "pipeline/subframe/subframe_builder.hpp"
@@ -97,6 +99,22 @@ struct MatcherEngineCounters {
   uint64_t pairs_rejected = 0;
   uint64_t rematches = 0;           // attempts with optimised poses (round >= 1)
   double pair_seconds_total = 0.0;
+  // State directory (restore()).
+  uint64_t subframes_restored = 0;
+  uint64_t pairs_restored = 0;      // pairs known as matched at restore
+  uint64_t state_files_corrupt = 0; // unreadable subframe or state files at restore: skipped
+  uint64_t state_write_errors = 0;  // failed writes or removals in the state directory
+};
+
+// What restore() found, for the node's log.
+struct RestoreReport {
+  std::string directory;
+  bool state_file_found = false;
+  size_t subframes = 0;            // restored
+  size_t pairs = 0;                // restored as already matched
+  size_t subframes_without_state = 0;  // stored but not (all) matched before the restart
+  std::vector<std::string> problems;   // one per skipped file or failed write: path and reason
+  std::vector<PairOutcome> outcomes;   // the pairs of those subframes, matched now
 };
 
 class MatcherEngine {
@@ -111,6 +129,21 @@ class MatcherEngine {
   // applied to all its pings. Pairs whose relative pose moved beyond the thresholds are re-matched
   // (up to max_association_rounds), pairs that overlap only under the new poses are tried.
   std::vector<PairOutcome> updateTrajectory(const std::vector<TrajectoryNode>& nodes);
+
+  // Restores the subframes and the pair bookkeeping from the store, then keeps the store up to date:
+  // each subframe's file is written when it is stored (before its pairs are matched) and removed
+  // when it is evicted, the state file is rewritten after each addSubframe and updateTrajectory.
+  // Subframes are restored in id order with their saved corrections; pairs saved as matched are not
+  // matched again. A subframe file without a state entry was stored but the process died while
+  // matching it: it gets the correction a new subframe would get (identity when nothing is known)
+  // and its pairs are matched here as addSubframe would have. Bad files are skipped, counted and
+  // reported, the rest is restored. Call once, on an empty engine; the store must outlive it.
+  RestoreReport restore(MatcherStateStore& store);
+  // The newest failed write in the state directory since the last call ("" when none).
+  std::string takeStateError();
+
+  // The bookkeeping the state file keeps: stored subframes' corrections and pairs, in id order.
+  MatcherState state() const;
 
   const MatcherEngineCounters& counters() const { return counters_; }
   size_t storedSubframes() const { return stored_.size(); }
@@ -133,12 +166,19 @@ class MatcherEngine {
   void setCorrection(Stored& stored, const sss::core::Pose& correction);
   PairOutcome matchStored(const PairKey& key, int round);
   std::vector<Footprint> allFootprints() const;
+  sss::core::Pose newSubframeCorrection(int64_t id, int line_id) const;
+  std::vector<PairOutcome> matchNewSubframe(int64_t id, const std::vector<Footprint>& others);
+  void evictBeyondLimit();
+  void saveState();
+  void recordStateError(const std::string& error);
 
   MatcherEngineOptions options_;
   DenseMatcher dense_;
   std::map<int64_t, Stored> stored_;
   std::map<PairKey, PairState> pairs_;
   MatcherEngineCounters counters_;
+  MatcherStateStore* store_ = nullptr;  // none: nothing persisted
+  std::string state_error_;
 };
 
 }  // namespace sss::matcher

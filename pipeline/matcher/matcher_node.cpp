@@ -1,13 +1,16 @@
 // sss-matcher: SSS_SUBFRAME + SSS_TRAJECTORY -> SSS_LOOP. Translation only; the logic is in
 // MatcherEngine. Matching a pair takes about a second, so it runs on a worker thread and the
-// process loop stays free for LCM, SSS_STATUS and the systemd watchdog.
+// process loop stays free for LCM, SSS_STATUS and the systemd watchdog. The stored subframes and
+// the pair bookkeeping are kept in the state directory; the worker restores them first at start.
 //   sss-matcher [--config FILE [--check-config]] [--lcm-url URL]
 #include <sys/eventfd.h>
 #include <unistd.h>
 
 #include <condition_variable>
 #include <cstdio>
+#include <cstdlib>
 #include <deque>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -34,6 +37,9 @@ struct NodeOptions {
   // (at 50 s per subframe and ~1 s per pair the queue stays empty; a long stall must not grow
   // memory without bound).
   int max_queued_subframes = 32;
+  // Stored subframes and pair bookkeeping (MatcherStateStore). Empty: $STATE_DIRECTORY (systemd
+  // StateDirectory=), else none: a restart then loses them.
+  std::string state_directory;
 };
 
 // Work for the matcher thread, in arrival order; only the newest trajectory matters.
@@ -75,6 +81,9 @@ int main(int argc, char** argv) {
     section.optional("trajectory_channel", options.trajectory_channel, {nonEmpty()});
     section.optional("loop_channel", options.loop_channel, {nonEmpty()});
     section.optional("max_queued_subframes", options.max_queued_subframes, {inRange(1, 10000)});
+    section.optional("state_directory", options.state_directory,
+                     {satisfies<std::string>([](const std::string& v) { return v.empty() || v.front() == '/'; },
+                                             "\"\" or an absolute path")});
     section.rejectUnknownKeys();
     for (const std::string& problem : sss::matcher::validateMatcherEngineOptions(options.engine)) {
       section.addProblem("matcher", "", problem);
@@ -85,11 +94,21 @@ int main(int argc, char** argv) {
     return code;
   }
   if (!arguments.lcm_url_override.empty()) options.process.lcm_url = arguments.lcm_url_override;
+  if (options.state_directory.empty()) {
+    if (const char* state = std::getenv("STATE_DIRECTORY")) options.state_directory = state;
+  }
 
   sss::transport::initLogging(options.process.process_name, options.process.log_level);
   sss::transport::ProcessLoop loop(options.process);
   sss::core::HealthMonitor& health = loop.health();
   sss::matcher::MatcherEngine engine(options.engine);
+  std::unique_ptr<sss::matcher::MatcherStateStore> store;
+  if (!options.state_directory.empty()) {
+    store = std::make_unique<sss::matcher::MatcherStateStore>(options.state_directory);
+  } else {
+    spdlog::warn("no state directory (config matcher.state_directory or $STATE_DIRECTORY): a restart loses the "
+                 "stored subframes");
+  }
   WorkQueue work;
   Results results;
   const int results_fd = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
@@ -98,7 +117,42 @@ int main(int argc, char** argv) {
     return 1;
   }
 
+  // Hands the engine's results to the process loop (worker thread).
+  auto handOver = [&](std::vector<sss::matcher::PairOutcome> outcomes, int64_t arrival) {
+    const std::string state_error = engine.takeStateError();
+    if (!state_error.empty() && health.recordError("state_write", state_error, sss::core::nowUtime()))
+      spdlog::warn("state directory: {}; further failures are counted in SSS_STATUS", state_error);
+    {
+      std::lock_guard<std::mutex> lock(results.mutex);
+      for (auto& outcome : outcomes) results.outcomes.emplace_back(std::move(outcome), arrival);
+      results.counters = engine.counters();
+      results.stored = engine.storedSubframes();
+      results.memory_bytes = engine.memoryBytes();
+      results.busy = false;
+    }
+    const uint64_t one = 1;
+    if (write(results_fd, &one, sizeof one) < 0) {
+      // The counter saturates only after 2^64 - 1 writes; nothing to do.
+    }
+  };
+
   std::thread worker([&] {
+    // First the state of the previous run (seconds for hundreds of subframes): the loop meanwhile
+    // answers the watchdog and queues what arrives.
+    if (store) {
+      {
+        std::lock_guard<std::mutex> lock(results.mutex);
+        results.busy = true;
+      }
+      sss::matcher::RestoreReport report = engine.restore(*store);
+      for (const std::string& problem : report.problems) spdlog::error("state directory: {}", problem);
+      spdlog::info("restored {} subframes and {} matched pairs from {}{}; {} subframe(s) stored but not matched "
+                   "before the restart: {} pair(s) matched now",
+                   report.subframes, report.pairs, report.directory,
+                   report.state_file_found ? "" : " (without matcher.state)", report.subframes_without_state,
+                   report.outcomes.size());
+      handOver(std::move(report.outcomes), sss::core::monotonicUtime());
+    }
     for (;;) {
       std::optional<std::pair<sss::subframe::Subframe, int64_t>> subframe;
       std::optional<std::vector<sss::matcher::TrajectoryNode>> trajectory;
@@ -121,20 +175,8 @@ int main(int argc, char** argv) {
         results.busy = true;
       }
       const int64_t arrival = subframe ? subframe->second : sss::core::monotonicUtime();
-      std::vector<sss::matcher::PairOutcome> outcomes =
-          subframe ? engine.addSubframe(std::move(subframe->first)) : engine.updateTrajectory(*trajectory);
-      {
-        std::lock_guard<std::mutex> lock(results.mutex);
-        for (auto& outcome : outcomes) results.outcomes.emplace_back(std::move(outcome), arrival);
-        results.counters = engine.counters();
-        results.stored = engine.storedSubframes();
-        results.memory_bytes = engine.memoryBytes();
-        results.busy = false;
-      }
-      const uint64_t one = 1;
-      if (write(results_fd, &one, sizeof one) < 0) {
-        // The counter saturates only after 2^64 - 1 writes; nothing to do.
-      }
+      handOver(subframe ? engine.addSubframe(std::move(subframe->first)) : engine.updateTrajectory(*trajectory),
+               arrival);
     }
   });
 
@@ -223,6 +265,10 @@ int main(int argc, char** argv) {
     set("closures_accepted", static_cast<double>(c.closures_accepted));
     set("pairs_rejected", static_cast<double>(c.pairs_rejected));
     set("rematches", static_cast<double>(c.rematches));
+    set("subframes_restored", static_cast<double>(c.subframes_restored));
+    set("pairs_restored", static_cast<double>(c.pairs_restored));
+    set("state_files_corrupt", static_cast<double>(c.state_files_corrupt));
+    set("state_write_errors", static_cast<double>(c.state_write_errors));
     set("mean_pair_s", c.pairs_attempted ? c.pair_seconds_total / static_cast<double>(c.pairs_attempted) : 0.0);
     set("memory_bytes", static_cast<double>(memory));
     set("busy", busy ? 1.0 : 0.0);

@@ -360,10 +360,16 @@ TEST_F(LiveChainTest, InsBridgeKilledMidMissionResumesItsOdometer) {
   EXPECT_NE(log.find("resumed the odometer from"), std::string::npos) << log;
 }
 
-// Known gap, kept here so it runs once fixed: the matcher keeps its stored subframes only in
-// memory: restarted mid-line 1 it never matches anything against line 0 again, and the line 1-2
-// closures alone make SLAM worse than DR (measured: DR 0.57 m, SLAM 0.79-0.81 m).
-TEST_F(LiveChainTest, DISABLED_MatcherKilledMidMissionStillBeatsDeadReckoning) { killAndRestart("sss-matcher"); }
+// The matcher restores its stored subframes and pair bookkeeping from its state directory:
+// restarted mid-line 1 it still matches lines 1 and 2 against line 0, and sends no closure twice.
+TEST_F(LiveChainTest, MatcherKilledMidMissionRestoresItsSubframes) {
+  killAndRestart("sss-matcher");
+  const std::string dir = root_ + "/kill_sss-matcher";
+  const std::string status = readFile(dir + "/logs/final_status.txt");
+  EXPECT_GE(statusCounter(status, "sss-matcher", "subframes_restored"), 1.0) << status;
+  EXPECT_EQ(statusCounter(status, "sss-matcher", "state_files_corrupt"), 0.0) << status;
+  EXPECT_GE(statusCounter(status, "sss-optimiser", "closures_accepted"), 4.0) << status;
+}
 
 // ---- link faults ------------------------------------------------------------------------------
 

@@ -2,6 +2,8 @@
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // lcm-gen decode() false positive at -O3
 // SSS_SUBFRAME, loop closures between the overlapping lines come out on SSS_LOOP and decode; a
 // malformed subframe and a malformed trajectory are counted, not fatal; SIGTERM stops it cleanly.
+// Killed with SIGKILL and started again, it restores its subframes from the state directory and
+// matches new lines against the old ones, without sending the old closures again.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <spawn.h>
@@ -10,6 +12,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <map>
 #include <set>
 #include <thread>
 
@@ -101,6 +105,76 @@ TEST(MatcherNode, SubframesInLoopClosuresOutBadMessagesCounted) {
     const double nees = error.transpose() * c.covariance.topLeftCorner<2, 2>().inverse() * error;
     EXPECT_LT(nees, 13.8) << c.subframe_id_a << "-" << c.subframe_id_b;
   }
+}
+
+TEST(MatcherNode, RestartAfterSigkillRestoresStateAndMatchesNewLinesAgainstOldOnes) {
+  const auto& survey = test::threeLineSurvey();
+  const std::string dir = ::testing::TempDir() + "/matcher_node_restart_" + std::to_string(getpid());
+  std::filesystem::create_directories(dir);
+  const std::string lcm_url =
+      "udpm://239.255.76.67:" + std::to_string(29000 + getpid() % 2000) + "?ttl=0&recv_buf_size=16777216";
+  const std::string config = dir + "/matcher.yaml";
+  {
+    std::ofstream file(config);
+    file << "matcher:\n  lcm_url: \"" << lcm_url << "\"\n  log_level: warn\n  state_directory: \"" << dir
+         << "/state\"\n";
+  }
+  sss::core::HealthMonitor health(sss::core::monotonicUtime());
+  sss::transport::LcmBus bus(lcm_url, health);
+  ASSERT_TRUE(bus.good());
+  std::vector<std::pair<int64_t, int64_t>> closures;  // in arrival order
+  bus.subscribe<sss_msgs::loop_closure_t>("SSS_LOOP", [&](const sss_msgs::loop_closure_t& message) {
+    closures.push_back({message.subframe_id_a, message.subframe_id_b});
+  });
+  std::map<std::string, double> status;  // the newest SSS_STATUS counters of sss-matcher
+  bus.subscribe<sss_msgs::status_t>("SSS_STATUS", [&](const sss_msgs::status_t& message) {
+    if (message.process != "sss-matcher") return;
+    for (int i = 0; i < message.num_counters; ++i) status[message.counter_name[i]] = message.counter_value[i];
+  });
+  auto waitFor = [&](const std::function<bool()>& done) {
+    const int64_t deadline = sss::core::monotonicUtime() + 60'000'000;
+    while (!done() && sss::core::monotonicUtime() < deadline) bus.handleTimeout(100);
+    return done();
+  };
+  auto publish = [&](int64_t id) {
+    for (const auto& subframe : survey.subframes) {
+      if (subframe.id == id) bus.publish("SSS_SUBFRAME", sss::subframe::toSubframeMessage(subframe, 16, 16.0));
+    }
+    bus.handleTimeout(100);
+  };
+
+  // Lines 0 and 1, then SIGKILL once their three pairs are matched (the state file is written
+  // before the closures go out).
+  pid_t matcher = sss::test::spawnProcess({SSS_MATCHER_PATH, "--config", config});
+  ASSERT_GT(matcher, 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  for (int64_t id : {0, 1, 2, 3}) publish(id);
+  EXPECT_TRUE(waitFor([&] { return closures.size() >= 3; })) << closures.size() << " closures";
+  ::kill(matcher, SIGKILL);
+  ::waitpid(matcher, nullptr, 0);
+  const size_t closures_before = closures.size();
+  status.clear();
+
+  matcher = sss::test::spawnProcess({SSS_MATCHER_PATH, "--config", config});
+  ASSERT_GT(matcher, 0);
+  EXPECT_TRUE(waitFor([&] { return status.count("subframes_restored"); }));
+  EXPECT_EQ(status["subframes_restored"], 4.0);
+  EXPECT_EQ(status["pairs_restored"], 3.0);
+  EXPECT_EQ(status["state_files_corrupt"], 0.0);
+  for (int64_t id : {4, 5}) publish(id);
+  // Line 2 overlaps lines 0 and 1 (pairs 0-4, 2-4, 3-4, 1-5, 2-5 in the DR round).
+  EXPECT_TRUE(waitFor([&] { return status["pairs_attempted"] >= 4.0 && status["busy"] == 0.0; }));
+  bus.handleTimeout(500);
+  ::kill(matcher, SIGTERM);
+  EXPECT_EQ(sss::test::waitExitCode(matcher), 0);
+  std::filesystem::remove_all(dir);
+
+  std::set<int64_t> old_partners_of_new;
+  for (size_t i = closures_before; i < closures.size(); ++i) {
+    EXPECT_GE(closures[i].second, 4) << "an old pair sent again: " << closures[i].first << "-" << closures[i].second;
+    if (closures[i].first <= 3) old_partners_of_new.insert(closures[i].first);
+  }
+  EXPECT_GE(old_partners_of_new.size(), 2u);  // at least 0 and 2 (the full subframes)
 }
 
 }  // namespace
