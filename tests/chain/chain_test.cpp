@@ -411,14 +411,19 @@ TEST_F(LiveChainTest, SonarLinkDropsAndAnInsOutageDoNotStopTheChain) {
   EXPECT_LT(a.slam_m, a.dr_m);
 }
 
-TEST_F(LiveChainTest, AnInsStallThatLeavesTheNavLateLosesNoPing) {
+TEST_F(LiveChainTest, AnInsStallThatLeavesTheNavLateLosesNoPingNorDoesALoggerRestart) {
   // The INS emulator stops for 0.5 s after burst 3786 of 7571 and then carries on where it was
   // (a stall: nothing skipped), so from mid-mission on every nav sample reaches the chain 10 s of
   // mission time after the ping it brackets. The subframe buffer holds pings up to 30 s for
   // their nav: none is lost.
-  const ChainRun run = runLive("ins_stall", "--ins-emulator-args \"--pause-every 3786 --pause-s 0.5\"");
+  // The LCM logger is killed too (at +9 s) and restarted: it records the rest in chain.lcm.1.
+  const ChainRun run = runLive("ins_stall", "--ins-emulator-args \"--pause-every 3786 --pause-s 0.5\" "
+                                            "--restart-on-failure --kill9 lcm-logger@9");
   ASSERT_EQ(run.exit_code, 0) << "see " << run.dir << "/logs";
   expectCleanExits(run);
+  EXPECT_NE(run.events.find("lcm-logger restarted"), std::string::npos) << run.events;
+  EXPECT_GT(fs::file_size(run.dir + "/chain.lcm"), 1000000u);
+  EXPECT_GT(fs::file_size(run.dir + "/chain.lcm.1"), 1000000u) << "the restarted logger recorded nothing";
   const std::string ins = readFile(run.dir + "/logs/ins-emulator.log");
   EXPECT_NE(ins.find(", 1 pauses, 0 skipped"), std::string::npos) << ins;
   const double pings = static_cast<double>(truth_.size());
