@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <set>
+#include <string>
 
 namespace sss::optimiser {
 
@@ -13,6 +15,17 @@ using sss::core::Pose;
 namespace {
 // A subframe pair in either order: (older id, newer id).
 std::pair<int64_t, int64_t> pairKey(int64_t a, int64_t b) { return {std::min(a, b), std::max(a, b)}; }
+
+// At most `limit` correspondences, evenly spread (idempotent: a thinned list is kept as it is).
+std::vector<sss::matcher::ClosureCorrespondence> thinned(const std::vector<sss::matcher::ClosureCorrespondence>& all,
+                                                         int limit) {
+  const size_t count = all.size();
+  const size_t keep = std::min(count, static_cast<size_t>(std::max(limit, 0)));
+  std::vector<sss::matcher::ClosureCorrespondence> out;
+  out.reserve(keep);
+  for (size_t k = 0; k < keep; ++k) out.push_back(all[k * count / keep]);
+  return out;
+}
 }  // namespace
 
 void readOptimiserEngineOptions(sss::core::ConfigSection& section, OptimiserEngineOptions& options) {
@@ -26,6 +39,7 @@ void readOptimiserEngineOptions(sss::core::ConfigSection& section, OptimiserEngi
   section.optional("max_trajectory_nodes", options.max_trajectory_nodes, {inRange(1, 100000)});
   section.optional("max_pending_closures", options.max_pending_closures, {inRange(0, 100000)});
   section.optional("max_stored_subframes", options.max_stored_subframes, {inRange(1, 1000000)});
+  section.optional("odometer_reset_tolerance_m", options.odometer_reset_tolerance_m, {inRange(0.0, 1e6)});
 }
 
 std::vector<std::string> validateOptimiserEngineOptions(const OptimiserEngineOptions& options) {
@@ -34,6 +48,7 @@ std::vector<std::string> validateOptimiserEngineOptions(const OptimiserEngineOpt
   if (options.max_trajectory_nodes < 1) errors.push_back("max_trajectory_nodes must be >= 1");
   if (options.max_pending_closures < 0) errors.push_back("max_pending_closures must be >= 0");
   if (options.max_stored_subframes < 1) errors.push_back("max_stored_subframes must be >= 1");
+  if (!(options.odometer_reset_tolerance_m >= 0.0)) errors.push_back("odometer_reset_tolerance_m must be >= 0");
   return errors;
 }
 
@@ -66,11 +81,42 @@ Status OptimiserEngine::addSubframe(const sss::subframe::Subframe& subframe) {
     return Status::error("subframe " + std::to_string(subframe.id) + " has no centre ping");
   }
   const sss::subframe::SubframePing& centre = subframe.centre();
-  const Status added = graph_.addNode(subframe.id, centre.utime_us, centre.T_world_body, centre.distance_travelled_m);
+  const double input_m = centre.distance_travelled_m;
+  if (!std::isfinite(input_m)) {
+    ++counters_.subframes_refused;
+    return Status::error("subframe " + std::to_string(subframe.id) + ": distance travelled is not finite; dropped");
+  }
+  // The graph needs a monotonic odometer; the INS's restarts at 0 with its bridge.
+  double offset_m = odometer_offset_m_;
+  double distance_m = input_m + offset_m;
+  std::string notice;
+  if (const std::optional<NodeState> previous = graph_.newestNode()) {
+    if (input_m < last_input_distance_m_ - options_.odometer_reset_tolerance_m) {
+      // Odometer reset: the distance since the previous node is lost; the horizontal straight line
+      // between the DR positions is the figure left (a lower bound of the path, exact on a line).
+      const double straight_m =
+          (centre.T_world_body.translation - previous->T_world_body_dr.translation).head<2>().norm();
+      distance_m = previous->distance_travelled_m + straight_m;
+      offset_m = distance_m - input_m;
+      char text[320];
+      std::snprintf(text, sizeof(text),
+                    "subframe %lld: INS odometer went back from %.3f m to %.3f m (odometer reset); distance from "
+                    "the previous node taken as the straight line between their DR positions, %.3f m; graph "
+                    "odometer offset now %.3f m",
+                    static_cast<long long>(subframe.id), last_input_distance_m_, input_m, straight_m, offset_m);
+      notice = text;
+    } else {
+      distance_m = std::max(distance_m, previous->distance_travelled_m);  // jitter within the tolerance
+    }
+  }
+  const Status added = graph_.addNode(subframe.id, centre.utime_us, centre.T_world_body, distance_m);
   if (!added.ok) {
     ++counters_.subframes_refused;
     return added;
   }
+  if (!notice.empty()) ++counters_.odometer_resets;
+  odometer_offset_m_ = offset_m;
+  last_input_distance_m_ = input_m;
   StoredSubframe& stored = stored_[subframe.id];
   stored.T_body_sonar = subframe.geometry.T_body_sonar;
   stored.centre_index = subframe.centre_ping_index;
@@ -78,6 +124,7 @@ Status OptimiserEngine::addSubframe(const sss::subframe::Subframe& subframe) {
     stored.utime_us.push_back(ping.utime_us);
     stored.dr.push_back(ping.T_world_body);
   }
+  unjournaled_subframes_.push_back(subframe.id);
   while (static_cast<int>(stored_.size()) > options_.max_stored_subframes) {
     stored_.erase(stored_.begin());
     ++counters_.subframes_forgotten;
@@ -98,7 +145,9 @@ Status OptimiserEngine::addSubframe(const sss::subframe::Subframe& subframe) {
     }
   }
   waiting_ = std::move(still_waiting);
-  return Status::success();
+  Status result = Status::success();
+  result.message = notice;
+  return result;
 }
 
 Status OptimiserEngine::addLoopClosure(const sss::matcher::LoopClosure& closure) {
@@ -106,7 +155,9 @@ Status OptimiserEngine::addLoopClosure(const sss::matcher::LoopClosure& closure)
   const bool known = graph_.estimate(closure.subframe_id_a) && graph_.estimate(closure.subframe_id_b);
   if (!known && std::max(closure.subframe_id_a, closure.subframe_id_b) > newest_subframe_id_ &&
       options_.max_pending_closures > 0) {
+    // Thinned now as addToGraph would: bounds what waits (and the checkpoint) without changing it.
     waiting_.push_back(closure);
+    waiting_.back().correspondences = thinned(closure.correspondences, options_.bathymetry.max_points_per_closure);
     if (static_cast<int>(waiting_.size()) > options_.max_pending_closures) {
       waiting_.pop_front();
       ++counters_.closures_refused;
@@ -140,11 +191,8 @@ Status OptimiserEngine::addToGraph(const sss::matcher::LoopClosure& closure) {
   StoredCorrespondences& stored = correspondences_[key];
   stored.association_round = closure.association_round;
   stored.mean_zncc = closure.mean_zncc;
-  stored.correspondences.clear();
-  const size_t count = closure.correspondences.size();
-  const size_t limit = static_cast<size_t>(options_.bathymetry.max_points_per_closure);
-  const size_t keep = std::min(count, limit);
-  for (size_t k = 0; k < keep; ++k) stored.correspondences.push_back(closure.correspondences[k * count / keep]);
+  stored.correspondences = thinned(closure.correspondences, options_.bathymetry.max_points_per_closure);
+  unjournaled_pairs_.insert(key);
   // A closure stored as (b, a) has its correspondences the other way round.
   if (closure.subframe_id_a != key.first) {
     for (auto& c : stored.correspondences) {
@@ -155,13 +203,6 @@ Status OptimiserEngine::addToGraph(const sss::matcher::LoopClosure& closure) {
     }
   }
   return added;
-}
-
-Status OptimiserEngine::loadCheckpoint(const std::string& path) {
-  const Status loaded = graph_.loadCheckpoint(path);
-  if (!loaded.ok) return loaded;
-  for (const NodeState& node : graph_.nodes()) newest_subframe_id_ = std::max(newest_subframe_id_, node.subframe_id);
-  return loaded;
 }
 
 UpdateReport OptimiserEngine::update() {

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <deque>
 #include <map>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -31,6 +32,10 @@ struct OptimiserEngineOptions {
   // Ping poses kept per subframe for the per-ping trajectory and the bathymetry: 200 pings of a
   // subframe take ~20 kB, 5000 subframes (~70 h of survey) ~100 MB. Oldest dropped first.
   int max_stored_subframes = 5000;
+  // The INS odometer (distance_travelled_m) restarts at 0 when its bridge restarts: a centre whose
+  // distance is lower than the previous one's by more than this is an odometer reset (see
+  // addSubframe); a smaller decrease is jitter and counts as no distance.
+  double odometer_reset_tolerance_m = 1.0;
 };
 
 void readOptimiserEngineOptions(sss::core::ConfigSection& section, OptimiserEngineOptions& options);
@@ -43,6 +48,7 @@ struct OptimiserEngineCounters {
   uint64_t closures_refused = 0;       // refused by the graph (see its counters) or never resolved
   uint64_t closures_waiting = 0;       // now waiting for their subframe (filled by counters())
   uint64_t subframes_forgotten = 0;    // ping poses dropped beyond max_stored_subframes
+  uint64_t odometer_resets = 0;        // INS odometer went backwards (see addSubframe)
 };
 
 // A stamped pose (per-ping trajectories).
@@ -70,7 +76,11 @@ class OptimiserEngine {
   explicit OptimiserEngine(const OptimiserEngineOptions& options);
 
   // A new subframe (its image is not kept): a node at its centre ping. Subframes must come in
-  // time order; a refused one leaves the engine unchanged.
+  // time order; a refused one leaves the engine unchanged. The graph's distance travelled is the
+  // centre's plus an offset that keeps it monotonic: when the INS odometer goes back (its bridge
+  // restarted), the distance from the previous node is the horizontal straight line between their
+  // DR positions, and the offset carries on from there. Such a subframe is accepted with a notice
+  // in the Status message (for the log) and counted in odometer_resets.
   Status addSubframe(const sss::subframe::Subframe& subframe);
   // A closure from the matcher. One naming a subframe not seen yet waits (bounded) for it.
   Status addLoopClosure(const sss::matcher::LoopClosure& closure);
@@ -97,9 +107,17 @@ class OptimiserEngine {
 
   const SlidingWindowPoseGraph& graph() const { return graph_; }
 
-  // The graph's checkpoint (nodes, closures, decisions, prior). Ping poses and correspondences
-  // are not in it: after a restart, the products cover the subframes seen since.
-  Status saveCheckpoint(const std::string& path) const { return graph_.saveCheckpoint(path); }
+  // Everything needed to carry on as if nothing happened: the graph (nodes, closures, decisions,
+  // prior), the ping times and DR poses of the stored subframes, the closures' correspondences, the
+  // closures waiting for their subframe, the odometer offset and the counters. Two files (see
+  // optimiser_checkpoint.cpp): `path`, text rewritten atomically on each save (engine state and
+  // graph: small, bounded by the graph), and `path`.journal, binary and append-only (each subframe's
+  // ping poses and each closure's correspondences written once), so a save costs what arrived since
+  // the previous one, however long the mission. `path` names the journal bytes that belong to it:
+  // a crash between the two writes leaves a consistent pair.
+  Status saveCheckpoint(const std::string& path);
+  // Replaces the engine's state. A missing, old-version (1: the graph alone), truncated or corrupt
+  // checkpoint or journal is refused with the reason and leaves the engine unchanged.
   Status loadCheckpoint(const std::string& path);
   OptimiserEngineCounters counters() const {
     OptimiserEngineCounters counters = counters_;
@@ -107,6 +125,7 @@ class OptimiserEngine {
     return counters;
   }
   const OptimiserEngineOptions& options() const { return options_; }
+  size_t storedSubframes() const { return stored_.size(); }
   size_t memoryBytes() const;
 
  private:
@@ -122,6 +141,15 @@ class OptimiserEngine {
     std::vector<sss::matcher::ClosureCorrespondence> correspondences;
   };
 
+  // The journal that the checkpoint at `path` uses, and the records not appended to it yet.
+  struct Journal {
+    std::string path;  // empty: none yet (the next save writes a new one with everything)
+    uint64_t id = 0;   // random, in both files: a journal of another checkpoint is refused
+    uint64_t bytes = 0;
+    uint64_t subframe_records = 0;
+    uint64_t correspondence_records = 0;
+  };
+
   Status addToGraph(const sss::matcher::LoopClosure& closure);
   // World-frame correction of a stored subframe's pings (rigid, as the matcher applies it).
   sss::core::Pose subframeCorrection(int64_t id, const StoredSubframe& stored, bool use_dr) const;
@@ -134,6 +162,12 @@ class OptimiserEngine {
   int64_t newest_subframe_id_ = -1;
   bool new_input_ = false;
   OptimiserEngineCounters counters_;
+  // Graph distance travelled = subframe centre's distance_travelled_m + odometer_offset_m_.
+  double odometer_offset_m_ = 0.0;
+  double last_input_distance_m_ = 0.0;  // the centre's distance_travelled_m of the newest node
+  Journal journal_;
+  std::vector<int64_t> unjournaled_subframes_;
+  std::set<std::pair<int64_t, int64_t>> unjournaled_pairs_;
 };
 
 }  // namespace sss::optimiser

@@ -2,8 +2,8 @@
 // SSS_POSE for every nav sample and the correction on DDS for the navigation computer.
 // Translation only; the logic is in OptimiserEngine. The graph is solved on a worker thread; the
 // process loop answers each nav sample from a snapshot of the newest solved graph, so a solve never
-// delays a pose. The graph is checkpointed after every update into the state directory and
-// restored at start. On SIGTERM (end of mission) or SIGUSR1 (on request) it runs full smoothing and
+// delays a pose. The engine (graph, ping poses, correspondences) is checkpointed after every update
+// into the state directory and restored at start. On SIGTERM (end of mission) or SIGUSR1 (on request) it runs full smoothing and
 // writes the products: optimised trajectory (TUM), bathymetry (PLY), heightmap (raster + PNG).
 //   sss-optimiser [--config FILE [--check-config]] [--lcm-url URL]
 #include <sys/eventfd.h>
@@ -80,6 +80,7 @@ struct Shared {
   sss::optimiser::PoseGraphCounters graph_counters;
   sss::optimiser::OptimiserEngineCounters engine_counters;
   double last_update_s = 0.0;
+  double last_checkpoint_s = 0.0;
   size_t memory_bytes = 0;
   std::vector<std::string> messages;  // log lines from the worker (logged by the loop)
 };
@@ -172,10 +173,11 @@ int main(int argc, char** argv) {
     if (fs::exists(checkpoint_path)) {
       const sss::optimiser::Status loaded = engine.loadCheckpoint(checkpoint_path);
       if (loaded.ok) {
-        spdlog::info("resumed from {}: {} nodes, {} closures accepted", checkpoint_path, engine.graph().numNodes(),
-                     engine.graph().counters().closures_accepted);
+        spdlog::info("resumed from {}: {} nodes, {} closures accepted, ping poses of {} subframes, {} odometer resets",
+                     checkpoint_path, engine.graph().numNodes(), engine.graph().counters().closures_accepted,
+                     engine.storedSubframes(), engine.counters().odometer_resets);
       } else {
-        spdlog::error("checkpoint {} not usable ({}); starting a new graph", checkpoint_path, loaded.message);
+        spdlog::error("checkpoint {} refused ({}); starting empty", checkpoint_path, loaded.message);
       }
     }
   } else {
@@ -218,6 +220,7 @@ int main(int argc, char** argv) {
       for (const auto& subframe : subframes) {
         const auto status = engine.addSubframe(subframe);
         if (!status.ok) messages.push_back("subframe " + std::to_string(subframe.id) + " refused: " + status.message);
+        else if (!status.message.empty()) messages.push_back(status.message);  // an odometer reset
       }
       for (const auto& closure : closures) {
         const auto status = engine.addLoopClosure(closure);
@@ -238,8 +241,11 @@ int main(int argc, char** argv) {
         last_update_monotonic_s = now_s;
         updated = true;
       }
+      double checkpoint_s = -1.0;
       if (updated && !checkpoint_path.empty()) {
+        const int64_t begin_us = sss::core::monotonicUtime();
         const auto saved = engine.saveCheckpoint(checkpoint_path);
+        checkpoint_s = 1e-6 * static_cast<double>(sss::core::monotonicUtime() - begin_us);
         if (!saved.ok) messages.push_back("checkpoint: " + saved.message);
       }
       if (!updated && messages.empty()) continue;
@@ -253,6 +259,7 @@ int main(int argc, char** argv) {
         shared.graph_counters = engine.graph().counters();
         shared.engine_counters = engine.counters();
         shared.last_update_s = engine.graph().counters().last_update_s;
+        if (checkpoint_s >= 0.0) shared.last_checkpoint_s = checkpoint_s;
         shared.memory_bytes = engine.memoryBytes();
         for (auto& m : messages) shared.messages.push_back(std::move(m));
       }
@@ -344,6 +351,7 @@ int main(int argc, char** argv) {
     sss::optimiser::PoseGraphCounters graph_counters;
     sss::optimiser::OptimiserEngineCounters engine_counters;
     size_t memory_bytes = 0;
+    double last_checkpoint_s = 0.0;
     {
       std::lock_guard<std::mutex> lock(shared.mutex);
       trajectory.swap(shared.trajectory);
@@ -351,6 +359,7 @@ int main(int argc, char** argv) {
       graph_counters = shared.graph_counters;
       engine_counters = shared.engine_counters;
       memory_bytes = shared.memory_bytes;
+      last_checkpoint_s = shared.last_checkpoint_s;
     }
     for (const auto& m : messages) spdlog::info("{}", m);
     if (trajectory && !trajectory->empty()) {
@@ -367,10 +376,12 @@ int main(int argc, char** argv) {
     health.setCounter("closures_refused", static_cast<double>(engine_counters.closures_refused));
     health.setCounter("closures_waiting", static_cast<double>(engine_counters.closures_waiting));
     health.setCounter("subframes_refused", static_cast<double>(engine_counters.subframes_refused));
+    health.setCounter("odometer_resets", static_cast<double>(engine_counters.odometer_resets));
     health.setCounter("updates", static_cast<double>(graph_counters.updates));
     health.setCounter("solver_failures", static_cast<double>(graph_counters.solver_failures));
     health.setCounter("last_update_ms", 1e3 * graph_counters.last_update_s);
     health.setCounter("memory_mb", static_cast<double>(memory_bytes) / 1e6);
+    health.setCounter("last_checkpoint_ms", 1e3 * last_checkpoint_s);
   });
 
   if (writer) {
@@ -413,7 +424,10 @@ int main(int argc, char** argv) {
   worker.join();
   close(results_fd);
   // End of mission: whatever arrived last, full smoothing, products and a final checkpoint.
-  for (const auto& subframe : shared.subframes) engine.addSubframe(subframe);
+  for (const auto& subframe : shared.subframes) {
+    const auto status = engine.addSubframe(subframe);
+    if (!status.message.empty()) spdlog::info("subframe {}: {}", subframe.id, status.message);
+  }
   for (const auto& closure : shared.closures) engine.addLoopClosure(closure);
   if (engine.graph().numNodes() > 0) {
     engine.finish();

@@ -914,6 +914,12 @@ std::vector<NodeState> SlidingWindowPoseGraph::nodes() const {
   return out;
 }
 
+std::optional<NodeState> SlidingWindowPoseGraph::newestNode() const {
+  if (nodes_.empty()) return std::nullopt;
+  const Node& n = nodes_.back();
+  return NodeState{n.id, n.utime_us, n.dr, n.estimate, n.distance_m, !isActive(static_cast<int>(nodes_.size()) - 1)};
+}
+
 std::vector<ClosureRecord> SlidingWindowPoseGraph::closures() const {
   std::vector<ClosureRecord> out;
   out.reserve(closures_.size());

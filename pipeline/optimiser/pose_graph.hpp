@@ -220,6 +220,7 @@ class SlidingWindowPoseGraph {
   // for a marginalised node the one it had when it left the window.
   std::optional<sss::core::Matrix6d> covariance(int64_t subframe_id) const;
   std::vector<NodeState> nodes() const;
+  std::optional<NodeState> newestNode() const;  // O(1)
   size_t numNodes() const { return nodes_.size(); }
   std::vector<ClosureRecord> closures() const;  // in arrival order
   const PoseGraphCounters& counters() const { return counters_; }
@@ -234,6 +235,9 @@ class SlidingWindowPoseGraph {
   Status saveCheckpoint(const std::string& path) const;
   // Replaces this graph's state; a missing, truncated or corrupt file leaves it unchanged.
   Status loadCheckpoint(const std::string& path);
+  // The same without the file and its checksum line (embedded in the optimiser's checkpoint).
+  std::string checkpointText() const;
+  Status restoreCheckpointText(const std::string& text);
 
   // The odometry model (see PoseGraphOptions) for distance d.
   static sss::core::Matrix6d odometryCovariance(const PoseGraphOptions& options, double distance_m);

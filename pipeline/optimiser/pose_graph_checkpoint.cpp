@@ -1,19 +1,12 @@
-// Checkpoint of the sliding-window pose graph: versioned text ("%.17g" doubles round-trip exactly),
-// an FNV-1a checksum line, written to a temporary file, fsync'ed and renamed into place.
-#include <fcntl.h>
-#include <unistd.h>
-
-#include <cctype>
-#include <cerrno>
+// Checkpoint of the sliding-window pose graph: versioned text (doubles round-trip exactly),
+// an FNV-1a checksum line, written to a temporary file, fsync'ed and renamed into place (see
+// checkpoint_io.hpp). The optimiser's own checkpoint embeds checkpointText().
 #include <cmath>
-#include <cinttypes>
-#include <cstdio>
-#include <cstdlib>
-#include <cstring>
-#include <fstream>
+#include <cstdint>
 #include <limits>
 #include <string>
 
+#include "pipeline/optimiser/checkpoint_io.hpp"
 #include "pipeline/optimiser/pose_graph.hpp"
 #include "pipeline/optimiser/pose_manifold.hpp"
 
@@ -28,142 +21,13 @@ constexpr const char* kMagic = "sss-pose-graph-checkpoint";
 constexpr int kVersion = 1;
 constexpr size_t kMaxFileBytes = size_t{1} << 31;  // 2 GiB: far above any mission
 
-uint64_t fnv1a(const char* data, size_t size) {
-  uint64_t hash = 1469598103934665603ull;
-  for (size_t i = 0; i < size; ++i) {
-    hash ^= static_cast<unsigned char>(data[i]);
-    hash *= 1099511628211ull;
-  }
-  return hash;
-}
-
-class Writer {
- public:
-  void word(const char* w) { separate(); text_ += w; }
-  void integer(int64_t v) {
-    separate();
-    text_ += std::to_string(v);
-  }
-  void unsignedInteger(uint64_t v) {
-    separate();
-    text_ += std::to_string(v);
-  }
-  void real(double v) {
-    char buffer[40];
-    std::snprintf(buffer, sizeof(buffer), "%.17g", v);
-    separate();
-    text_ += buffer;
-  }
-  void pose(const Pose& p) {
-    for (double v : toParameters(p)) real(v);
-  }
-  void matrix(const Eigen::MatrixXd& m) {
-    for (int r = 0; r < m.rows(); ++r)
-      for (int c = 0; c < m.cols(); ++c) real(m(r, c));
-  }
-  void endLine() {
-    text_ += '\n';
-    at_line_start_ = true;
-  }
-  std::string& text() { return text_; }
-
- private:
-  void separate() {
-    if (!at_line_start_) text_ += ' ';
-    at_line_start_ = false;
-  }
-  std::string text_;
-  bool at_line_start_ = true;
-};
-
-class Reader {
- public:
-  explicit Reader(const std::string& text) : text_(text) {}
-
-  bool token(std::string& out) {
-    while (pos_ < text_.size() && std::isspace(static_cast<unsigned char>(text_[pos_]))) ++pos_;
-    if (pos_ >= text_.size()) return false;
-    const size_t start = pos_;
-    while (pos_ < text_.size() && !std::isspace(static_cast<unsigned char>(text_[pos_]))) ++pos_;
-    out.assign(text_, start, pos_ - start);
-    return true;
-  }
-  bool expect(const char* word) {
-    std::string t;
-    return token(t) && t == word;
-  }
-  bool integer(int64_t& v) {
-    std::string t;
-    if (!token(t)) return false;
-    errno = 0;
-    char* end = nullptr;
-    const long long parsed = std::strtoll(t.c_str(), &end, 10);
-    if (errno != 0 || end != t.c_str() + t.size() || t.empty()) return false;
-    v = parsed;
-    return true;
-  }
-  bool unsignedInteger(uint64_t& v) {
-    std::string t;
-    if (!token(t) || t.empty() || t[0] == '-') return false;
-    errno = 0;
-    char* end = nullptr;
-    const unsigned long long parsed = std::strtoull(t.c_str(), &end, 10);
-    if (errno != 0 || end != t.c_str() + t.size()) return false;
-    v = parsed;
-    return true;
-  }
-  bool boundedInt(int& v, int64_t min, int64_t max) {
-    int64_t parsed = 0;
-    if (!integer(parsed) || parsed < min || parsed > max) return false;
-    v = static_cast<int>(parsed);
-    return true;
-  }
-  bool real(double& v) {
-    std::string t;
-    if (!token(t)) return false;
-    errno = 0;
-    char* end = nullptr;
-    const double parsed = std::strtod(t.c_str(), &end);
-    if (end != t.c_str() + t.size() || t.empty()) return false;
-    v = parsed;
-    return true;
-  }
-  bool finite(double& v) { return real(v) && std::isfinite(v); }
-  bool pose(Pose& p) {
-    double x[kPoseAmbientSize];
-    for (double& v : x)
-      if (!finite(v)) return false;
-    p = fromParameters(x);
-    return std::abs(p.rotation.norm() - 1.0) < 1e-6;
-  }
-  bool matrix(Eigen::MatrixXd& m, int rows, int cols) {
-    m.resize(rows, cols);
-    for (int r = 0; r < rows; ++r)
-      for (int c = 0; c < cols; ++c)
-        if (!finite(m(r, c))) return false;
-    return true;
-  }
-  bool matrix6(Matrix6d& m) {
-    Eigen::MatrixXd d;
-    if (!matrix(d, 6, 6)) return false;
-    m = d;
-    return true;
-  }
-  // Upper bound of the records of `tokens_per_record` tokens that could still follow: guards
-  // allocations against a corrupt count.
-  size_t remainingRecords(size_t tokens_per_record) const {
-    return (text_.size() - pos_) / (2 * tokens_per_record) + 1;
-  }
-
- private:
-  const std::string& text_;
-  size_t pos_ = 0;
-};
+using checkpoint::TextReader;
+using checkpoint::TextWriter;
 
 }  // namespace
 
-Status SlidingWindowPoseGraph::saveCheckpoint(const std::string& path) const {
-  Writer w;
+std::string SlidingWindowPoseGraph::checkpointText() const {
+  TextWriter w;
   w.word(kMagic);
   w.integer(kVersion);
   w.endLine();
@@ -229,65 +93,29 @@ Status SlidingWindowPoseGraph::saveCheckpoint(const std::string& path) const {
                 s.pcm_candidates})
     w.integer(v);
   w.endLine();
-  std::string& text = w.text();
-  char checksum[64];
-  std::snprintf(checksum, sizeof(checksum), "checksum %016" PRIx64 "\n", fnv1a(text.data(), text.size()));
-  text += checksum;
+  return std::move(w.text());
+}
 
-  const std::string temporary = path + ".tmp";
-  FILE* file = std::fopen(temporary.c_str(), "wb");
-  if (!file) return Status::error("checkpoint " + temporary + ": cannot open for writing: " + std::strerror(errno));
-  const bool written = std::fwrite(text.data(), 1, text.size(), file) == text.size() && std::fflush(file) == 0 &&
-                       ::fsync(::fileno(file)) == 0;
-  const int write_errno = errno;
-  if (std::fclose(file) != 0 || !written) {
-    std::remove(temporary.c_str());
-    return Status::error("checkpoint " + temporary + ": write failed: " + std::strerror(write_errno) +
-                         "; the previous checkpoint is kept");
-  }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    const int rename_errno = errno;
-    std::remove(temporary.c_str());
-    return Status::error("checkpoint " + path + ": rename failed: " + std::strerror(rename_errno));
-  }
-  // Make the rename itself durable (best effort: some file systems refuse fsync on directories).
-  const size_t slash = path.find_last_of('/');
-  const std::string directory = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
-  const int dir = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY);
-  if (dir >= 0) {
-    ::fsync(dir);
-    ::close(dir);
-  }
+Status SlidingWindowPoseGraph::saveCheckpoint(const std::string& path) const {
+  std::string text = checkpointText();
+  checkpoint::appendChecksum(text);
+  std::string error;
+  if (!checkpoint::writeAtomically(path, text, error)) return Status::error("checkpoint " + error);
   return Status::success();
 }
 
 Status SlidingWindowPoseGraph::loadCheckpoint(const std::string& path) {
-  auto fail = [&](const std::string& why) {
-    return Status::error("checkpoint " + path + ": " + why + "; graph left unchanged");
-  };
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return fail(std::string("cannot open: ") + std::strerror(errno));
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  if (size < 0 || static_cast<uint64_t>(size) > kMaxFileBytes) return fail("unreadable size or larger than 2 GiB");
-  in.seekg(0, std::ios::beg);
-  std::string text(static_cast<size_t>(size), '\0');
-  if (!in.read(text.data(), size)) return fail("read failed");
+  std::string text, error;
+  if (!checkpoint::readChecked(path, kMaxFileBytes, text, error))
+    return Status::error("checkpoint " + path + ": " + error + "; graph left unchanged");
+  const Status restored = restoreCheckpointText(text);
+  if (!restored.ok) return Status::error("checkpoint " + path + ": " + restored.message + "; graph left unchanged");
+  return restored;
+}
 
-  // Checksum line: the last line, over every byte before it.
-  const size_t line = text.rfind("checksum ");
-  if (line == std::string::npos || (line > 0 && text[line - 1] != '\n'))
-    return fail("no checksum line (truncated?)");
-  const std::string checksum_line = text.substr(line);
-  uint64_t stored = 0;
-  char tail = 0;
-  if (std::sscanf(checksum_line.c_str(), "checksum %16" SCNx64 "%c", &stored, &tail) != 2 || tail != '\n' ||
-      checksum_line.size() != 9 + 16 + 1)
-    return fail("malformed checksum line (truncated?)");
-  if (fnv1a(text.data(), line) != stored) return fail("checksum mismatch: the file is corrupt");
-  text.resize(line);
-
-  Reader r(text);
+Status SlidingWindowPoseGraph::restoreCheckpointText(const std::string& text) {
+  auto fail = [](const std::string& why) { return Status::error(why); };
+  TextReader r(text);
   int64_t version = 0;
   if (!r.expect(kMagic)) return fail("not a pose-graph checkpoint");
   if (!r.integer(version)) return fail("bad version field");

@@ -626,6 +626,7 @@ TEST(OptimiserNode, NavToPoseClosuresCorrectDdsCheckpointRestartAndBadInput) {
   EXPECT_EQ(counterOf(second_pid, "nodes"), 13.0);
   EXPECT_EQ(counterOf(second_pid, "closures_accepted"), 6.0);
   EXPECT_GE(counterOf(second_pid, "updates"), 1.0);
+  EXPECT_EQ(counterOf(second_pid, "odometer_resets"), 0.0);
   ASSERT_TRUE(waitFor([&] { return hasAllIds(seen.trajectory_ids.back(), 13); }, 5.0));
   std::vector<int64_t> after_restart_phase;
   for (int k = 0; k < 5; ++k) after_restart_phase.push_back(centreUtime(1, 1) + k * 10'000'000 + 7);
@@ -637,7 +638,7 @@ TEST(OptimiserNode, NavToPoseClosuresCorrectDdsCheckpointRestartAndBadInput) {
   pumpFor(0.2);
   for (int64_t t : nav_sent) EXPECT_EQ(seen.pose_count[t], 1) << "nav utime " << t;
 
-  // ---- 4 (end). SIGTERM: exit 0, products of the subframes since the restart ----------------------------
+  // ---- 4 (end). SIGTERM: exit 0, products of every subframe (the checkpoint holds the ping poses) ----------
   ::kill(child.pid, SIGTERM);
   const int exit_code = waitExitWithin(child.pid, 15.0);
   child.pid = -1;
@@ -655,20 +656,27 @@ TEST(OptimiserNode, NavToPoseClosuresCorrectDdsCheckpointRestartAndBadInput) {
     tum_poses[stamp] = t;
   }
   std::printf("[optimiser_node_test] products: %zu poses in slam.tum\n", tum_poses.size());
-  EXPECT_GE(tum_poses.size(), static_cast<size_t>(kPingsPerSubframe));
+  EXPECT_EQ(tum_poses.size(), static_cast<size_t>(13 * kPingsPerSubframe));
+  std::vector<sss::subframe::SubframePing> all_pings;
+  for (int line = 0; line < 2; ++line)
+    for (int j = 0; j < kSubframesPerLine + line; ++j)
+      for (const auto& ping : makeSubframe(line, j).pings) all_pings.push_back(ping);
   double worst_tum_error = 0.0;
-  for (const auto& ping : after_restart.pings) {
+  for (const auto& ping : all_pings) {
     char stamp[64];
     std::snprintf(stamp, sizeof stamp, "%lld.%06lld", static_cast<long long>(ping.utime_us / 1000000),
                   static_cast<long long>(ping.utime_us % 1000000));
     const auto found = tum_poses.find(stamp);
-    ASSERT_NE(found, tum_poses.end()) << "slam.tum lacks ping " << stamp << " of the subframe after the restart";
-    // Corrected like the rest of line B (its DR carries the same 2 m error).
+    ASSERT_NE(found, tum_poses.end()) << "slam.tum lacks ping " << stamp;
+    // Corrected (line B's DR carries a 2 m error). Between line A's last centre and line B's first,
+    // the correction blends across the 100 s excursion: the half subframes next to it (5 s) get up
+    // to kDrErrorM * 5 / 105 = 0.1 m of the other line's correction on top.
+    const bool beside_excursion = ping.utime_us > centreUtime(0, kSubframesPerLine - 1) && ping.utime_us < centreUtime(1, 0);
     const double error = (found->second - stateAt(ping.utime_us).truth.translation).norm();
     worst_tum_error = std::max(worst_tum_error, error);
-    EXPECT_LT(error, kCorrectedToleranceM) << stamp;
+    EXPECT_LT(error, kCorrectedToleranceM + (beside_excursion ? 0.1 : 0.0)) << stamp;
   }
-  std::printf("[optimiser_node_test] slam.tum, subframe after the restart: worst error %.3f m (DR %.3f m)\n",
+  std::printf("[optimiser_node_test] slam.tum, every ping before and after the restart: worst error %.3f m (DR %.3f m)\n",
               worst_tum_error, kDrErrorM);
 
   fs::remove_all(dir);

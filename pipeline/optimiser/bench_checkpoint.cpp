@@ -1,0 +1,175 @@
+// sss-bench-optimiser-checkpoint: an H-hour lawnmower of subframes (200 ping poses each) and
+// closures (with correspondences, each pair delivered in R association rounds) fed to the optimiser
+// engine, one update and one checkpoint save per subframe, as sss-optimiser does. Prints, per hour,
+// the checkpoint's size (rewritten file + journal) and save times, and what a full rewrite of
+// everything would cost at that point; a JSON summary last.
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "pipeline/optimiser/optimiser_engine.hpp"
+#include "pipeline/optimiser/synthetic_subframes.hpp"
+
+namespace {
+
+using namespace sss::optimiser;
+
+void usage() {
+  std::fprintf(stderr,
+               "usage: sss-bench-optimiser-checkpoint [--hours H] [--correspondences N] [--rounds R] [--dir D]\n"
+               "H-hour (default 3) lawnmower of 2 km lines, 100 m subframes of 200 pings, closures between\n"
+               "neighbouring lines with N correspondences (default 3000, the bathymetry's max_points_per_closure),\n"
+               "each pair sent in R association rounds (default 2); checkpoints into D (default /tmp).\n");
+}
+
+double fileBytes(const std::string& path) {
+  struct stat s {};
+  return ::stat(path.c_str(), &s) == 0 ? static_cast<double>(s.st_size) : 0.0;
+}
+
+double seconds(const std::chrono::steady_clock::time_point& since) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+double percentile(std::vector<double> values, double p) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  return values[std::min(values.size() - 1, static_cast<size_t>(std::ceil(p * values.size())) - 1)];
+}
+
+struct HourFigures {
+  double hours = 0.0;
+  double file_mb = 0.0, journal_mb = 0.0;
+  double save_p50_ms = 0.0, save_max_ms = 0.0;  // saves during that hour
+  double graph_text_ms = 0.0;                   // formatting the graph's text alone (no I/O)
+  double full_rewrite_ms = 0.0;                 // everything written anew at the end of that hour
+  double load_ms = 0.0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  double hours = 3.0;
+  int rounds = 2;
+  std::string dir = "/tmp";
+  synthetic::SubframeOptions subframe_options;
+  subframe_options.correspondences_per_closure = 3000;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    auto next = [&]() -> const char* {
+      if (i + 1 >= argc) {
+        usage();
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (arg == "--hours") hours = std::atof(next());
+    else if (arg == "--correspondences") subframe_options.correspondences_per_closure = std::atoi(next());
+    else if (arg == "--rounds") rounds = std::atoi(next());
+    else if (arg == "--dir") dir = next();
+    else {
+      usage();
+      return arg == "--help" || arg == "-h" ? 0 : 2;
+    }
+  }
+  if (!(hours > 0.0) || rounds < 1 || subframe_options.correspondences_per_closure < 0) {
+    usage();
+    return 2;
+  }
+  synthetic::MissionOptions mission_options;
+  mission_options.line_length_m = 2000.0;
+  mission_options.heading_bias_rad = 0.0005;
+  mission_options.velocity_scale_error = 0.001;
+  const double line_time_s =
+      (mission_options.line_length_m + M_PI * 0.5 * mission_options.line_spacing_m) / mission_options.speed_m_s;
+  mission_options.num_lines = std::max(2, static_cast<int>(std::ceil(hours * 3600.0 / line_time_s)));
+  const synthetic::Mission mission = synthetic::makeLawnmowerMission(mission_options);
+  std::vector<std::vector<sss::core::Pose>> truth;
+  const std::vector<sss::subframe::Subframe> subframes = synthetic::makeSubframes(mission, subframe_options, &truth);
+
+  OptimiserEngineOptions options;
+  options.graph.window_size = 45;  // as sss-bench-optimiser: two 2 km lines
+  OptimiserEngine engine(options);
+  const std::string path = dir + "/sss-bench-checkpoint-" + std::to_string(::getpid()) + ".checkpoint";
+  const std::string full_path = path + ".full";
+  std::printf("mission: %.1f h, %d lines, %zu subframes, %zu closures x %d rounds, %d correspondences each\n", hours,
+              mission_options.num_lines, subframes.size(), mission.closures.size(), rounds,
+              subframe_options.correspondences_per_closure);
+  std::printf("%6s %9s %11s %12s %12s %14s %16s %9s\n", "hours", "file_MB", "journal_MB", "save_p50_ms",
+              "save_max_ms", "graph_text_ms", "full_rewrite_ms", "load_ms");
+
+  std::vector<HourFigures> figures;
+  std::vector<double> save_ms;  // this hour's
+  std::vector<double> all_save_ms;
+  int next_hour = 1;
+  const int64_t start_utime_us = mission.nodes.front().utime_us;
+  // Round r of a closure arrives r subframes after round 0 (re-association with newer poses).
+  std::vector<std::vector<std::pair<size_t, int>>> arrivals(subframes.size() + rounds);
+  for (size_t c = 0; c < mission.closures.size(); ++c)
+    for (int r = 0; r < rounds; ++r) arrivals[mission.closures[c].newer_node + r].push_back({c, r});
+  for (size_t i = 0; i < subframes.size(); ++i) {
+    engine.addSubframe(subframes[i]);
+    for (const auto& [c, r] : arrivals[i])
+      engine.addLoopClosure(synthetic::makeMatcherClosure(mission, c, truth, subframe_options, r));
+    engine.update();
+    const auto t0 = std::chrono::steady_clock::now();
+    const Status saved = engine.saveCheckpoint(path);
+    save_ms.push_back(1e3 * seconds(t0));
+    all_save_ms.push_back(save_ms.back());
+    if (!saved.ok) {
+      std::fprintf(stderr, "%s\n", saved.message.c_str());
+      return 1;
+    }
+    const double mission_h = 1e-6 * static_cast<double>(subframes[i].pings.back().utime_us - start_utime_us) / 3600.0;
+    if (mission_h < next_hour && i + 1 < subframes.size()) continue;
+    HourFigures f;
+    f.hours = mission_h;
+    f.file_mb = fileBytes(path) / 1e6;
+    f.journal_mb = fileBytes(path + ".journal") / 1e6;
+    f.save_p50_ms = percentile(save_ms, 0.5);
+    f.save_max_ms = percentile(save_ms, 1.0);
+    const auto t3 = std::chrono::steady_clock::now();
+    const size_t graph_bytes = engine.graph().checkpointText().size();
+    f.graph_text_ms = 1e3 * seconds(t3);
+    (void)graph_bytes;
+    OptimiserEngine copy = engine;  // a save to another path writes everything anew
+    const auto t1 = std::chrono::steady_clock::now();
+    copy.saveCheckpoint(full_path);
+    f.full_rewrite_ms = 1e3 * seconds(t1);
+    OptimiserEngine loaded(options);
+    const auto t2 = std::chrono::steady_clock::now();
+    const Status load = loaded.loadCheckpoint(path);
+    f.load_ms = 1e3 * seconds(t2);
+    if (!load.ok) std::fprintf(stderr, "%s\n", load.message.c_str());
+    std::printf("%6.2f %9.2f %11.2f %12.2f %12.2f %14.2f %16.1f %9.1f\n", f.hours, f.file_mb, f.journal_mb,
+                f.save_p50_ms, f.save_max_ms, f.graph_text_ms, f.full_rewrite_ms, f.load_ms);
+    figures.push_back(f);
+    save_ms.clear();
+    ++next_hour;
+  }
+  for (const std::string& p : {path, path + ".journal", full_path, full_path + ".journal"}) std::remove(p.c_str());
+
+  std::string json = "{\"saves\": " + std::to_string(all_save_ms.size()) +
+                     ", \"save_p50_ms\": " + std::to_string(percentile(all_save_ms, 0.5)) +
+                     ", \"save_p95_ms\": " + std::to_string(percentile(all_save_ms, 0.95)) +
+                     ", \"save_max_ms\": " + std::to_string(percentile(all_save_ms, 1.0)) + ", \"hours\": [";
+  for (size_t k = 0; k < figures.size(); ++k) {
+    const HourFigures& f = figures[k];
+    char item[256];
+    std::snprintf(item, sizeof(item),
+                  "%s{\"h\": %.2f, \"file_mb\": %.3f, \"journal_mb\": %.2f, \"save_p50_ms\": %.2f, \"save_max_ms\": %.2f, "
+                  "\"graph_text_ms\": %.2f, \"full_rewrite_ms\": %.1f, \"load_ms\": %.1f}",
+                  k ? ", " : "", f.hours, f.file_mb, f.journal_mb, f.save_p50_ms, f.save_max_ms, f.graph_text_ms,
+                  f.full_rewrite_ms, f.load_ms);
+    json += item;
+  }
+  std::printf("%s]}\n", json.c_str());
+  return 0;
+}
