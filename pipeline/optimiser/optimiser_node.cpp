@@ -19,6 +19,7 @@
 #include <filesystem>
 #include <memory>
 #include <mutex>
+#include <limits>
 #include <optional>
 #include <string>
 #include <thread>
@@ -293,8 +294,23 @@ int main(int argc, char** argv) {
       health.recordError("dds", "DDS writer unavailable", sss::core::nowUtime());
     }
   }
+  // Written from the nav callback, so the navigation computer gets a correction as soon as its
+  // nav sample is answered (not up to a timer period later), at most dds.rate_hz; a sample held
+  // back by the rate goes out from the timer if no newer nav comes within the period.
   std::optional<sss_dds_NavigationCorrection> pending_dds;
   uint64_t dds_written = 0;
+  const auto dds_period_us = static_cast<int64_t>(1e6 / options.dds_rate_hz);
+  int64_t last_dds_write_us = std::numeric_limits<int64_t>::min() / 2;
+  auto writeDds = [&](const sss_dds_NavigationCorrection& sample, int64_t now_us) {
+    last_dds_write_us = now_us;
+    pending_dds.reset();
+    if (writer->write(sample)) {
+      ++dds_written;
+      health.setCounter("dds_corrections", static_cast<double>(dds_written));
+    } else if (health.recordError("dds_write", "DDS write failed", sss::core::nowUtime())) {
+      spdlog::warn("DDS write failed; further failures are counted in SSS_STATUS");
+    }
+  };
 
   // ---- subscriptions ------------------------------------------------------------------------------
   loop.bus().subscribe<sss_msgs::nav_t>(options.nav_channel, [&](const sss_msgs::nav_t& message) {
@@ -311,8 +327,16 @@ int main(int argc, char** argv) {
     const auto dr = sss::subframe::poseOf(nav);
     const sss_msgs::pose_t pose = sss::optimiser::toPoseMessage(nav.utime_us, dr, correction, plane);
     loop.bus().publish(options.pose_channel, pose, arrival);
-    if (writer) pending_dds = sss::optimiser::toDdsCorrection(pose, static_cast<uint32_t>(options.vehicle_id),
-                                                              correction.accepted_closures);
+    if (writer) {
+      const sss_dds_NavigationCorrection sample =
+          sss::optimiser::toDdsCorrection(pose, static_cast<uint32_t>(options.vehicle_id), correction.accepted_closures);
+      const int64_t now_us = sss::core::monotonicUtime();
+      if (now_us - last_dds_write_us >= dds_period_us) {
+        writeDds(sample, now_us);
+      } else {
+        pending_dds = sample;
+      }
+    }
   });
   loop.bus().subscribe<sss_msgs::subframe_t>(options.subframe_channel, [&](const sss_msgs::subframe_t& message) {
     sss::subframe::Subframe subframe;
@@ -385,15 +409,9 @@ int main(int argc, char** argv) {
   });
 
   if (writer) {
-    loop.addTimer(1.0 / options.dds_rate_hz, [&] {
-      if (!pending_dds) return;
-      if (writer->write(*pending_dds)) {
-        ++dds_written;
-        health.setCounter("dds_corrections", static_cast<double>(dds_written));
-      } else if (health.recordError("dds_write", "DDS write failed", sss::core::nowUtime())) {
-        spdlog::warn("DDS write failed; further failures are counted in SSS_STATUS");
-      }
-      pending_dds.reset();
+    loop.addTimer(0.5 / options.dds_rate_hz, [&] {
+      const int64_t now_us = sss::core::monotonicUtime();
+      if (pending_dds && now_us - last_dds_write_us >= dds_period_us) writeDds(*pending_dds, now_us);
     });
   }
   std::signal(SIGUSR1, onSigusr1);

@@ -499,7 +499,8 @@ int main(int argc, char** argv) {
     }
     std::vector<double> dds_nav_ms, dds_write_ms;
     for (const DdsArrival& a : listener.arrivals()) {
-      // The phase's last nav sample has no successor: it waits for the next write timer, an end effect.
+      // The phase's last nav sample may have been held back by the rate limit and left by the
+      // timer: an end effect.
       const auto sent = sent_at_us.find(a.utime_us);
       if (sent == sent_at_us.end() || a.utime_us == last) continue;
       dds_nav_ms.push_back(1e-3 * static_cast<double>(a.receive_monotonic_us - sent->second));
@@ -538,12 +539,11 @@ int main(int argc, char** argv) {
   std::printf("host load average (1 min, %ld cores): %.2f before, %.2f after\n", sysconf(_SC_NPROCESSORS_ONLN),
               load_before, load_after);
   std::printf("LCM: the time from publishing SSS_NAV to receiving its SSS_POSE (decode, correction, encode, two\n"
-              "  udpm hops). DDS: the optimiser writes the newest corrected pose at %.0f Hz; 'correction for it' is\n"
-              "  from publishing the nav sample a DDS sample carries (utime_us) to its arrival, so it includes the\n"
-              "  age of that newest sample when the write timer fires (0 to one nav period, %.1f ms; with periodic\n"
-              "  nav the phase stays nearly fixed within a run; the last sample of a phase is left out); 'write ->\n"
-              "  read' is the DDS transport alone (writer source timestamp vs dds_time() at the reader, same clock).\n",
-              dds_rate_hz, 1e3 / rate_hz);
+              "  udpm hops). DDS: the optimiser writes the corrected pose of a nav sample as it answers it, at most\n"
+              "  %.0f Hz (nav at %.0f Hz: one sample in %.0f goes out); 'correction for it' is from publishing the nav\n"
+              "  sample a DDS sample carries (utime_us) to its arrival; 'write -> read' is the DDS transport alone\n"
+              "  (writer source timestamp vs dds_time() at the reader, same clock).\n",
+              dds_rate_hz, rate_hz, rate_hz / dds_rate_hz);
 
   // ---- stop: SIGTERM, clean exit --------------------------------------------------------------------------
   ::kill(child, SIGTERM);
