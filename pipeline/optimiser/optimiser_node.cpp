@@ -295,12 +295,14 @@ int main(int argc, char** argv) {
     }
   }
   // Written from the nav callback, so the navigation computer gets a correction as soon as its
-  // nav sample is answered (not up to a timer period later), at most dds.rate_hz; a sample held
-  // back by the rate goes out from the timer if no newer nav comes within the period.
+  // nav sample is answered (not up to a timer period later), at most dds.rate_hz. A sample held
+  // back by the rate goes out from the timer only when the nav has gone quiet for half a period
+  // (otherwise the next nav sample, a few ms later, is written fresh instead).
   std::optional<sss_dds_NavigationCorrection> pending_dds;
   uint64_t dds_written = 0;
   const auto dds_period_us = static_cast<int64_t>(1e6 / options.dds_rate_hz);
   int64_t last_dds_write_us = std::numeric_limits<int64_t>::min() / 2;
+  int64_t last_nav_us = 0;
   auto writeDds = [&](const sss_dds_NavigationCorrection& sample, int64_t now_us) {
     last_dds_write_us = now_us;
     pending_dds.reset();
@@ -331,6 +333,7 @@ int main(int argc, char** argv) {
       const sss_dds_NavigationCorrection sample =
           sss::optimiser::toDdsCorrection(pose, static_cast<uint32_t>(options.vehicle_id), correction.accepted_closures);
       const int64_t now_us = sss::core::monotonicUtime();
+      last_nav_us = now_us;
       if (now_us - last_dds_write_us >= dds_period_us) {
         writeDds(sample, now_us);
       } else {
@@ -409,9 +412,11 @@ int main(int argc, char** argv) {
   });
 
   if (writer) {
-    loop.addTimer(0.5 / options.dds_rate_hz, [&] {
+    loop.addTimer(0.25 / options.dds_rate_hz, [&] {
       const int64_t now_us = sss::core::monotonicUtime();
-      if (pending_dds && now_us - last_dds_write_us >= dds_period_us) writeDds(*pending_dds, now_us);
+      if (pending_dds && now_us - last_dds_write_us >= dds_period_us && now_us - last_nav_us >= dds_period_us / 2) {
+        writeDds(*pending_dds, now_us);
+      }
     });
   }
   std::signal(SIGUSR1, onSigusr1);
