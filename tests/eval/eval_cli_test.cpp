@@ -13,6 +13,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <sstream>
 
 #ifndef SSS_EVAL_PATH
@@ -158,6 +159,66 @@ TEST_F(EvalCli, ComparesHeightmapsAndWritesErrorMaps) {
   EXPECT_EQ(json["estimates"].size(), 0u);
 }
 
+TEST_F(EvalCli, ScoresLoopClosuresAndLandmarkConsistency) {
+  // Two closures between lines 0 and 1 (poses 200 and 800, 0.5 m apart on the path); the accepted
+  // one 0.3 m too far along track, the rejected one 4 m.
+  std::ofstream csv(path("loop_closures.csv"));
+  csv << "# loop closures\nsubframe_id_a,subframe_id_b,utime_a_us,utime_b_us,round,status,rejection,dx_m,dy_m,dz_m,"
+         "droll_rad,dpitch_rad,dheading_rad,num_inliers,mean_zncc,north_a_m,east_a_m,north_b_m,east_b_m\n";
+  const sss::core::Pose T_a_b = truth_[200].T_world_body.inverse() * truth_[800].T_world_body;
+  const double heading_rad = sss::core::eulerFromQuaternion(T_a_b.rotation).heading_rad;
+  for (const auto& [status, along_error_m] : {std::pair<const char*, double>{"accepted", 0.3}, {"rejected", 4.0}}) {
+    csv << "3,7," << truth_[200].utime_us << "," << truth_[800].utime_us << ",0," << status << ",none,"
+        << std::setprecision(12) << T_a_b.translation.x() + along_error_m << "," << T_a_b.translation.y() << ","
+        << T_a_b.translation.z() << ",0,0," << heading_rad << ",50,0.6,0,0,0,0\n";
+  }
+  csv.close();
+  const ProgramRun result = run("--gt " + path("truth.tum") + " --est " + path("dr.tum") + " --label DR --est " +
+                                path("slam.tum") + " --closures " + path("loop_closures.csv") +
+                                " --closure-table --lce --lce-seabed-depth-m 50 --json " + path("c.json"));
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("truth (self-check)"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("3-7"), std::string::npos) << result.out;  // the per-closure table
+  EXPECT_NE(result.out.find("accepted"), std::string::npos) << result.out;
+
+  const YAML::Node json = YAML::LoadFile(path("c.json"));
+  const YAML::Node closures = json["closures"];
+  EXPECT_EQ(closures["count"].as<size_t>(), 2u);
+  EXPECT_EQ(closures["dr"]["label"].as<std::string>(), "DR");
+  ASSERT_EQ(closures["groups"].size(), 2u);
+  EXPECT_EQ(closures["groups"][0]["status"].as<std::string>(), "accepted");
+  // TUM files hold 6 decimals: the truth read back is within 1 um.
+  EXPECT_NEAR(closures["groups"][0]["closure"]["along_m"]["rmse"].as<double>(), 0.3, 1e-5);
+  EXPECT_NEAR(closures["groups"][0]["closure"]["along_m"]["bias"].as<double>(), 0.3, 1e-5);
+  EXPECT_NEAR(closures["groups"][1]["closure"]["along_m"]["max"].as<double>(), 4.0, 1e-5);
+  EXPECT_NEAR(closures["groups"][0]["closure"]["lateral_m"]["max"].as<double>(), 0.0, 1e-5);
+  // DR is the truth shifted 2 m east everywhere: its relative poses are the truth's.
+  EXPECT_NEAR(closures["groups"][0]["dr"]["horizontal_m"]["max"].as<double>(), 0.0, 1e-5);
+  for (const char* key : {"subframe_id_a", "subframe_id_b", "round", "status", "rejection", "utime_a_us", "utime_b_us",
+                          "truth", "error", "dr_error"}) {
+    EXPECT_TRUE(closures["closures"][0][key]) << key;
+  }
+
+  const YAML::Node lce = json["lce"];
+  EXPECT_DOUBLE_EQ(lce["seabed_depth_m"].as<double>(), 50.0);
+  EXPECT_GT(lce["correspondences"].as<size_t>(), 500u);  // ~39 rows x (9 + 9 + 5) columns
+  EXPECT_LT(lce["truth"]["horizontal_m"]["max"].as<double>(), 1e-3);
+  ASSERT_EQ(lce["estimates"].size(), 2u);
+  EXPECT_EQ(lce["estimates"][0]["label"].as<std::string>(), "DR");
+  EXPECT_LT(lce["estimates"][0]["horizontal_m"]["max"].as<double>(), 1e-3);  // a constant shift is consistent
+  for (const char* key : {"seabed_depth_source", "grid_m", "min_ground_range_m", "max_ground_range_m",
+                          "max_correspondences", "sightings", "seabed_points", "candidate_pairs"}) {
+    EXPECT_TRUE(lce[key]) << key;
+  }
+
+  // Closures and LCE alone (no --est): no DR, the truth's LCE only.
+  ASSERT_EQ(run("--gt " + path("truth.tum") + " --closures " + path("loop_closures.csv") + " --lce --json " +
+                path("d.json")).exit_code, 0);
+  const YAML::Node alone = YAML::LoadFile(path("d.json"));
+  EXPECT_TRUE(alone["closures"]["dr"].IsNull());
+  EXPECT_EQ(alone["lce"]["estimates"].size(), 0u);
+}
+
 TEST_F(EvalCli, BadInputsExitWithCodeTwoAndAClearMessage) {
   {
     std::ofstream bad(path("bad.tum"));
@@ -191,6 +252,13 @@ TEST_F(EvalCli, BadInputsExitWithCodeTwoAndAClearMessage) {
   result = run("--seabed " + path("truth.tum") + " --heightmap " + path("truth.tum"));  // not YAML maps
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_NE(result.err.find("truth.tum"), std::string::npos) << result.err;
+  EXPECT_EQ(run("--gt " + path("truth.tum") + " --est " + path("dr.tum") + " --closures-dr " + path("dr.tum")).exit_code, 2);
+  EXPECT_EQ(run("--gt " + path("truth.tum") + " --lce --lce-swath-m 70,10").exit_code, 2);
+  EXPECT_EQ(run("--gt " + path("truth.tum") + " --lce --lce-grid-m 0").exit_code, 2);
+  EXPECT_EQ(run("--closures " + path("truth.tum")).exit_code, 2);  // no --gt
+  result = run("--gt " + path("truth.tum") + " --closures " + path("truth.tum"));  // not a closure file
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.err.find("the header has no column"), std::string::npos) << result.err;
   EXPECT_EQ(run("--help").exit_code, 0);
 }
 

@@ -211,6 +211,18 @@ TEST_F(RunReport, WritesEveryFigureAndMetricsMatchTheKnownErrors) {
   EXPECT_EQ(closures["rejected"].as<int>(), 1);
   EXPECT_EQ(closures["total"].as<int>(), 4);
   EXPECT_EQ(closures["rejection_reasons"]["chi_square_gate"].as<int>(), 1);
+  // The fabricated closures claim B 0.1 m ahead of A: every one is off by the true relative pose.
+  EXPECT_EQ(json["closure_errors"]["accepted"].as<int>(), 3);
+  EXPECT_GT(json["closure_errors"]["closure"]["horizontal_m"]["rmse"].as<double>(), 10.0);
+  for (const char* key : {"along_m", "lateral_m", "depth_m", "heading_deg", "horizontal_m"}) {
+    EXPECT_TRUE(json["closure_errors"]["dr"][key]) << key;
+  }
+  // LCE: the truth is its own self-check; SLAM (the truth shifted as a whole) is consistent too.
+  EXPECT_GT(json["lce"]["correspondences"].as<int>(), 100);
+  EXPECT_LT(json["lce"]["truth_max_m"].as<double>(), 1e-3);
+  EXPECT_LT(json["lce"]["slam"]["max"].as<double>(), 1e-3);
+  EXPECT_GT(json["lce"]["dr"]["mean"].as<double>(), json["lce"]["slam"]["mean"].as<double>());
+  EXPECT_NE(json["lce"]["seabed_depth_source"].as<std::string>().find("seabed"), std::string::npos);
   EXPECT_DOUBLE_EQ(json["run"]["real_time_factor"].as<double>(), 12.0);
   EXPECT_DOUBLE_EQ(json["run"]["peak_rss_mib"].as<double>(), 321.5);
 

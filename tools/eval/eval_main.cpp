@@ -1,5 +1,5 @@
-// sss-eval: trajectory (ATE, RPE, per survey line) and heightmap accuracy against the simulator's
-// ground truth; prints a table, writes the JSON report (keys in report.hpp) and PNG figures.
+// sss-eval: trajectory (ATE, RPE, per survey line, LCE), loop-closure and heightmap accuracy against
+// the simulator's ground truth; prints a table, writes the JSON report (keys in report.hpp) and PNG figures.
 #include "tools/eval/report.hpp"
 
 #include <cerrno>
@@ -18,6 +18,8 @@ const char* kUsage =
     "                [--seabed seabed.yaml --heightmap HM.yaml [--heightmap ...] [--heightmap-label NAME ...]]\n"
     "                [--json OUT.json] [--plot OUT.png] [--error-map PREFIX]\n"
     "                [--time-tolerance-s S] [--max-gap-s S] [--no-interpolation] [--rpe-windows-m 10,50,100]\n"
+    "                [--closures loop_closures.csv [--closures-dr DR.tum] [--closure-table]]\n"
+    "                [--lce [--lce-swath-m 10,70] [--lce-grid-m 5] [--lce-max-pairs 20000] [--lce-seabed-depth-m D]]\n"
     "TUM lines: 'sec.usec x y z qx qy qz qw' in local NED metres (as sss-sim writes them).\n"
     "--label names the estimates in order (default: file name); the first estimate is the baseline\n"
     "  of the 'vs first' column (horizontal ATE RMSE improvement, %).\n"
@@ -26,6 +28,17 @@ const char* kUsage =
     "  PREFIX_<label>_depth.f32 (estimate - true depth, the seabed raster format).\n"
     "Truth is interpolated at estimate times (gaps up to --max-gap-s, default 1 s); otherwise the\n"
     "  nearest truth pose within --time-tolerance-s (default 0.02 s) is used.\n"
+    "--closures: each loop closure's relative pose (sss-process loop_closures.csv: dx_m dy_m dz_m =\n"
+    "  B's centre in A's body frame, dheading_rad) minus the truth's at the two centre times, as along\n"
+    "  (x), lateral (y), depth (z) and heading errors; RMS and max per status (accepted, rejected, ...).\n"
+    "  The same for DR's relative pose: --closures-dr DR.tum, by default the first --est.\n"
+    "  --closure-table also lists every closure.\n"
+    "--lce: landmark consistency error of the truth (a self-check, ~0) and of every --est, on\n"
+    "  correspondences made from the truth: seabed points every --lce-grid-m metres, each sighted when\n"
+    "  a survey line's fan plane passes over it at a ground range within --lce-swath-m MIN,MAX; two\n"
+    "  sightings from different lines make a pair (at most --lce-max-pairs, thinned evenly). Flat\n"
+    "  seabed at --lce-seabed-depth-m, else the mean depth of --seabed, else the truth's median depth\n"
+    "  + 18 m (the simulator's default altitude); without pitch the result does not depend on it.\n"
     "Exit codes: 0 ok, 1 an output could not be written, 2 bad arguments or input files.\n";
 
 bool parsePositive(const std::string& flag, const std::string& text, double& value) {
@@ -59,6 +72,14 @@ int main(int argc, char** argv) {
       options.trajectory.association.interpolate_truth = false;
       continue;
     }
+    if (arg == "--lce") {
+      request.lce = true;
+      continue;
+    }
+    if (arg == "--closure-table") {
+      options.closure_table = true;
+      continue;
+    }
     if (arg.rfind("--", 0) != 0 || i + 1 >= argc) {
       std::cerr << "sss-eval: unexpected argument '" << arg << "' (or a flag without its value)\n" << kUsage;
       return 2;
@@ -74,6 +95,34 @@ int main(int argc, char** argv) {
     else if (arg == "--json") request.json_path = value;
     else if (arg == "--plot") request.plot_path = value;
     else if (arg == "--error-map") request.error_map_prefix = value;
+    else if (arg == "--closures") request.closures_path = value;
+    else if (arg == "--closures-dr") request.closures_dr_path = value;
+    else if (arg == "--lce-swath-m") {
+      const size_t comma = value.find(',');
+      double max_m = 0.0;
+      if (comma == std::string::npos || !parsePositive(arg, value.substr(0, comma), number) ||
+          !parsePositive(arg, value.substr(comma + 1), max_m) || !(max_m > number)) {
+        std::cerr << "sss-eval: --lce-swath-m expects MIN,MAX ground ranges with MIN < MAX, e.g. 10,70\n";
+        return 2;
+      }
+      options.lce.min_ground_range_m = number;
+      options.lce.max_ground_range_m = max_m;
+    } else if (arg == "--lce-grid-m") {
+      if (!parsePositive(arg, value, number) || !(number >= 0.1)) {
+        std::cerr << "sss-eval: --lce-grid-m expects a spacing of at least 0.1 m\n";
+        return 2;
+      }
+      options.lce.grid_m = number;
+    } else if (arg == "--lce-max-pairs") {
+      if (!parsePositive(arg, value, number) || !(number >= 1.0) || number != std::floor(number)) {
+        std::cerr << "sss-eval: --lce-max-pairs expects a whole number of at least 1\n";
+        return 2;
+      }
+      options.lce.max_correspondences = static_cast<size_t>(number);
+    } else if (arg == "--lce-seabed-depth-m") {
+      if (!parsePositive(arg, value, number)) return 2;
+      options.lce_seabed_depth_m = number;
+    }
     else if (arg == "--time-tolerance-s") {
       if (!parsePositive(arg, value, number)) return 2;
       options.trajectory.association.max_time_difference_s = number;
@@ -100,13 +149,18 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  if (estimates.empty() && heightmaps.empty()) {
-    std::cerr << "sss-eval: nothing to evaluate: give --gt TRUTH.tum --est EST.tum and/or --seabed S.yaml --heightmap H.yaml\n"
+  if (estimates.empty() && heightmaps.empty() && request.closures_path.empty() && !request.lce) {
+    std::cerr << "sss-eval: nothing to evaluate: give --gt TRUTH.tum with --est EST.tum, --closures C.csv or --lce,\n"
+                 "  and/or --seabed S.yaml --heightmap H.yaml\n"
               << kUsage;
     return 2;
   }
-  if (!estimates.empty() && request.truth_path.empty()) {
-    std::cerr << "sss-eval: --est needs --gt TRUTH.tum\n";
+  if ((!estimates.empty() || !request.closures_path.empty() || request.lce) && request.truth_path.empty()) {
+    std::cerr << "sss-eval: --est, --closures and --lce need --gt TRUTH.tum\n";
+    return 2;
+  }
+  if (!request.closures_dr_path.empty() && request.closures_path.empty()) {
+    std::cerr << "sss-eval: --closures-dr needs --closures loop_closures.csv\n";
     return 2;
   }
   if (!heightmaps.empty() && request.seabed_path.empty()) {

@@ -38,9 +38,184 @@ size_t tableRpeIndex(const EvalReport& report) {
   return best;
 }
 
+std::vector<std::string> closureStatisticsCells(const RelativePoseErrorStatistics& s) {
+  return {cell(s.along_m.abs.rmse, 3),     cell(s.along_m.abs.max, 3),     cell(s.lateral_m.abs.rmse, 3),
+          cell(s.lateral_m.abs.max, 3),   cell(s.depth_m.abs.rmse, 3),    cell(s.depth_m.abs.max, 3),
+          cell(s.heading_deg.abs.rmse, 3), cell(s.heading_deg.abs.max, 3), cell(s.horizontal_m.rmse, 3)};
+}
+
+std::vector<std::string> closureErrorCells(bool present, const RelativePoseError& e) {
+  if (!present) return {"-", "-", "-", "-"};
+  return {cell(e.along_m, 3), cell(e.lateral_m, 3), cell(e.depth_m, 3), cell(e.heading_rad * 180.0 / M_PI, 3)};
+}
+
+std::string formatClosureTable(const EvalReport& report) {
+  const ClosureEvaluation& ev = report.closures.evaluation;
+  const std::string dr_label = report.closures.dr.path.empty() ? "" : report.closures.dr.label;
+  std::ostringstream out;
+  out << "loop closures " << report.closures.path << ": " << ev.closures.size() << " (" << ev.without_truth
+      << " outside the truth" << (dr_label.empty() ? ", no DR" : ", " + std::to_string(ev.without_dr) + " outside DR")
+      << "); error = relative pose - truth's, in A's body frame (x along, y lateral, z depth)\n";
+  std::vector<std::vector<std::string>> rows = {
+      {"status", "n", "source", "along", "along", "lateral", "lateral", "depth", "depth", "heading", "heading", "horiz"},
+      {"", "", "", "RMS m", "max m", "RMS m", "max m", "RMS m", "max m", "RMS deg", "max deg", "RMS m"}};
+  for (const ClosureGroup& g : ev.groups) {
+    std::vector<std::string> row = {g.status, std::to_string(g.count), "closure"};
+    for (const std::string& c : closureStatisticsCells(g.closure)) row.push_back(c);
+    rows.push_back(row);
+    if (dr_label.empty()) continue;
+    row = {"", std::to_string(g.dr.horizontal_m.count), dr_label};
+    for (const std::string& c : closureStatisticsCells(g.dr)) row.push_back(c);
+    rows.push_back(row);
+  }
+  out << formatColumns(rows);
+  if (report.options.closure_table) {
+    std::vector<std::vector<std::string>> list = {
+        {"closure a-b", "round", "status", "true dx", "true dy", "along", "lateral", "depth", "heading"},
+        {"", "", "", "m", "m", "err m", "err m", "err m", "err deg"}};
+    if (!dr_label.empty()) {
+      for (const char* name : {"DR along", "DR lateral", "DR depth", "DR heading"}) list[0].push_back(name);
+      for (const char* unit : {"err m", "err m", "err m", "err deg"}) list[1].push_back(unit);
+    }
+    for (const ClosureError& e : ev.closures) {
+      const ClosureRecord& c = e.closure;
+      std::vector<std::string> row = {std::to_string(c.subframe_id_a) + "-" + std::to_string(c.subframe_id_b),
+                                      c.round < 0 ? "-" : std::to_string(c.round), c.status,
+                                      e.has_truth ? cell(e.truth.translation_m.x(), 2) : "-",
+                                      e.has_truth ? cell(e.truth.translation_m.y(), 2) : "-"};
+      for (const std::string& v : closureErrorCells(e.has_truth, e.closure_error)) row.push_back(v);
+      if (!dr_label.empty()) {
+        for (const std::string& v : closureErrorCells(e.has_dr, e.dr_error)) row.push_back(v);
+      }
+      list.push_back(row);
+    }
+    out << "\n" << formatColumns(list);
+  }
+  return out.str();
+}
+
+std::string formatLceTable(const LceReport& lce, const TrueCorrespondenceOptions& options) {
+  char summary[512];
+  std::snprintf(summary, sizeof summary,
+                "landmark consistency error (LCE): %zu correspondences (of %zu) from %zu seabed points seen from 2+ "
+                "lines; grid %.1f m, swath %.0f-%.0f m, flat seabed at %.2f m (%s)\n",
+                lce.correspondences.pairs.size(), lce.correspondences.candidate_pairs,
+                lce.correspondences.seabed_points, options.grid_m, options.min_ground_range_m,
+                options.max_ground_range_m, lce.seabed_depth_m, lce.seabed_depth_source.c_str());
+  std::vector<std::vector<std::string>> rows = {{"trajectory", "pairs", "skipped", "mean", "RMSE", "median", "max"},
+                                                {"", "", "", "m", "m", "m", "m"}};
+  std::vector<const LceEntry*> entries = {&lce.truth};
+  for (const LceEntry& e : lce.estimates) entries.push_back(&e);
+  for (const LceEntry* e : entries) {
+    const ErrorStatistics& h = e->result.horizontal_m;
+    rows.push_back({e->label, std::to_string(h.count), std::to_string(e->result.skipped), cell(h.mean, 3),
+                    cell(h.rmse, 3), cell(h.median, 3), cell(h.max, 3)});
+  }
+  return summary + formatColumns(rows);
+}
+
 std::string withSuffix(const std::string& png_path, const std::string& suffix) {
   const std::string stem = png_path.substr(0, png_path.size() - 4);  // checked to end in .png
   return stem + suffix + ".png";
+}
+
+void writeRelativePoseError(JsonWriter& json, const std::string& key, bool present, const RelativePoseError& e) {
+  if (!present) {
+    json.key(key).null();
+    return;
+  }
+  json.key(key).beginObject();
+  json.key("along_m").value(e.along_m);
+  json.key("lateral_m").value(e.lateral_m);
+  json.key("depth_m").value(e.depth_m);
+  json.key("heading_deg").value(e.heading_rad * 180.0 / M_PI);
+  json.endObject();
+}
+
+void writeClosuresJson(JsonWriter& json, const ClosureReport& closures) {
+  const ClosureEvaluation& ev = closures.evaluation;
+  json.key("closures").beginObject();
+  json.key("path").value(closures.path);
+  if (closures.dr.path.empty()) {
+    json.key("dr").null();
+  } else {
+    json.key("dr").beginObject();
+    json.key("label").value(closures.dr.label);
+    json.key("path").value(closures.dr.path);
+    json.endObject();
+  }
+  json.key("count").value(static_cast<uint64_t>(ev.closures.size()));
+  json.key("without_truth").value(static_cast<uint64_t>(ev.without_truth));
+  json.key("without_dr").value(static_cast<uint64_t>(ev.without_dr));
+  json.key("groups").beginArray();
+  for (const ClosureGroup& g : ev.groups) {
+    json.beginObject();
+    json.key("status").value(g.status);
+    json.key("count").value(static_cast<uint64_t>(g.count));
+    writeRelativePoseErrorStatistics(json, "closure", g.closure);
+    writeRelativePoseErrorStatistics(json, "dr", g.dr);
+    json.endObject();
+  }
+  json.endArray();
+  json.key("closures").beginArray();
+  for (const ClosureError& e : ev.closures) {
+    const ClosureRecord& c = e.closure;
+    json.beginObject();
+    json.key("subframe_id_a").value(static_cast<int64_t>(c.subframe_id_a));
+    json.key("subframe_id_b").value(static_cast<int64_t>(c.subframe_id_b));
+    if (c.round < 0) json.key("round").null();
+    else json.key("round").value(c.round);
+    json.key("status").value(c.status);
+    json.key("rejection").value(c.rejection);
+    json.key("utime_a_us").value(static_cast<int64_t>(c.utime_a_us));
+    json.key("utime_b_us").value(static_cast<int64_t>(c.utime_b_us));
+    if (e.has_truth) {
+      json.key("truth").beginObject();
+      json.key("dx_m").value(e.truth.translation_m.x());
+      json.key("dy_m").value(e.truth.translation_m.y());
+      json.key("dz_m").value(e.truth.translation_m.z());
+      json.key("dheading_deg").value(e.truth.heading_rad * 180.0 / M_PI);
+      json.endObject();
+    } else {
+      json.key("truth").null();
+    }
+    writeRelativePoseError(json, "error", e.has_truth, e.closure_error);
+    writeRelativePoseError(json, "dr_error", e.has_dr, e.dr_error);
+    json.endObject();
+  }
+  json.endArray();
+  json.endObject();
+}
+
+void writeLceEntry(JsonWriter& json, const LceEntry& entry) {
+  writeErrorStatistics(json, "horizontal_m", entry.result.horizontal_m);
+  json.key("skipped").value(static_cast<uint64_t>(entry.result.skipped));
+}
+
+void writeLceJson(JsonWriter& json, const LceReport& lce, const TrueCorrespondenceOptions& options) {
+  json.key("lce").beginObject();
+  json.key("seabed_depth_m").value(lce.seabed_depth_m);
+  json.key("seabed_depth_source").value(lce.seabed_depth_source);
+  json.key("grid_m").value(options.grid_m);
+  json.key("min_ground_range_m").value(options.min_ground_range_m);
+  json.key("max_ground_range_m").value(options.max_ground_range_m);
+  json.key("max_correspondences").value(static_cast<uint64_t>(options.max_correspondences));
+  json.key("sightings").value(static_cast<uint64_t>(lce.correspondences.sightings));
+  json.key("seabed_points").value(static_cast<uint64_t>(lce.correspondences.seabed_points));
+  json.key("candidate_pairs").value(static_cast<uint64_t>(lce.correspondences.candidate_pairs));
+  json.key("correspondences").value(static_cast<uint64_t>(lce.correspondences.pairs.size()));
+  json.key("truth").beginObject();
+  writeLceEntry(json, lce.truth);
+  json.endObject();
+  json.key("estimates").beginArray();
+  for (const LceEntry& e : lce.estimates) {
+    json.beginObject();
+    json.key("label").value(e.label);
+    writeLceEntry(json, e);
+    json.endObject();
+  }
+  json.endArray();
+  json.endObject();
 }
 
 }  // namespace
@@ -59,9 +234,9 @@ bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalR
   report = EvalReport();
   report.options = options;
   report.truth_path = request.truth_path;
-  if (!request.estimates.empty()) {
+  if (!request.estimates.empty() || !request.closures_path.empty() || request.lce) {
     if (request.truth_path.empty()) {
-      error = "estimates need the truth trajectory (--gt TRUTH.tum)";
+      error = "estimates, closures and LCE need the truth trajectory (--gt TRUTH.tum)";
       return false;
     }
     TumReadResult truth = readTum(request.truth_path);
@@ -74,8 +249,9 @@ bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalR
     report.truth_distance_m = distance.back();
     report.lines = segmentSurveyLines(report.truth, options.trajectory.lines);
   }
+  std::vector<Trajectory> estimates;  // kept for the closures' DR and the LCE
   for (const EvalInput& input : request.estimates) {
-    const TumReadResult estimate = readTum(input.path);
+    TumReadResult estimate = readTum(input.path);
     if (!estimate.ok) {
       error = estimate.error;
       return false;
@@ -88,6 +264,7 @@ bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalR
       return false;
     }
     report.estimates.push_back(std::move(entry));
+    estimates.push_back(std::move(estimate.poses));
   }
   if (!report.estimates.empty()) {
     const double first = report.estimates.front().evaluation.ate.horizontal_m.rmse;
@@ -97,13 +274,16 @@ bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalR
     }
   }
 
-  if (!request.heightmaps.empty()) {
+  HeightmapRaster seabed;
+  const bool lce_needs_seabed = request.lce && !std::isfinite(options.lce_seabed_depth_m) && !request.seabed_path.empty();
+  if (!request.heightmaps.empty() || lce_needs_seabed) {
     if (request.seabed_path.empty()) {
       error = "heightmaps need the true seabed (--seabed seabed.yaml)";
       return false;
     }
-    HeightmapRaster seabed;
     if (!readHeightmap(request.seabed_path, seabed, error)) return false;
+  }
+  if (!request.heightmaps.empty()) {
     for (const EvalInput& input : request.heightmaps) {
       HeightmapRaster estimate;
       if (!readHeightmap(input.path, estimate, error)) return false;
@@ -116,6 +296,54 @@ bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalR
       }
       report.heightmaps.push_back(std::move(entry));
     }
+  }
+
+  if (!request.closures_path.empty()) {
+    std::vector<ClosureRecord> closures;
+    if (!readClosureCsv(request.closures_path, closures, error)) return false;
+    report.has_closures = true;
+    report.closures.path = request.closures_path;
+    Trajectory dr;
+    if (!request.closures_dr_path.empty()) {
+      TumReadResult read = readTum(request.closures_dr_path);
+      if (!read.ok) {
+        error = read.error;
+        return false;
+      }
+      dr = std::move(read.poses);
+      report.closures.dr = {defaultLabel({"", request.closures_dr_path}), request.closures_dr_path};
+    } else if (!estimates.empty()) {
+      dr = estimates.front();
+      report.closures.dr = report.estimates.front().input;
+    }
+    const double max_gap_s = options.trajectory.association.max_interpolation_gap_s;
+    report.closures.evaluation = evaluateClosures(closures, report.truth, dr.empty() ? nullptr : &dr, max_gap_s);
+  }
+
+  if (request.lce) {
+    if (report.lines.empty()) {
+      error = request.truth_path + ": no survey lines found in the truth; --lce needs straight lines seen from both sides";
+      return false;
+    }
+    LceReport& lce = report.lce;
+    if (std::isfinite(options.lce_seabed_depth_m)) {
+      lce.seabed_depth_m = options.lce_seabed_depth_m;
+      lce.seabed_depth_source = "--lce-seabed-depth-m";
+    } else {
+      lce.seabed_depth_m = flatSeabedDepthM(report.truth, lce_needs_seabed ? &seabed : nullptr,
+                                            options.lce_default_altitude_m, lce.seabed_depth_source);
+      if (lce_needs_seabed) lce.seabed_depth_source += " " + request.seabed_path;
+    }
+    LandmarkConsistencyOptions model;
+    model.seabed_depth_m = lce.seabed_depth_m;
+    model.max_interpolation_gap_s = options.trajectory.association.max_interpolation_gap_s;
+    lce.correspondences = generateTrueCorrespondences(report.truth, report.lines, options.lce, model);
+    lce.truth = {"truth (self-check)", landmarkConsistency(report.truth, lce.correspondences.pairs, model)};
+    for (size_t i = 0; i < estimates.size(); ++i) {
+      lce.estimates.push_back({report.estimates[i].input.label,
+                               landmarkConsistency(estimates[i], lce.correspondences.pairs, model)});
+    }
+    report.has_lce = true;
   }
   return true;
 }
@@ -185,13 +413,15 @@ bool writeFigures(const EvalRequest& request, EvalReport& report, std::string& e
 
 std::string formatTable(const EvalReport& report) {
   std::ostringstream out;
-  if (!report.estimates.empty()) {
+  if (!report.truth.empty()) {
     char summary[512];
     std::snprintf(summary, sizeof summary, "truth %s: %zu poses, %.1f s, %.0f m, %zu survey lines\n",
                   report.truth_path.c_str(), report.truth.size(),
                   static_cast<double>(report.truth.back().utime_us - report.truth.front().utime_us) * 1e-6,
                   report.truth_distance_m, report.lines.size());
     out << summary;
+  }
+  if (!report.estimates.empty()) {
     const size_t rpe_index = tableRpeIndex(report);
     const std::string rpe_window = report.options.trajectory.rpe.windows_m.empty()
                                        ? "RPE"
@@ -242,6 +472,8 @@ std::string formatTable(const EvalReport& report) {
     }
     out << "\n" << formatColumns(rows);
   }
+  if (report.has_closures) out << "\n" << formatClosureTable(report);
+  if (report.has_lce) out << "\n" << formatLceTable(report.lce, report.options.lce);
   return out.str();
 }
 
@@ -386,6 +618,11 @@ std::string reportJson(const EvalReport& report) {
   }
   json.endArray();
 
+  if (report.has_closures) writeClosuresJson(json, report.closures);
+  else json.key("closures").null();
+  if (report.has_lce) writeLceJson(json, report.lce, report.options.lce);
+  else json.key("lce").null();
+
   json.key("outputs").beginObject();
   json.key("json").value(report.json_path);
   json.key("plots").beginArray();
@@ -422,6 +659,27 @@ void writeErrorStatistics(JsonWriter& json, const std::string& key, const ErrorS
   json.key("mean").value(stats.mean);
   json.key("median").value(stats.median);
   json.key("max").value(stats.max);
+  json.endObject();
+}
+
+void writeSignedStatistics(JsonWriter& json, const std::string& key, const SignedErrorStatistics& stats) {
+  json.key(key).beginObject();
+  json.key("count").value(static_cast<uint64_t>(stats.abs.count));
+  json.key("rmse").value(stats.abs.rmse);
+  json.key("mean").value(stats.abs.mean);
+  json.key("median").value(stats.abs.median);
+  json.key("max").value(stats.abs.max);
+  json.key("bias").value(stats.bias);
+  json.endObject();
+}
+
+void writeRelativePoseErrorStatistics(JsonWriter& json, const std::string& key, const RelativePoseErrorStatistics& s) {
+  json.key(key).beginObject();
+  writeSignedStatistics(json, "along_m", s.along_m);
+  writeSignedStatistics(json, "lateral_m", s.lateral_m);
+  writeSignedStatistics(json, "depth_m", s.depth_m);
+  writeSignedStatistics(json, "heading_deg", s.heading_deg);
+  writeErrorStatistics(json, "horizontal_m", s.horizontal_m);
   json.endObject();
 }
 

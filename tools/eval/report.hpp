@@ -1,5 +1,5 @@
-// One evaluation run of sss-eval: reads the truth, the estimates and heightmaps, computes every
-// metric, and renders the terminal table, the JSON report and the figures.
+// One evaluation run of sss-eval: reads the truth, the estimates, heightmaps and loop closures,
+// computes every metric, and renders the terminal table, the JSON report and the figures.
 //
 // JSON report (schema "sss-eval/1"; keys are stable, new keys may be added; numbers that do not
 // exist, e.g. statistics over zero samples, are null). `stats` is
@@ -26,11 +26,28 @@
 //   "heightmaps": [{"label", "path", "estimate_cells", "cells_with_data", "compared_cells",
 //                   "coverage_fraction", "covered_area_m2", "abs_error_m": stats (MAE = mean),
 //                   "mean_signed_error_m", "error_map_yaml", "error_map_png" (null when not written)}],
+//   "closures": null | {  (--closures; error = estimate - truth in A's true body frame)
+//     "path", "dr": null | {"label", "path"}, "count", "without_truth", "without_dr",
+//     "groups": [{"status" (accepted, rejected, superseded, pending), "count",
+//                 "closure": errors, "dr": errors (count 0 without DR)}],
+//     "closures": [{"subframe_id_a", "subframe_id_b", "round", "status", "rejection", "utime_a_us",
+//                   "utime_b_us", "truth": null | {"dx_m", "dy_m", "dz_m", "dheading_deg"},
+//                   "error": null | component, "dr_error": null | component}]},
+//     errors = {"along_m", "lateral_m", "depth_m", "heading_deg": stats of |error| + "bias" (mean
+//               signed error), "horizontal_m": stats of |(along, lateral)|};
+//     component = {"along_m", "lateral_m", "depth_m", "heading_deg"} (signed)
+//   "lce": null | {  (--lce; landmark consistency error on correspondences made from the truth)
+//     "seabed_depth_m", "seabed_depth_source", "grid_m", "min_ground_range_m", "max_ground_range_m",
+//     "max_correspondences", "sightings", "seabed_points", "candidate_pairs", "correspondences",
+//     "truth": {"horizontal_m": stats, "skipped"} (the self-check, ~0),
+//     "estimates": [{"label", "horizontal_m": stats, "skipped"}]},
 //   "outputs": {"json", "plots": [...]}
 // }
 #pragma once
 
+#include "tools/eval/closure_metrics.hpp"
 #include "tools/eval/heightmap_metrics.hpp"
+#include "tools/eval/landmark_consistency.hpp"
 #include "tools/eval/json_writer.hpp"
 #include "tools/eval/plots.hpp"
 #include "tools/eval/trajectory_io.hpp"
@@ -55,12 +72,21 @@ struct EvalRequest {
   std::string json_path;               // empty: no JSON
   std::string plot_path;               // X.png: X.png (trajectories), X_error.png, X_heightmap_<label>.png
   std::string error_map_prefix;        // P: P_<label>.yaml + P_<label>_depth.f32 per heightmap
+  std::string closures_path;           // loop_closures.csv of sss-process; needs the truth
+  std::string closures_dr_path;        // DR trajectory for the closures' baseline; empty: the first estimate
+  bool lce = false;                    // landmark consistency of the truth and every estimate
 };
 
 struct EvalOptions {
   TrajectoryEvaluationOptions trajectory;
   double table_rpe_window_m = 50.0;  // the table shows the configured window closest to this
   ErrorMapPngOptions error_map_png;
+  bool closure_table = false;  // the table lists every closure (else only the statistics)
+  TrueCorrespondenceOptions lce;
+  // Depth of the flat seabed of the LCE model: this when finite, else flatSeabedDepthM() with the
+  // request's seabed raster if any and lce_default_altitude_m (the simulator's default altitude).
+  double lce_seabed_depth_m = std::numeric_limits<double>::quiet_NaN();
+  double lce_default_altitude_m = 18.0;
 };
 
 struct EstimateReport {
@@ -76,6 +102,25 @@ struct HeightmapReport {
   std::string error_map_png;
 };
 
+struct ClosureReport {
+  std::string path;
+  EvalInput dr;  // the DR trajectory the closures are compared with; path empty without one
+  ClosureEvaluation evaluation;
+};
+
+struct LceEntry {
+  std::string label;
+  LandmarkConsistencyResult result;
+};
+
+struct LceReport {
+  double seabed_depth_m = 0.0;
+  std::string seabed_depth_source;
+  TrueCorrespondences correspondences;
+  LceEntry truth;  // the self-check
+  std::vector<LceEntry> estimates;
+};
+
 struct EvalReport {
   EvalOptions options;
   std::string truth_path;
@@ -84,13 +129,17 @@ struct EvalReport {
   std::vector<SurveyLine> lines;
   std::vector<EstimateReport> estimates;
   std::vector<HeightmapReport> heightmaps;
+  bool has_closures = false;
+  ClosureReport closures;
+  bool has_lce = false;
+  LceReport lce;
   std::vector<std::string> plots;  // figure files written
   std::string json_path;
 };
 
 // Reads every input and computes every metric. False with a message naming the file (and line)
 // for bad or unusable input: unreadable or malformed files, an estimate with no pose in the
-// truth's time span, a heightmap that does not overlap the seabed.
+// truth's time span, a heightmap that does not overlap the seabed, --lce without survey lines.
 bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalReport& report, std::string& error);
 
 // Figures and error-map rasters of the request (plot_path, error_map_prefix). False with a
@@ -98,7 +147,8 @@ bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalR
 bool writeFigures(const EvalRequest& request, EvalReport& report, std::string& error);
 
 // The aligned terminal table: one row per estimate (ATE RMSE raw and aligned, horizontal ATE RMSE
-// and max, RPE, improvement vs the first estimate), per-line horizontal RMSE, heightmaps.
+// and max, RPE, improvement vs the first estimate), per-line horizontal RMSE, heightmaps, closure
+// errors per status (and per closure with options.closure_table), LCE per trajectory.
 std::string formatTable(const EvalReport& report);
 
 // The JSON report described at the top of this file.
@@ -111,5 +161,9 @@ std::string fileSafeLabel(const std::string& label);
 std::string formatColumns(const std::vector<std::vector<std::string>>& rows);
 // {"count", "rmse", "mean", "median", "max"} under key (NaN as null).
 void writeErrorStatistics(JsonWriter& json, const std::string& key, const ErrorStatistics& stats);
+// Stats of |error| + "bias" (mean signed error) under key.
+void writeSignedStatistics(JsonWriter& json, const std::string& key, const SignedErrorStatistics& stats);
+// {"along_m", "lateral_m", "depth_m", "heading_deg": signed stats, "horizontal_m": stats} under key.
+void writeRelativePoseErrorStatistics(JsonWriter& json, const std::string& key, const RelativePoseErrorStatistics& stats);
 
 }  // namespace sss::eval

@@ -569,6 +569,20 @@ std::vector<Table> metricTables(const RunReport& report, const RunReportOptions&
   const auto matched = [](const TrajectoryEvaluation& e) {
     return std::to_string(e.association.pairs.size()) + "/" + std::to_string(e.estimate_poses);
   };
+  if (report.has_lce) {
+    row("landmark consistency error (LCE) mean", report.lce_dr.mean, report.lce_slam.mean, " m", 3);
+    row("landmark consistency error (LCE) RMSE", report.lce_dr.rmse, report.lce_slam.rmse, " m", 3);
+  }
+  if (report.has_closure_errors) {
+    // DR column: DR's relative pose between the two subframe centres; SLAM column: the closure's.
+    const std::string accepted = " (" + std::to_string(report.closure_errors_accepted) + " accepted)";
+    row("closure relative pose error RMS, horizontal" + accepted, report.closure_errors_dr.horizontal_m.rmse,
+        report.closure_errors.horizontal_m.rmse, " m", 3);
+    row("closure relative pose error RMS, lateral" + accepted, report.closure_errors_dr.lateral_m.abs.rmse,
+        report.closure_errors.lateral_m.abs.rmse, " m", 3);
+    row("closure relative pose error RMS, heading" + accepted, report.closure_errors_dr.heading_deg.abs.rmse,
+        report.closure_errors.heading_deg.abs.rmse, " deg", 3);
+  }
   trajectory.rows.push_back({{"poses matched to the truth"}, {matched(report.dr)}, {matched(report.slam)}, {""}});
   tables.push_back(trajectory);
 
@@ -985,6 +999,40 @@ RunReport writeRunReport(const RunReportRequest& request, const RunReportOptions
     } else {
       report.has_closures = true;
       report.closure_counts = countClosures(report.closures);
+      // The same file as sss-eval --closures reads: relative pose errors of the accepted closures.
+      std::vector<ClosureRecord> records;
+      if (!readClosureCsv(report.closures_path, records, error)) {
+        report.notes.push_back("loop closures without relative poses, no closure errors: " + error);
+      } else {
+        const ClosureEvaluation closures =
+            evaluateClosures(records, truth, &dr, options.trajectory.association.max_interpolation_gap_s);
+        for (const ClosureGroup& group : closures.groups) {
+          if (group.status != "accepted") continue;
+          report.has_closure_errors = true;
+          report.closure_errors_accepted = group.count;
+          report.closure_errors = group.closure;
+          report.closure_errors_dr = group.dr;
+        }
+      }
+    }
+    if (!report.lines.empty()) {
+      // Landmark consistency on correspondences made from the truth (sss-eval --lce).
+      HeightmapRaster seabed;
+      const std::string seabed_path = joinPath(request.mission_dir, "seabed.yaml");
+      const bool have_seabed = fileExists(seabed_path) && readHeightmap(seabed_path, seabed, error);
+      LandmarkConsistencyOptions model;
+      model.seabed_depth_m = flatSeabedDepthM(truth, have_seabed ? &seabed : nullptr, options.lce_altitude_m,
+                                              report.lce_seabed_depth_source);
+      model.max_interpolation_gap_s = options.trajectory.association.max_interpolation_gap_s;
+      const TrueCorrespondences pairs = generateTrueCorrespondences(truth, report.lines, options.lce, model);
+      if (!pairs.pairs.empty()) {
+        report.has_lce = true;
+        report.lce_seabed_depth_m = model.seabed_depth_m;
+        report.lce_correspondences = pairs.pairs.size();
+        report.lce_truth_max_m = landmarkConsistency(truth, pairs.pairs, model).horizontal_m.max;
+        report.lce_dr = landmarkConsistency(dr, pairs.pairs, model).horizontal_m;
+        report.lce_slam = landmarkConsistency(slam, pairs.pairs, model).horizontal_m;
+      }
     }
     const std::string summary_path = joinPath(request.run_dir, "summary.json");
     if (!fileExists(summary_path)) {
@@ -1167,6 +1215,29 @@ std::string runReportJson(const RunReport& report, const RunReportRequest& reque
     json.endObject();
   } else {
     json.key("closures").null();
+  }
+
+  if (report.has_closure_errors) {
+    json.key("closure_errors").beginObject();
+    json.key("accepted").value(static_cast<uint64_t>(report.closure_errors_accepted));
+    writeRelativePoseErrorStatistics(json, "closure", report.closure_errors);
+    writeRelativePoseErrorStatistics(json, "dr", report.closure_errors_dr);
+    json.endObject();
+  } else {
+    json.key("closure_errors").null();
+  }
+  if (report.has_lce) {
+    json.key("lce").beginObject();
+    json.key("seabed_depth_m").value(report.lce_seabed_depth_m);
+    json.key("seabed_depth_source").value(report.lce_seabed_depth_source);
+    json.key("correspondences").value(static_cast<uint64_t>(report.lce_correspondences));
+    json.key("truth_max_m").value(report.lce_truth_max_m);
+    writeErrorStatistics(json, "dr", report.lce_dr);
+    writeErrorStatistics(json, "slam", report.lce_slam);
+    json.key("mean_improvement_percent").value(improvementPercent(report.lce_dr.mean, report.lce_slam.mean));
+    json.endObject();
+  } else {
+    json.key("lce").null();
   }
 
   if (report.has_summary) {

@@ -22,13 +22,21 @@
 //                        "bias_m", "coverage_fraction", "compared_cells"}, "mae_improvement_percent"},
 //   "closures": null | {"path", "accepted", "rejected", "pending", "superseded", "total",
 //                       "rejection_reasons": {"chi_square_gate": n, ...}},
+//   "closure_errors": null | {"accepted", "closure": errors, "dr": errors} (accepted closures' relative
+//                     pose - the truth's and DR's - the truth's, in A's body frame; errors as in
+//                     sss-eval's JSON, report.hpp),
+//   "lce": null | {"seabed_depth_m", "seabed_depth_source", "correspondences", "truth_max_m" (self-check),
+//                  "dr": stats, "slam": stats, "mean_improvement_percent"} (landmark consistency on
+//                  correspondences made from the truth, as sss-eval --lce),
 //   "run": null | {"pings", "subframes", "pairs_attempted", "closures_accepted", "closures_rejected",
 //                  "wall_s", "mission_s", "real_time_factor", "peak_rss_mib"},
 //   "notes": [...], "files": [...]
 // }
 #pragma once
 
+#include "tools/eval/closure_metrics.hpp"
 #include "tools/eval/heightmap_metrics.hpp"
+#include "tools/eval/landmark_consistency.hpp"
 #include "tools/eval/trajectory_io.hpp"
 #include "tools/eval/trajectory_metrics.hpp"
 
@@ -53,6 +61,8 @@ struct RunReportOptions {
   TrajectoryEvaluationOptions trajectory;
   double rpe_window_m = 100.0;     // the table shows the configured RPE window closest to this
   double same_change_percent = 2.0;  // |change| below this: "about the same" in the verdict
+  TrueCorrespondenceOptions lce;     // landmark consistency error, as sss-eval --lce
+  double lce_altitude_m = 18.0;      // flat seabed without seabed.yaml: truth median depth + this
 };
 
 // ---- loop_closures.csv ---------------------------------------------------------------------
@@ -143,6 +153,18 @@ struct RunReport {
   std::string closures_path;
   std::vector<LoopClosureRecord> closures;
   LoopClosureCounts closure_counts;
+  bool has_closure_errors = false;   // the accepted closures against the truth (and DR)
+  size_t closure_errors_accepted = 0;
+  RelativePoseErrorStatistics closure_errors;
+  RelativePoseErrorStatistics closure_errors_dr;
+
+  bool has_lce = false;
+  double lce_seabed_depth_m = std::numeric_limits<double>::quiet_NaN();
+  std::string lce_seabed_depth_source;
+  size_t lce_correspondences = 0;
+  double lce_truth_max_m = std::numeric_limits<double>::quiet_NaN();
+  ErrorStatistics lce_dr;
+  ErrorStatistics lce_slam;
 
   bool has_summary = false;
   RunSummary summary;

@@ -1,0 +1,224 @@
+// Loop-closure accuracy against ground truth. See closure_metrics.hpp.
+#include "tools/eval/closure_metrics.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <sstream>
+
+namespace sss::eval {
+namespace {
+
+std::string trim(const std::string& text) {
+  const size_t first = text.find_first_not_of(" \t\r");
+  if (first == std::string::npos) return "";
+  const size_t last = text.find_last_not_of(" \t\r");
+  return text.substr(first, last - first + 1);
+}
+
+std::vector<std::string> splitCsv(const std::string& line) {
+  std::vector<std::string> fields;
+  std::string field;
+  std::istringstream in(line);
+  while (std::getline(in, field, ',')) fields.push_back(trim(field));
+  if (!line.empty() && line.back() == ',') fields.push_back("");
+  return fields;
+}
+
+bool parseDouble(const std::string& text, double& value) {
+  char* end = nullptr;
+  errno = 0;
+  value = std::strtod(text.c_str(), &end);
+  return !text.empty() && end == text.c_str() + text.size() && errno != ERANGE && std::isfinite(value);
+}
+
+bool parseInteger(const std::string& text, int64_t& value) {
+  char* end = nullptr;
+  errno = 0;
+  value = std::strtoll(text.c_str(), &end, 10);
+  return !text.empty() && end == text.c_str() + text.size() && errno != ERANGE;
+}
+
+SignedErrorStatistics signedStatistics(const std::vector<double>& values) {
+  SignedErrorStatistics stats;
+  std::vector<double> magnitudes;
+  double sum = 0.0;
+  for (double v : values) {
+    magnitudes.push_back(std::abs(v));
+    sum += v;
+  }
+  stats.abs = errorStatistics(magnitudes);
+  if (!values.empty()) stats.bias = sum / static_cast<double>(values.size());
+  return stats;
+}
+
+}  // namespace
+
+bool readClosureCsv(const std::string& path, std::vector<ClosureRecord>& closures, std::string& error) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    error = path + ": cannot open; check the path";
+    return false;
+  }
+  closures.clear();
+  std::map<std::string, size_t> column;
+  static const char* kIntegers[] = {"subframe_id_a", "subframe_id_b", "utime_a_us", "utime_b_us"};
+  static const char* kNumbers[] = {"dx_m", "dy_m", "dz_m", "dheading_rad"};
+  std::string text;
+  int line_number = 0;
+  while (std::getline(in, text)) {
+    ++line_number;
+    const std::string line = trim(text);
+    if (line.empty() || line[0] == '#') continue;
+    const std::vector<std::string> fields = splitCsv(line);
+    const std::string where = path + ":" + std::to_string(line_number) + ": ";
+    if (column.empty()) {
+      for (size_t k = 0; k < fields.size(); ++k) column[fields[k]] = k;
+      std::vector<const char*> needed(std::begin(kIntegers), std::end(kIntegers));
+      needed.insert(needed.end(), std::begin(kNumbers), std::end(kNumbers));
+      for (const char* name : needed) {
+        if (!column.count(name)) {
+          error = where + "the header has no column '" + name +
+                  "' (expected the loop_closures.csv of sss-process: subframe_id_a,subframe_id_b,utime_a_us,"
+                  "utime_b_us,round,status,rejection,dx_m,dy_m,dz_m,droll_rad,dpitch_rad,dheading_rad,...)";
+          return false;
+        }
+      }
+      continue;
+    }
+    if (fields.size() != column.size()) {
+      error = where + std::to_string(fields.size()) + " fields, the header has " + std::to_string(column.size());
+      return false;
+    }
+    ClosureRecord record;
+    record.line = line_number;
+    int64_t integers[4];
+    for (int k = 0; k < 4; ++k) {
+      const std::string& field = fields[column[kIntegers[k]]];
+      if (!parseInteger(field, integers[k])) {
+        error = where + kIntegers[k] + " '" + field + "' is not an integer";
+        return false;
+      }
+    }
+    record.subframe_id_a = integers[0];
+    record.subframe_id_b = integers[1];
+    record.utime_a_us = integers[2];
+    record.utime_b_us = integers[3];
+    double numbers[4];
+    for (int k = 0; k < 4; ++k) {
+      const std::string& field = fields[column[kNumbers[k]]];
+      if (!parseDouble(field, numbers[k])) {
+        error = where + kNumbers[k] + " '" + field + "' is not a finite number";
+        return false;
+      }
+    }
+    record.translation_m = Eigen::Vector3d(numbers[0], numbers[1], numbers[2]);
+    record.heading_rad = numbers[3];
+    if (column.count("round")) {
+      int64_t round = 0;
+      if (!parseInteger(fields[column["round"]], round)) {
+        error = where + "round '" + fields[column["round"]] + "' is not an integer";
+        return false;
+      }
+      record.round = static_cast<int>(round);
+    }
+    record.status = column.count("status") ? fields[column["status"]] : "unknown";
+    if (record.status.empty()) record.status = "unknown";
+    if (column.count("rejection")) record.rejection = fields[column["rejection"]];
+    closures.push_back(std::move(record));
+  }
+  if (column.empty()) {
+    error = path + ": no header line (expected subframe_id_a,subframe_id_b,utime_a_us,utime_b_us,...,dx_m,dy_m,dz_m,"
+                   "...,dheading_rad)";
+    return false;
+  }
+  return true;
+}
+
+RelativePoseXyzHeading relativePose(const sss::core::Pose& T_world_a, const sss::core::Pose& T_world_b) {
+  const sss::core::Pose T_a_b = T_world_a.inverse() * T_world_b;
+  // Heading as the closure file writes it: the Euler heading of T_a_b's rotation.
+  return {T_a_b.translation, sss::core::eulerFromQuaternion(T_a_b.rotation).heading_rad};
+}
+
+RelativePoseError relativePoseError(const RelativePoseXyzHeading& estimate, const RelativePoseXyzHeading& truth) {
+  const Eigen::Vector3d d = estimate.translation_m - truth.translation_m;
+  return {d.x(), d.y(), d.z(), sss::core::wrapAngle(estimate.heading_rad - truth.heading_rad)};
+}
+
+RelativePoseErrorStatistics relativePoseErrorStatistics(const std::vector<RelativePoseError>& errors) {
+  std::vector<double> along, lateral, depth, heading_deg, horizontal;
+  for (const RelativePoseError& e : errors) {
+    along.push_back(e.along_m);
+    lateral.push_back(e.lateral_m);
+    depth.push_back(e.depth_m);
+    heading_deg.push_back(e.heading_rad * 180.0 / M_PI);
+    horizontal.push_back(std::hypot(e.along_m, e.lateral_m));
+  }
+  RelativePoseErrorStatistics stats;
+  stats.along_m = signedStatistics(along);
+  stats.lateral_m = signedStatistics(lateral);
+  stats.depth_m = signedStatistics(depth);
+  stats.heading_deg = signedStatistics(heading_deg);
+  stats.horizontal_m = errorStatistics(horizontal);
+  return stats;
+}
+
+ClosureEvaluation evaluateClosures(const std::vector<ClosureRecord>& closures, const Trajectory& truth,
+                                   const Trajectory* dr, double max_gap_s) {
+  ClosureEvaluation result;
+  for (const ClosureRecord& record : closures) {
+    ClosureError entry;
+    entry.closure = record;
+    const std::optional<sss::core::Pose> truth_a = poseAtTime(truth, record.utime_a_us, max_gap_s);
+    const std::optional<sss::core::Pose> truth_b = poseAtTime(truth, record.utime_b_us, max_gap_s);
+    if (truth_a && truth_b) {
+      entry.has_truth = true;
+      entry.truth = relativePose(*truth_a, *truth_b);
+      entry.closure_error = relativePoseError({record.translation_m, record.heading_rad}, entry.truth);
+      if (dr) {
+        const std::optional<sss::core::Pose> dr_a = poseAtTime(*dr, record.utime_a_us, max_gap_s);
+        const std::optional<sss::core::Pose> dr_b = poseAtTime(*dr, record.utime_b_us, max_gap_s);
+        if (dr_a && dr_b) {
+          entry.has_dr = true;
+          entry.dr_error = relativePoseError(relativePose(*dr_a, *dr_b), entry.truth);
+        } else {
+          ++result.without_dr;
+        }
+      }
+    } else {
+      ++result.without_truth;
+    }
+    result.closures.push_back(entry);
+  }
+
+  // Groups in a fixed order of the statuses sss-process writes, then any other status as found.
+  std::vector<std::string> statuses = {"accepted", "rejected", "superseded", "pending"};
+  for (const ClosureError& e : result.closures) {
+    if (std::find(statuses.begin(), statuses.end(), e.closure.status) == statuses.end()) {
+      statuses.push_back(e.closure.status);
+    }
+  }
+  for (const std::string& status : statuses) {
+    std::vector<RelativePoseError> closure_errors, dr_errors;
+    for (const ClosureError& e : result.closures) {
+      if (e.closure.status != status || !e.has_truth) continue;
+      closure_errors.push_back(e.closure_error);
+      if (e.has_dr) dr_errors.push_back(e.dr_error);
+    }
+    if (closure_errors.empty()) continue;
+    ClosureGroup group;
+    group.status = status;
+    group.count = closure_errors.size();
+    group.closure = relativePoseErrorStatistics(closure_errors);
+    group.dr = relativePoseErrorStatistics(dr_errors);
+    result.groups.push_back(group);
+  }
+  return result;
+}
+
+}  // namespace sss::eval
