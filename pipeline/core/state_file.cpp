@@ -1,6 +1,7 @@
 // Atomic key-value state files; see state_file.hpp.
 #include "pipeline/core/state_file.hpp"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -29,22 +30,48 @@ bool writeStateFile(const std::string& path, const std::string& format, const St
     }
     text << key << ' ' << value << '\n';
   }
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-    out << text.str();
-    out.flush();
-    if (!out) {
-      error = "cannot write " + temporary + ": " + std::strerror(errno);
-      return false;
-    }
+  return writeFileAtomically(path, text.str(), error);
+}
+
+void syncDirectoryOf(const std::string& path) {
+  // Some file systems refuse fsync on directories: best effort.
+  const size_t slash = path.find_last_of('/');
+  const std::string directory = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+  const int dir = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY);
+  if (dir >= 0) {
+    ::fsync(dir);
+    ::close(dir);
   }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    error = "cannot rename " + temporary + " to " + path + ": " + std::strerror(errno);
-    ::unlink(temporary.c_str());
+}
+
+bool writeFileAtomically(const std::string& path, const std::function<bool(std::FILE*)>& write_body,
+                         std::string& error) {
+  const std::string temporary = path + ".tmp";
+  std::FILE* file = std::fopen(temporary.c_str(), "wb");
+  if (!file) {
+    error = temporary + ": cannot open for writing: " + std::strerror(errno);
     return false;
   }
+  const bool written = write_body(file) && std::fflush(file) == 0 && ::fsync(::fileno(file)) == 0;
+  const int write_errno = errno;
+  if (std::fclose(file) != 0 || !written) {
+    std::remove(temporary.c_str());
+    error = temporary + ": write failed: " + std::strerror(write_errno) + "; the previous file is kept";
+    return false;
+  }
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    const int rename_errno = errno;
+    std::remove(temporary.c_str());
+    error = path + ": rename failed: " + std::strerror(rename_errno);
+    return false;
+  }
+  syncDirectoryOf(path);
   return true;
+}
+
+bool writeFileAtomically(const std::string& path, const std::string& bytes, std::string& error) {
+  return writeFileAtomically(
+      path, [&](std::FILE* file) { return std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size(); }, error);
 }
 
 bool readStateFile(const std::string& path, const std::string& format, StateValues& values, std::string& error) {

@@ -4,6 +4,8 @@
 // torn one. For a few counters and numbers, not for bulk data.
 #pragma once
 
+#include <cstdio>
+#include <functional>
 #include <map>
 #include <string>
 
@@ -14,6 +16,15 @@ namespace sss::core {
 // first entry: systemd joins several with ':'), else "" (nothing written). env_value may be null
 // (the variable unset).
 std::string resolveSystemdDirectory(const std::string& configured, const char* env_value);
+
+// Replaces path with what write_body writes (a temporary file, flushed and fsynced, renamed over
+// path, the directory fsynced): a kill or power loss at any moment leaves the old or the new
+// file. False with `error` set when it cannot (the old file is then intact).
+bool writeFileAtomically(const std::string& path, const std::function<bool(std::FILE*)>& write_body,
+                         std::string& error);
+bool writeFileAtomically(const std::string& path, const std::string& bytes, std::string& error);
+// fsync of the directory holding path (makes a rename durable); best effort.
+void syncDirectoryOf(const std::string& path);
 
 using StateValues = std::map<std::string, std::string>;
 

@@ -2,7 +2,6 @@
 // (versioned text, "%.17g" doubles round-trip exactly, checksum line). See matcher_state.hpp.
 #include "pipeline/matcher/matcher_state.hpp"
 
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -13,6 +12,8 @@
 #include <filesystem>
 #include <sstream>
 #include <stdexcept>
+
+#include "pipeline/core/state_file.hpp"
 
 namespace sss::matcher {
 namespace {
@@ -49,36 +50,6 @@ class Fnv1a {
  private:
   uint64_t hash_ = 1469598103934665603ull;
 };
-
-// Writes through `body(FILE*)` into <path>.tmp, fsyncs it, renames it into place and fsyncs the
-// directory (best effort: some file systems refuse fsync on directories).
-template <typename Body>
-bool writeAtomically(const std::string& path, Body body, std::string& error) {
-  const std::string temporary = path + ".tmp";
-  FILE* file = std::fopen(temporary.c_str(), "wb");
-  if (!file) {
-    error = temporary + ": cannot open for writing: " + std::strerror(errno);
-    return false;
-  }
-  const bool written = body(file) && std::fflush(file) == 0 && ::fsync(::fileno(file)) == 0;
-  const int write_errno = errno;
-  if (std::fclose(file) != 0 || !written) {
-    std::remove(temporary.c_str());
-    error = temporary + ": write failed: " + std::strerror(write_errno) + "; the previous file is kept";
-    return false;
-  }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    error = path + ": rename failed: " + std::strerror(errno);
-    std::remove(temporary.c_str());
-    return false;
-  }
-  const int directory = ::open(fs::path(path).parent_path().c_str(), O_RDONLY | O_DIRECTORY);
-  if (directory >= 0) {
-    ::fsync(directory);
-    ::close(directory);
-  }
-  return true;
-}
 
 bool readWholeFile(const std::string& path, uintmax_t max_bytes, std::string& contents, std::string& error) {
   std::error_code ec;
@@ -278,7 +249,7 @@ bool MatcherStateStore::open(std::string& error) {
 }
 
 bool MatcherStateStore::writeSubframe(const sss::subframe::Subframe& s, std::string& error) {
-  return writeAtomically(
+  return sss::core::writeFileAtomically(
       subframePath(s.id),
       [&](FILE* file) {
         BinaryWriter out(file);
@@ -334,7 +305,7 @@ bool MatcherStateStore::writeState(const MatcherState& state, std::string& error
   char checksum[40];
   std::snprintf(checksum, sizeof checksum, "checksum %016" PRIx64 "\n", hash.value());
   text += checksum;
-  return writeAtomically(
+  return sss::core::writeFileAtomically(
       statePath(), [&](FILE* file) { return std::fwrite(text.data(), 1, text.size(), file) == text.size(); }, error);
 }
 

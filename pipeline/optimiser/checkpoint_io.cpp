@@ -1,7 +1,6 @@
 // Checkpoint text, checksums and atomic file writes, see checkpoint_io.hpp.
 #include "pipeline/optimiser/checkpoint_io.hpp"
 
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <charconv>
@@ -218,40 +217,5 @@ bool readChecked(const std::string& path, size_t max_bytes, std::string& text, s
   return true;
 }
 
-void syncDirectoryOf(const std::string& path) {
-  // Some file systems refuse fsync on directories: best effort.
-  const size_t slash = path.find_last_of('/');
-  const std::string directory = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
-  const int dir = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY);
-  if (dir >= 0) {
-    ::fsync(dir);
-    ::close(dir);
-  }
-}
-
-bool writeAtomically(const std::string& path, const std::string& bytes, std::string& error) {
-  const std::string temporary = path + ".tmp";
-  FILE* file = std::fopen(temporary.c_str(), "wb");
-  if (!file) {
-    error = temporary + ": cannot open for writing: " + std::strerror(errno);
-    return false;
-  }
-  const bool written = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size() && std::fflush(file) == 0 &&
-                       ::fsync(::fileno(file)) == 0;
-  const int write_errno = errno;
-  if (std::fclose(file) != 0 || !written) {
-    std::remove(temporary.c_str());
-    error = temporary + ": write failed: " + std::strerror(write_errno) + "; the previous file is kept";
-    return false;
-  }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    const int rename_errno = errno;
-    std::remove(temporary.c_str());
-    error = path + ": rename failed: " + std::strerror(rename_errno);
-    return false;
-  }
-  syncDirectoryOf(path);
-  return true;
-}
 
 }  // namespace sss::optimiser::checkpoint

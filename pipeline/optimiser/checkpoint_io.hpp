@@ -68,10 +68,6 @@ void appendChecksum(std::string& text);
 // Reads the whole file (at most max_bytes), checks its last line "checksum ..." and returns the
 // text before it; false with `error` ("cannot open: ...", "checksum mismatch: ...") otherwise.
 bool readChecked(const std::string& path, size_t max_bytes, std::string& text, std::string& error);
-// Writes bytes to path + ".tmp", fsyncs it, renames it over path and fsyncs the directory: a crash
-// leaves either the old or the new file, never a mix.
-bool writeAtomically(const std::string& path, const std::string& bytes, std::string& error);
-// fsync of the directory holding path (makes a rename or a new file durable; best effort).
-void syncDirectoryOf(const std::string& path);
+// Whole files are replaced with sss::core::writeFileAtomically (pipeline/core/state_file.hpp).
 
 }  // namespace sss::optimiser::checkpoint

@@ -19,6 +19,7 @@
 #include <string>
 #include <type_traits>
 
+#include "pipeline/core/state_file.hpp"
 #include "pipeline/optimiser/checkpoint_io.hpp"
 #include "pipeline/optimiser/optimiser_engine.hpp"
 #include "pipeline/optimiser/pose_manifold.hpp"
@@ -208,7 +209,7 @@ Status OptimiserEngine::saveCheckpoint(const std::string& path) {
   }
   std::string error;
   if (fresh) {
-    if (!checkpoint::writeAtomically(journal_path, journalHeader(journal.id) + records, error)) return fail(error);
+    if (!sss::core::writeFileAtomically(journal_path, journalHeader(journal.id) + records, error)) return fail(error);
   } else if (!records.empty() && !appendAt(journal_path, journal.bytes, records, error)) {
     return fail(error);
   }
@@ -266,7 +267,7 @@ Status OptimiserEngine::saveCheckpoint(const std::string& path) {
   w.raw(graph);
   std::string& text = w.text();
   checkpoint::appendChecksum(text);
-  if (!checkpoint::writeAtomically(path, text, error)) return fail(error);
+  if (!sss::core::writeFileAtomically(path, text, error)) return fail(error);
 
   journal_ = journal;
   unjournaled_subframes_.clear();

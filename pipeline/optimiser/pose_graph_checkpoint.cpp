@@ -6,6 +6,7 @@
 #include <limits>
 #include <string>
 
+#include "pipeline/core/state_file.hpp"
 #include "pipeline/optimiser/checkpoint_io.hpp"
 #include "pipeline/optimiser/pose_graph.hpp"
 #include "pipeline/optimiser/pose_manifold.hpp"
@@ -100,7 +101,7 @@ Status SlidingWindowPoseGraph::saveCheckpoint(const std::string& path) const {
   std::string text = checkpointText();
   checkpoint::appendChecksum(text);
   std::string error;
-  if (!checkpoint::writeAtomically(path, text, error)) return Status::error("checkpoint " + error);
+  if (!sss::core::writeFileAtomically(path, text, error)) return Status::error("checkpoint " + error);
   return Status::success();
 }
 

@@ -70,7 +70,7 @@ TEST_F(StateFileTest, RefusesForeignTornAndMalformedFiles) {
   EXPECT_FALSE(writeStateFile(path_, "demo 1", {{"key", "a\nb"}}, error));
   // A directory that does not exist: an error, no exception.
   EXPECT_FALSE(writeStateFile((dir_ / "no" / "state").string(), "demo 1", {{"k", "v"}}, error));
-  EXPECT_NE(error.find("cannot write"), std::string::npos) << error;
+  EXPECT_NE(error.find("state.tmp: cannot open for writing"), std::string::npos) << error;
 }
 
 TEST(ResolveSystemdDirectory, ConfiguredThenTheFirstEntryOfTheEnvironmentThenNone) {

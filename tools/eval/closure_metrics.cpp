@@ -10,38 +10,10 @@
 #include <optional>
 #include <sstream>
 
+#include "tools/eval/csv_fields.hpp"
+
 namespace sss::eval {
 namespace {
-
-std::string trim(const std::string& text) {
-  const size_t first = text.find_first_not_of(" \t\r");
-  if (first == std::string::npos) return "";
-  const size_t last = text.find_last_not_of(" \t\r");
-  return text.substr(first, last - first + 1);
-}
-
-std::vector<std::string> splitCsv(const std::string& line) {
-  std::vector<std::string> fields;
-  std::string field;
-  std::istringstream in(line);
-  while (std::getline(in, field, ',')) fields.push_back(trim(field));
-  if (!line.empty() && line.back() == ',') fields.push_back("");
-  return fields;
-}
-
-bool parseDouble(const std::string& text, double& value) {
-  char* end = nullptr;
-  errno = 0;
-  value = std::strtod(text.c_str(), &end);
-  return !text.empty() && end == text.c_str() + text.size() && errno != ERANGE && std::isfinite(value);
-}
-
-bool parseInteger(const std::string& text, int64_t& value) {
-  char* end = nullptr;
-  errno = 0;
-  value = std::strtoll(text.c_str(), &end, 10);
-  return !text.empty() && end == text.c_str() + text.size() && errno != ERANGE;
-}
 
 SignedErrorStatistics signedStatistics(const std::vector<double>& values) {
   SignedErrorStatistics stats;
@@ -72,9 +44,9 @@ bool readClosureCsv(const std::string& path, std::vector<ClosureRecord>& closure
   int line_number = 0;
   while (std::getline(in, text)) {
     ++line_number;
-    const std::string line = trim(text);
+    const std::string line = trimField(text);
     if (line.empty() || line[0] == '#') continue;
-    const std::vector<std::string> fields = splitCsv(line);
+    const std::vector<std::string> fields = splitCsvLine(line);
     const std::string where = path + ":" + std::to_string(line_number) + ": ";
     if (column.empty()) {
       for (size_t k = 0; k < fields.size(); ++k) column[fields[k]] = k;
@@ -99,7 +71,7 @@ bool readClosureCsv(const std::string& path, std::vector<ClosureRecord>& closure
     int64_t integers[4];
     for (int k = 0; k < 4; ++k) {
       const std::string& field = fields[column[kIntegers[k]]];
-      if (!parseInteger(field, integers[k])) {
+      if (!parseInteger64(field, integers[k])) {
         error = where + kIntegers[k] + " '" + field + "' is not an integer";
         return false;
       }
@@ -111,7 +83,7 @@ bool readClosureCsv(const std::string& path, std::vector<ClosureRecord>& closure
     double numbers[4];
     for (int k = 0; k < 4; ++k) {
       const std::string& field = fields[column[kNumbers[k]]];
-      if (!parseDouble(field, numbers[k])) {
+      if (!parseFiniteDouble(field, numbers[k])) {
         error = where + kNumbers[k] + " '" + field + "' is not a finite number";
         return false;
       }
@@ -120,7 +92,7 @@ bool readClosureCsv(const std::string& path, std::vector<ClosureRecord>& closure
     record.heading_rad = numbers[3];
     if (column.count("round")) {
       int64_t round = 0;
-      if (!parseInteger(fields[column["round"]], round)) {
+      if (!parseInteger64(fields[column["round"]], round)) {
         error = where + "round '" + fields[column["round"]] + "' is not an integer";
         return false;
       }

@@ -2,6 +2,7 @@
 // See run_report.hpp.
 #include "tools/eval/run_report.hpp"
 
+#include "tools/eval/csv_fields.hpp"
 #include "tools/eval/json_writer.hpp"
 #include "tools/eval/plots.hpp"
 #include "tools/eval/report.hpp"
@@ -32,29 +33,6 @@ std::string joinPath(const std::string& dir, const std::string& name) { return (
 bool fileExists(const std::string& path) {
   std::error_code ec;
   return fs::is_regular_file(path, ec);
-}
-
-std::string trim(const std::string& text) {
-  const size_t first = text.find_first_not_of(" \t\r");
-  if (first == std::string::npos) return "";
-  const size_t last = text.find_last_not_of(" \t\r");
-  return text.substr(first, last - first + 1);
-}
-
-std::vector<std::string> splitCsv(const std::string& line) {
-  std::vector<std::string> fields;
-  std::string field;
-  std::istringstream in(line);
-  while (std::getline(in, field, ',')) fields.push_back(trim(field));
-  if (!line.empty() && line.back() == ',') fields.push_back("");
-  return fields;
-}
-
-bool parseDouble(const std::string& text, double& value) {
-  char* end = nullptr;
-  errno = 0;
-  value = std::strtod(text.c_str(), &end);
-  return !text.empty() && end == text.c_str() + text.size() && errno != ERANGE && std::isfinite(value);
 }
 
 double improvementPercent(double dr, double slam) {
@@ -829,9 +807,9 @@ bool readLoopClosures(const std::string& path, std::vector<LoopClosureRecord>& c
   static const char* kNeeded[] = {"status", "north_a_m", "east_a_m", "north_b_m", "east_b_m"};
   while (std::getline(in, text)) {
     ++line_number;
-    const std::string line = trim(text);
+    const std::string line = trimField(text);
     if (line.empty() || line[0] == '#') continue;
-    const std::vector<std::string> fields = splitCsv(line);
+    const std::vector<std::string> fields = splitCsvLine(line);
     const std::string where = path + ":" + std::to_string(line_number) + ": ";
     if (column.empty()) {
       for (size_t k = 0; k < fields.size(); ++k) column[fields[k]] = k;
@@ -860,7 +838,7 @@ bool readLoopClosures(const std::string& path, std::vector<LoopClosureRecord>& c
     double values[4];
     for (int k = 0; k < 4; ++k) {
       const std::string& field = fields[column[kNeeded[k + 1]]];
-      if (!parseDouble(field, values[k])) {
+      if (!parseFiniteDouble(field, values[k])) {
         error = where + kNeeded[k + 1] + " '" + field + "' is not a finite number";
         return false;
       }
@@ -918,7 +896,7 @@ bool readRunSummary(const std::string& path, RunSummary& summary, std::string& e
   for (const auto& [key, value] : keys) {
     const YAML::Node node = root[key];
     double number = kNaN;
-    if (node && node.IsScalar() && parseDouble(node.Scalar(), number)) {
+    if (node && node.IsScalar() && parseFiniteDouble(node.Scalar(), number)) {
       *value = number;
     } else {
       result.missing_keys.push_back(key);
