@@ -31,48 +31,26 @@ SignedErrorStatistics signedStatistics(const std::vector<double>& values) {
 }  // namespace
 
 bool readClosureCsv(const std::string& path, std::vector<ClosureRecord>& closures, std::string& error) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    error = path + ": cannot open; check the path";
+  static const char* kIntegers[] = {"subframe_id_a", "subframe_id_b", "utime_a_us", "utime_b_us"};
+  static const char* kNumbers[] = {"dx_m", "dy_m", "dz_m", "dheading_rad"};
+  std::vector<std::string> required(std::begin(kIntegers), std::end(kIntegers));
+  required.insert(required.end(), std::begin(kNumbers), std::end(kNumbers));
+  CsvTable table;
+  if (!readCsvTable(path, required,
+                    "the loop_closures.csv of sss-process: subframe_id_a,subframe_id_b,utime_a_us,utime_b_us,round,"
+                    "status,rejection,dx_m,dy_m,dz_m,droll_rad,dpitch_rad,dheading_rad,...",
+                    table, error)) {
     return false;
   }
   closures.clear();
-  std::map<std::string, size_t> column;
-  static const char* kIntegers[] = {"subframe_id_a", "subframe_id_b", "utime_a_us", "utime_b_us"};
-  static const char* kNumbers[] = {"dx_m", "dy_m", "dz_m", "dheading_rad"};
-  std::string text;
-  int line_number = 0;
-  while (std::getline(in, text)) {
-    ++line_number;
-    const std::string line = trimField(text);
-    if (line.empty() || line[0] == '#') continue;
-    const std::vector<std::string> fields = splitCsvLine(line);
-    const std::string where = path + ":" + std::to_string(line_number) + ": ";
-    if (column.empty()) {
-      for (size_t k = 0; k < fields.size(); ++k) column[fields[k]] = k;
-      std::vector<const char*> needed(std::begin(kIntegers), std::end(kIntegers));
-      needed.insert(needed.end(), std::begin(kNumbers), std::end(kNumbers));
-      for (const char* name : needed) {
-        if (!column.count(name)) {
-          error = where + "the header has no column '" + name +
-                  "' (expected the loop_closures.csv of sss-process: subframe_id_a,subframe_id_b,utime_a_us,"
-                  "utime_b_us,round,status,rejection,dx_m,dy_m,dz_m,droll_rad,dpitch_rad,dheading_rad,...)";
-          return false;
-        }
-      }
-      continue;
-    }
-    if (fields.size() != column.size()) {
-      error = where + std::to_string(fields.size()) + " fields, the header has " + std::to_string(column.size());
-      return false;
-    }
+  for (const CsvRow& row : table.rows) {
     ClosureRecord record;
-    record.line = line_number;
+    record.line = row.line;
     int64_t integers[4];
     for (int k = 0; k < 4; ++k) {
-      const std::string& field = fields[column[kIntegers[k]]];
+      const std::string& field = table.field(row, kIntegers[k]);
       if (!parseInteger64(field, integers[k])) {
-        error = where + kIntegers[k] + " '" + field + "' is not an integer";
+        error = table.where(row) + kIntegers[k] + " '" + field + "' is not an integer";
         return false;
       }
     }
@@ -82,31 +60,26 @@ bool readClosureCsv(const std::string& path, std::vector<ClosureRecord>& closure
     record.utime_b_us = integers[3];
     double numbers[4];
     for (int k = 0; k < 4; ++k) {
-      const std::string& field = fields[column[kNumbers[k]]];
+      const std::string& field = table.field(row, kNumbers[k]);
       if (!parseFiniteDouble(field, numbers[k])) {
-        error = where + kNumbers[k] + " '" + field + "' is not a finite number";
+        error = table.where(row) + kNumbers[k] + " '" + field + "' is not a finite number";
         return false;
       }
     }
     record.translation_m = Eigen::Vector3d(numbers[0], numbers[1], numbers[2]);
     record.heading_rad = numbers[3];
-    if (column.count("round")) {
+    if (table.has("round")) {
       int64_t round = 0;
-      if (!parseInteger64(fields[column["round"]], round)) {
-        error = where + "round '" + fields[column["round"]] + "' is not an integer";
+      if (!parseInteger64(table.field(row, "round"), round)) {
+        error = table.where(row) + "round '" + table.field(row, "round") + "' is not an integer";
         return false;
       }
       record.round = static_cast<int>(round);
     }
-    record.status = column.count("status") ? fields[column["status"]] : "unknown";
+    record.status = table.has("status") ? table.field(row, "status") : "unknown";
     if (record.status.empty()) record.status = "unknown";
-    if (column.count("rejection")) record.rejection = fields[column["rejection"]];
+    if (table.has("rejection")) record.rejection = table.field(row, "rejection");
     closures.push_back(std::move(record));
-  }
-  if (column.empty()) {
-    error = path + ": no header line (expected subframe_id_a,subframe_id_b,utime_a_us,utime_b_us,...,dx_m,dy_m,dz_m,"
-                   "...,dheading_rad)";
-    return false;
   }
   return true;
 }

@@ -4,6 +4,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <sstream>
 
 namespace sss::eval {
@@ -36,6 +37,48 @@ bool parseInteger64(const std::string& text, int64_t& value) {
   errno = 0;
   value = std::strtoll(text.c_str(), &end, 10);
   return !text.empty() && end == text.c_str() + text.size() && errno != ERANGE;
+}
+
+bool readCsvTable(const std::string& path, const std::vector<std::string>& required, const std::string& expected,
+                  CsvTable& table, std::string& error) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    error = path + ": cannot open; check the path";
+    return false;
+  }
+  table = CsvTable{};
+  table.path = path;
+  std::string text;
+  int line_number = 0;
+  bool have_header = false;
+  while (std::getline(in, text)) {
+    ++line_number;
+    const std::string line = trimField(text);
+    if (line.empty() || line[0] == '#') continue;
+    CsvRow row{line_number, splitCsvLine(line)};
+    if (!have_header) {
+      for (size_t k = 0; k < row.fields.size(); ++k) table.column[row.fields[k]] = k;
+      for (const std::string& name : required) {
+        if (!table.has(name)) {
+          error = table.where(row) + "the header has no column '" + name + "' (expected " + expected + ")";
+          return false;
+        }
+      }
+      have_header = true;
+      continue;
+    }
+    if (row.fields.size() != table.column.size()) {
+      error = table.where(row) + std::to_string(row.fields.size()) + " fields, the header has " +
+              std::to_string(table.column.size());
+      return false;
+    }
+    table.rows.push_back(std::move(row));
+  }
+  if (!have_header) {
+    error = path + ": no header line (expected " + expected + ")";
+    return false;
+  }
+  return true;
 }
 
 }  // namespace sss::eval

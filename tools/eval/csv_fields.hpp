@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -15,5 +16,29 @@ std::vector<std::string> splitCsvLine(const std::string& line);
 // The whole text is one finite number / one integer in range; false otherwise.
 bool parseFiniteDouble(const std::string& text, double& value);
 bool parseInteger64(const std::string& text, int64_t& value);
+
+// A CSV file with a header line, columns found by name (any order, extra columns ignored).
+struct CsvRow {
+  int line = 0;  // in the file, for messages
+  std::vector<std::string> fields;
+};
+struct CsvTable {
+  std::string path;
+  std::map<std::string, size_t> column;
+  std::vector<CsvRow> rows;
+
+  bool has(const std::string& name) const { return column.count(name) != 0; }
+  // The named field of a row; the column must exist (required, or checked with has()).
+  const std::string& field(const CsvRow& row, const std::string& name) const { return row.fields[column.at(name)]; }
+  // "PATH:LINE: " for a message about the row.
+  std::string where(const CsvRow& row) const { return path + ":" + std::to_string(row.line) + ": "; }
+};
+
+// Reads path: '#' and blank lines skipped, the first other line is the header, every row must have
+// as many fields as the header. False with "PATH[:LINE]: ..." on a missing file, a missing
+// required column or header, or a row of another length; `expected` (e.g. "a,b,...") is quoted
+// in the header messages.
+bool readCsvTable(const std::string& path, const std::vector<std::string>& required, const std::string& expected,
+                  CsvTable& table, std::string& error);
 
 }  // namespace sss::eval

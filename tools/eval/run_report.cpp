@@ -795,61 +795,34 @@ bool writeText(const std::string& path, const std::string& text, std::string& er
 // ---- loop closures and summary -----------------------------------------------------------
 
 bool readLoopClosures(const std::string& path, std::vector<LoopClosureRecord>& closures, std::string& error) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    error = path + ": cannot open; check the path";
+  static const char* kCentres[] = {"north_a_m", "east_a_m", "north_b_m", "east_b_m"};
+  CsvTable table;
+  if (!readCsvTable(path, {"status", kCentres[0], kCentres[1], kCentres[2], kCentres[3]},
+                    "subframe_id_a,subframe_id_b,...,status,...,north_a_m,east_a_m,north_b_m,east_b_m", table, error)) {
     return false;
   }
   closures.clear();
-  std::map<std::string, size_t> column;
-  std::string text;
-  int line_number = 0;
-  static const char* kNeeded[] = {"status", "north_a_m", "east_a_m", "north_b_m", "east_b_m"};
-  while (std::getline(in, text)) {
-    ++line_number;
-    const std::string line = trimField(text);
-    if (line.empty() || line[0] == '#') continue;
-    const std::vector<std::string> fields = splitCsvLine(line);
-    const std::string where = path + ":" + std::to_string(line_number) + ": ";
-    if (column.empty()) {
-      for (size_t k = 0; k < fields.size(); ++k) column[fields[k]] = k;
-      for (const char* name : kNeeded) {
-        if (!column.count(name)) {
-          error = where + "the header has no column '" + name +
-                  "' (expected subframe_id_a,subframe_id_b,...,status,...,north_a_m,east_a_m,north_b_m,east_b_m)";
-          return false;
-        }
-      }
-      continue;
-    }
-    if (fields.size() != column.size()) {
-      error = where + std::to_string(fields.size()) + " fields, the header has " + std::to_string(column.size());
-      return false;
-    }
+  for (const CsvRow& row : table.rows) {
     LoopClosureRecord record;
-    record.line = line_number;
-    record.status = fields[column["status"]];
+    record.line = row.line;
+    record.status = table.field(row, "status");
     if (record.status != "accepted" && record.status != "rejected" && record.status != "pending" &&
         record.status != "superseded") {
-      error = where + "status '" + record.status + "' is not accepted, rejected, pending or superseded";
+      error = table.where(row) + "status '" + record.status + "' is not accepted, rejected, pending or superseded";
       return false;
     }
-    if (column.count("rejection")) record.rejection = fields[column["rejection"]];
+    if (table.has("rejection")) record.rejection = table.field(row, "rejection");
     double values[4];
     for (int k = 0; k < 4; ++k) {
-      const std::string& field = fields[column[kNeeded[k + 1]]];
+      const std::string& field = table.field(row, kCentres[k]);
       if (!parseFiniteDouble(field, values[k])) {
-        error = where + kNeeded[k + 1] + " '" + field + "' is not a finite number";
+        error = table.where(row) + kCentres[k] + " '" + field + "' is not a finite number";
         return false;
       }
     }
     record.centre_a_north_east_m = Eigen::Vector2d(values[0], values[1]);
     record.centre_b_north_east_m = Eigen::Vector2d(values[2], values[3]);
     closures.push_back(std::move(record));
-  }
-  if (column.empty()) {
-    error = path + ": no header line (expected subframe_id_a,subframe_id_b,...,status,...,north_b_m,east_b_m)";
-    return false;
   }
   return true;
 }
