@@ -17,6 +17,7 @@
 #include <thread>
 #include <vector>
 
+#include "pipeline/core/state_file.hpp"
 #include "pipeline/core/time.hpp"
 #include "pipeline/matcher/loop_closure_message.hpp"
 #include "pipeline/matcher/matcher_engine.hpp"
@@ -94,9 +95,7 @@ int main(int argc, char** argv) {
     return code;
   }
   if (!arguments.lcm_url_override.empty()) options.process.lcm_url = arguments.lcm_url_override;
-  if (options.state_directory.empty()) {
-    if (const char* state = std::getenv("STATE_DIRECTORY")) options.state_directory = state;
-  }
+  options.state_directory = sss::core::resolveSystemdDirectory(options.state_directory, std::getenv("STATE_DIRECTORY"));
 
   sss::transport::initLogging(options.process.process_name, options.process.log_level);
   sss::transport::ProcessLoop loop(options.process);

@@ -25,6 +25,7 @@
 #include <thread>
 #include <vector>
 
+#include "pipeline/core/state_file.hpp"
 #include "pipeline/core/geodesy.hpp"
 #include "pipeline/core/time.hpp"
 #include "pipeline/matcher/loop_closure_message.hpp"
@@ -153,9 +154,7 @@ int main(int argc, char** argv) {
     return code;
   }
   if (!arguments.lcm_url_override.empty()) options.process.lcm_url = arguments.lcm_url_override;
-  if (options.state_directory.empty()) {
-    if (const char* state = std::getenv("STATE_DIRECTORY")) options.state_directory = state;
-  }
+  options.state_directory = sss::core::resolveSystemdDirectory(options.state_directory, std::getenv("STATE_DIRECTORY"));
   if (options.products_directory.empty() && !options.state_directory.empty()) {
     options.products_directory = options.state_directory + "/products";
   }
