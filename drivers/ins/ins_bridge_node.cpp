@@ -69,6 +69,8 @@ void loadOdometer(const std::string& path, sss::ins::InsBridge& bridge) {
   spdlog::info("resumed the odometer from {}: {:.1f} m travelled", path, state.distance_travelled_m);
 }
 
+// On the real-time loop that answers every INS epoch: no fsync (it can block for tens of ms).
+// After a power loss the odometer may be a second or so behind; the optimiser bridges that.
 bool saveOdometer(const std::string& path, const sss::ins::OdometerState& state, std::string& error) {
   auto number = [](double value) { return fmt::format("{:.17g}", value); };
   return sss::core::writeStateFile(path, kOdometerFormat,
@@ -77,7 +79,7 @@ bool saveOdometer(const std::string& path, const sss::ins::OdometerState& state,
                                     {"north_m", number(state.position_ned_m.x())},
                                     {"east_m", number(state.position_ned_m.y())},
                                     {"down_m", number(state.position_ned_m.z())}},
-                                   error);
+                                   error, sss::core::Durability::kSurvivesProcessKill);
 }
 
 speed_t baudConstant(int baud) {

@@ -20,7 +20,8 @@ std::string resolveSystemdDirectory(const std::string& configured, const char* e
   return directories.substr(0, directories.find(':'));
 }
 
-bool writeStateFile(const std::string& path, const std::string& format, const StateValues& values, std::string& error) {
+bool writeStateFile(const std::string& path, const std::string& format, const StateValues& values, std::string& error,
+                    Durability durability) {
   std::ostringstream text;
   text << format << '\n';
   for (const auto& [key, value] : values) {
@@ -30,7 +31,7 @@ bool writeStateFile(const std::string& path, const std::string& format, const St
     }
     text << key << ' ' << value << '\n';
   }
-  return writeFileAtomically(path, text.str(), error);
+  return writeFileAtomically(path, text.str(), error, durability);
 }
 
 void syncDirectoryOf(const std::string& path) {
@@ -45,14 +46,15 @@ void syncDirectoryOf(const std::string& path) {
 }
 
 bool writeFileAtomically(const std::string& path, const std::function<bool(std::FILE*)>& write_body,
-                         std::string& error) {
+                         std::string& error, Durability durability) {
+  const bool sync = durability == Durability::kSurvivesPowerLoss;
   const std::string temporary = path + ".tmp";
   std::FILE* file = std::fopen(temporary.c_str(), "wb");
   if (!file) {
     error = temporary + ": cannot open for writing: " + std::strerror(errno);
     return false;
   }
-  const bool written = write_body(file) && std::fflush(file) == 0 && ::fsync(::fileno(file)) == 0;
+  const bool written = write_body(file) && std::fflush(file) == 0 && (!sync || ::fsync(::fileno(file)) == 0);
   const int write_errno = errno;
   if (std::fclose(file) != 0 || !written) {
     std::remove(temporary.c_str());
@@ -65,13 +67,15 @@ bool writeFileAtomically(const std::string& path, const std::function<bool(std::
     error = path + ": rename failed: " + std::strerror(rename_errno);
     return false;
   }
-  syncDirectoryOf(path);
+  if (sync) syncDirectoryOf(path);
   return true;
 }
 
-bool writeFileAtomically(const std::string& path, const std::string& bytes, std::string& error) {
+bool writeFileAtomically(const std::string& path, const std::string& bytes, std::string& error,
+                         Durability durability) {
   return writeFileAtomically(
-      path, [&](std::FILE* file) { return std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size(); }, error);
+      path, [&](std::FILE* file) { return std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size(); }, error,
+      durability);
 }
 
 bool readStateFile(const std::string& path, const std::string& format, StateValues& values, std::string& error) {

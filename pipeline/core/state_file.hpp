@@ -17,12 +17,18 @@ namespace sss::core {
 // (the variable unset).
 std::string resolveSystemdDirectory(const std::string& configured, const char* env_value);
 
-// Replaces path with what write_body writes (a temporary file, flushed and fsynced, renamed over
-// path, the directory fsynced): a kill or power loss at any moment leaves the old or the new
-// file. False with `error` set when it cannot (the old file is then intact).
+// What a replaced file survives. The rename alone survives a kill of the process; surviving a
+// power loss takes two fsyncs, which can block for tens of ms: not on a real-time thread.
+enum class Durability { kSurvivesPowerLoss, kSurvivesProcessKill };
+
+// Replaces path with what write_body writes (a temporary file renamed over path; with
+// kSurvivesPowerLoss the file is fsynced before and its directory after): a kill at any moment
+// leaves the old or the new file. False with `error` set when it cannot (the old file is then
+// intact).
 bool writeFileAtomically(const std::string& path, const std::function<bool(std::FILE*)>& write_body,
-                         std::string& error);
-bool writeFileAtomically(const std::string& path, const std::string& bytes, std::string& error);
+                         std::string& error, Durability durability = Durability::kSurvivesPowerLoss);
+bool writeFileAtomically(const std::string& path, const std::string& bytes, std::string& error,
+                         Durability durability = Durability::kSurvivesPowerLoss);
 // fsync of the directory holding path (makes a rename durable); best effort.
 void syncDirectoryOf(const std::string& path);
 
@@ -30,7 +36,8 @@ using StateValues = std::map<std::string, std::string>;
 
 // Writes `format` then one `key value` line per entry to path (keys without spaces or newlines,
 // values without newlines). False with `error` set when it cannot; the old file is then intact.
-bool writeStateFile(const std::string& path, const std::string& format, const StateValues& values, std::string& error);
+bool writeStateFile(const std::string& path, const std::string& format, const StateValues& values, std::string& error,
+                    Durability durability = Durability::kSurvivesPowerLoss);
 
 // Reads a file written by writeStateFile. False with `error` when it is missing, of another
 // format, or malformed (a line without a value, a duplicate key).

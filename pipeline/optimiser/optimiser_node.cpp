@@ -25,8 +25,8 @@
 #include <thread>
 #include <vector>
 
-#include "pipeline/core/state_file.hpp"
 #include "pipeline/core/geodesy.hpp"
+#include "pipeline/core/state_file.hpp"
 #include "pipeline/core/time.hpp"
 #include "pipeline/matcher/loop_closure_message.hpp"
 #include "pipeline/optimiser/optimiser_engine.hpp"
