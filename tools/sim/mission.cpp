@@ -73,8 +73,10 @@ void readSimOptions(sss::core::ConfigSection section, SimOptions& o) {
 
   sss::core::ConfigSection vehicle = subsection(section, "vehicle");
   TrajectoryOptions& t = o.trajectory;
-  vehicle.optional("pattern", t.pattern, {sss::core::oneOf({"lawnmower", "loop"})});
+  vehicle.optional("pattern", t.pattern, {sss::core::oneOf({"lawnmower", "loop", "cross"})});
   vehicle.optional("lines", t.lines, {inRange(1, 200)});
+  vehicle.optional("cross_lines", t.cross_lines, {inRange(1, 200)});
+  vehicle.optional("cross_turn_radius_m", t.cross_turn_radius_m, {inRange(5.0, 1000.0)});
   vehicle.optional("line_length_m", t.line_length_m, {inRange(10.0, 20000.0)});
   vehicle.optional("line_spacing_m", t.line_spacing_m, {inRange(5.0, 2000.0)});
   vehicle.optional("line_heading_deg", t.line_heading_deg, {inRange(-360.0, 360.0)});
@@ -153,9 +155,11 @@ std::vector<std::string> validateSimOptions(const SimOptions& o) {
     add("dead_reckoning.heading_deviation_min_rad", o.dead_reckoning.heading_deviation_min_rad, "exceeds the max");
   if (o.seabed.boulder_min_radius_m > o.seabed.boulder_max_radius_m)
     add("seabed.boulder_min_radius_m", o.seabed.boulder_min_radius_m, "exceeds boulder_max_radius_m");
-  if (o.trajectory.pattern != "lawnmower" && o.trajectory.pattern != "loop")
-    problems.push_back("sim.vehicle.pattern: " + o.trajectory.pattern + " is not lawnmower or loop");
-  if (o.trajectory.pattern == "lawnmower" && o.trajectory.lines > 1 && o.trajectory.line_spacing_m < 20.0)
+  if (o.trajectory.pattern != "lawnmower" && o.trajectory.pattern != "loop" && o.trajectory.pattern != "cross")
+    problems.push_back("sim.vehicle.pattern: " + o.trajectory.pattern + " is not lawnmower, loop or cross");
+  if (o.trajectory.pattern == "cross" && o.trajectory.cross_lines < 1)
+    add("vehicle.cross_lines", o.trajectory.cross_lines, "is too few for a cross pattern; use at least 1");
+  if (o.trajectory.pattern != "loop" && o.trajectory.lines > 1 && o.trajectory.line_spacing_m < 20.0)
     add("vehicle.line_spacing_m", o.trajectory.line_spacing_m, "is below 20 m: the 10 m turn radius minimum");
   if (o.trajectory.pattern == "loop" && o.trajectory.lines < 3)
     add("vehicle.lines", o.trajectory.lines, "is too few for a loop; use at least 3");
@@ -197,6 +201,8 @@ std::string simOptionsYaml(const SimOptions& o) {
   const TrajectoryOptions& t = o.trajectory;
   out << YAML::Key << "vehicle" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "pattern" << YAML::Value << t.pattern << YAML::Key << "lines" << YAML::Value << t.lines << YAML::Key
+      << "cross_lines" << YAML::Value << t.cross_lines << YAML::Key << "cross_turn_radius_m" << YAML::Value
+      << t.cross_turn_radius_m << YAML::Key
       << "line_length_m" << YAML::Value << t.line_length_m << YAML::Key << "line_spacing_m" << YAML::Value << t.line_spacing_m
       << YAML::Key << "line_heading_deg" << YAML::Value << t.line_heading_deg << YAML::Key << "speed_m_s" << YAML::Value
       << t.speed_m_s << YAML::Key << "altitude_m" << YAML::Value << t.altitude_m << YAML::Key << "roll_amplitude_rad"

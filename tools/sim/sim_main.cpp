@@ -12,10 +12,12 @@
 namespace {
 
 const char* kUsage =
-    "usage: sss-sim --out DIR [--config FILE] [--seed N] [--pattern lawnmower|loop] [--lines N]\n"
-    "               [--line-length-m M] [--line-spacing-m M] [--range-m M] [--altitude-m M]\n"
+    "usage: sss-sim --out DIR [--config FILE] [--seed N] [--pattern lawnmower|loop|cross] [--lines N]\n"
+    "               [--cross-lines K] [--line-length-m M] [--line-spacing-m M] [--range-m M] [--altitude-m M]\n"
     "               [--ping-rate-hz HZ] [--drift-scale K] [--heading-noise-rad S] [--duration-s S]\n"
     "Defaults make a ~20 minute, 5-line lawnmower at 2 m/s, 18 m altitude, 75 m range per side.\n"
+    "--pattern cross: the lawnmower's --lines, then --cross-lines K (2) lines perpendicular to them\n"
+    "  across the block at 1/(K+1) ... K/(K+1) of the line length, one spacing beyond the outer lines.\n"
     "The config file's `sim` section holds every other parameter (see mission.yaml of any run).\n";
 
 bool parseNumber(const std::string& flag, const std::string& text, double& value) {
@@ -78,13 +80,14 @@ int main(int argc, char** argv) {
     double number = 0.0;
     if (flag == "--pattern") {
       options.trajectory.pattern = value;
-    } else if (flag == "--seed" || flag == "--lines") {
+    } else if (flag == "--seed" || flag == "--lines" || flag == "--cross-lines") {
       if (!parseNumber(flag, value, number) || number < 0 || number != static_cast<double>(static_cast<int64_t>(number))) {
         std::cerr << "sss-sim: " << flag << " expects a non-negative integer, got '" << value << "'\n";
         return 2;
       }
       if (flag == "--seed") options.seed = static_cast<int64_t>(number);
-      else options.trajectory.lines = static_cast<int>(number);
+      else if (flag == "--lines") options.trajectory.lines = static_cast<int>(number);
+      else options.trajectory.cross_lines = static_cast<int>(number);
     } else if (numeric.count(flag)) {
       if (!parseNumber(flag, value, number)) return 2;
       *numeric.at(flag) = number;

@@ -1,9 +1,11 @@
-// Survey path planning (straight lines joined by semicircular turns) and the vehicle's true
-// motion along it: terrain following on the smooth seabed, autopilot wobble, bank in turns.
+// Survey path planning (straight lines joined by semicircular turns, crossing lines by
+// turn-straight-turn paths) and the vehicle's true motion along it: terrain following on the smooth
+// seabed, autopilot wobble, bank in turns.
 #include "tools/sim/trajectory.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <stdexcept>
 
@@ -14,6 +16,67 @@ constexpr double kPi = 3.14159265358979323846;
 
 Eigen::Vector2d headingVector(double heading_rad) { return {std::cos(heading_rad), std::sin(heading_rad)}; }
 Eigen::Vector2d starboardVector(double heading_rad) { return {-std::sin(heading_rad), std::cos(heading_rad)}; }
+
+// Angle in [0, 2 pi).
+double positiveAngle(double angle_rad) {
+  const double a = std::fmod(angle_rad, 2.0 * kPi);
+  return a < 0.0 ? a + 2.0 * kPi : a;
+}
+
+PathSegment arcSegment(const Eigen::Vector2d& start, double heading_rad, double radius_m, double sign, double angle_rad) {
+  PathSegment arc;
+  arc.is_line = false;
+  arc.start = start;
+  arc.start_heading_rad = heading_rad;
+  arc.turn_radius_m = radius_m;
+  arc.turn_sign = sign;
+  arc.length_m = radius_m * angle_rad;
+  return arc;
+}
+
+// The shortest turn-straight-turn path (Dubins' CSC words: RSR, LSL, RSL, LSR) from one pose to
+// another with turns of the given radius; segments without start distances. RSR and LSL always
+// exist, so there is always a path (not always the shortest Dubins path, which may be CCC when the
+// poses are closer than ~4 radii; the survey never asks for that).
+std::vector<PathSegment> turnStraightTurn(const Eigen::Vector2d& from, double from_heading_rad, const Eigen::Vector2d& to,
+                                          double to_heading_rad, double radius_m) {
+  std::vector<PathSegment> best;
+  double best_length = std::numeric_limits<double>::infinity();
+  for (const double first : {1.0, -1.0}) {
+    for (const double second : {1.0, -1.0}) {
+      // A point on a turn of sign s lies at centre - s r starboard(heading).
+      const Eigen::Vector2d c1 = from + first * radius_m * starboardVector(from_heading_rad);
+      const Eigen::Vector2d c2 = to + second * radius_m * starboardVector(to_heading_rad);
+      const Eigen::Vector2d d = c2 - c1;
+      const double distance = d.norm();
+      double straight = distance, heading = std::atan2(d.y(), d.x());
+      if (first != second) {
+        // Inner tangent: d = straight * heading vector - 2 s1 r * starboard vector.
+        if (distance < 2.0 * radius_m) continue;
+        straight = std::sqrt(distance * distance - 4.0 * radius_m * radius_m);
+        heading += std::atan2(2.0 * first * radius_m, straight);
+      }
+      const double arc1 = positiveAngle(first * (heading - from_heading_rad));
+      const double arc2 = positiveAngle(second * (to_heading_rad - heading));
+      const double length = radius_m * (arc1 + arc2) + straight;
+      if (length >= best_length) continue;
+      best_length = length;
+      best.clear();
+      const Eigen::Vector2d q1 = c1 - first * radius_m * starboardVector(heading);
+      const Eigen::Vector2d q2 = c2 - second * radius_m * starboardVector(heading);
+      if (arc1 > 1e-9) best.push_back(arcSegment(from, from_heading_rad, radius_m, first, arc1));
+      if (straight > 1e-9) {
+        PathSegment line;
+        line.start = q1;
+        line.start_heading_rad = heading;
+        line.length_m = straight;
+        best.push_back(line);
+      }
+      if (arc2 > 1e-9) best.push_back(arcSegment(q2, heading, radius_m, second, arc2));
+    }
+  }
+  return best;
+}
 
 }  // namespace
 
@@ -27,7 +90,7 @@ std::vector<PathSegment> planSurvey(const TrajectoryOptions& options) {
 
   // Each line: lateral offset (in spacings) and direction (+1 along h0, -1 against).
   std::vector<std::pair<double, double>> lines;
-  if (options.pattern == "lawnmower") {
+  if (options.pattern == "lawnmower" || options.pattern == "cross") {
     for (int k = 0; k < options.lines; ++k) lines.emplace_back(k * s, k % 2 == 0 ? 1.0 : -1.0);
   } else if (options.pattern == "loop") {
     // Racetrack loops that step sideways by one spacing per loop: the outbound lines lie side by
@@ -73,6 +136,38 @@ std::vector<PathSegment> planSurvey(const TrajectoryOptions& options) {
     turn.length_m = kPi * turn.turn_radius_m;
     segments.push_back(turn);
     distance += turn.length_m;
+  }
+  if (options.pattern != "cross") return segments;
+
+  // Crossing lines: perpendicular to the lawnmower at 1/(K+1) ... K/(K+1) of its length, one
+  // spacing beyond the outer lines on either side; the first from the side and end where the
+  // lawnmower finished, then alternating.
+  if (options.cross_lines < 1) throw std::invalid_argument("planSurvey: cross_lines must be >= 1");
+  if (options.cross_turn_radius_m < 5.0) throw std::invalid_argument("planSurvey: cross_turn_radius_m below 5 m");
+  const double lateral_min = -s, lateral_max = (options.lines - 1) * s + s;
+  const PathSegment& last = segments.back();
+  const bool finished_far_end = last.start_heading_rad == h0;  // the last lawnmower line flew along h0
+  for (int j = 0; j < options.cross_lines; ++j) {
+    const int k = finished_far_end ? options.cross_lines - 1 - j : j;
+    const double along_m = length * (k + 1) / (options.cross_lines + 1);
+    const bool to_port = j % 2 == 0;  // the lawnmower ends on its starboard-most line
+    PathSegment line;
+    line.is_line = true;
+    line.line_index = options.lines + j;
+    line.length_m = lateral_max - lateral_min;
+    line.start = along * along_m + lateral * (to_port ? lateral_max : lateral_min);
+    line.start_heading_rad = sss::core::wrapAngle(h0 + (to_port ? -0.5 * kPi : 0.5 * kPi));
+    const PathSegment& previous = segments.back();
+    const Eigen::Vector2d previous_end = previous.start + headingVector(previous.start_heading_rad) * previous.length_m;
+    for (PathSegment connection : turnStraightTurn(previous_end, previous.start_heading_rad, line.start,
+                                                   line.start_heading_rad, options.cross_turn_radius_m)) {
+      connection.start_distance_m = distance;
+      segments.push_back(connection);
+      distance += connection.length_m;
+    }
+    line.start_distance_m = distance;
+    segments.push_back(line);
+    distance += line.length_m;
   }
   return segments;
 }

@@ -1,5 +1,5 @@
-// Simulated AUV path: lawnmower or loop survey lines joined by turns, flown at constant speed and
-// altitude over the seabed with small roll/pitch motion; the ground-truth pose at any time.
+// Simulated AUV path: lawnmower, loop or lawnmower + crossing survey lines joined by turns, flown at
+// constant speed and altitude over the seabed with small roll/pitch motion; the ground-truth pose at any time.
 #pragma once
 
 #include "pipeline/core/pose.hpp"
@@ -14,8 +14,12 @@
 namespace sss::sim {
 
 struct TrajectoryOptions {
-  std::string pattern = "lawnmower";  // "lawnmower" or "loop"
+  std::string pattern = "lawnmower";  // "lawnmower", "loop" or "cross"
   int lines = 5;
+  // "cross": after the lawnmower, this many lines perpendicular to it across the block (evenly
+  // spaced along it, alternating directions), joined by turn-straight-turn paths of this radius.
+  int cross_lines = 2;
+  double cross_turn_radius_m = 20.0;
   double line_length_m = 400.0;
   double line_spacing_m = 70.0;  // 75 m range: adjacent lines overlap ~50% of a 150 m swath pair
   double line_heading_deg = 0.0; // heading of the first line, clockwise from north
@@ -32,10 +36,10 @@ struct TrajectoryOptions {
   uint64_t seed = 1;
 };
 
-// One straight line or one turn of the path, parameterised by distance along the path.
+// One straight or one arc of the path, parameterised by distance along the path.
 struct PathSegment {
-  bool is_line = true;
-  int line_index = -1;          // survey line number for lines, -1 for turns
+  bool is_line = true;          // straight: a survey line, or part of a connection (line_index -1)
+  int line_index = -1;          // survey line number for survey lines, -1 for connections
   double start_distance_m = 0.0;
   double length_m = 0.0;
   Eigen::Vector2d start = Eigen::Vector2d::Zero();  // north, east
