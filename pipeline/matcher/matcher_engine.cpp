@@ -68,6 +68,7 @@ PairOutcome MatcherEngine::matchStored(const PairKey& key, int round) {
   const Stored& a = stored_.at(key.first);
   const Stored& b = stored_.at(key.second);
   const PairMatch match = matchPair(a.subframe, a.poses, b.subframe, b.poses, dense_, options_.pair);
+  if (pair_observer_) pair_observer_(a.subframe, b.subframe, round, match);
   PairOutcome outcome;
   outcome.subframe_id_a = key.first;
   outcome.subframe_id_b = key.second;

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 #include <utility>
@@ -117,9 +118,17 @@ struct RestoreReport {
   std::vector<PairOutcome> outcomes;   // the pairs of those subframes, matched now
 };
 
+// Sees every pair the engine matches (the two subframes, the association round, the dense matches
+// and their decimation), accepted or not; for evaluation tools (sss-process --write-matches).
+using PairMatchObserver = std::function<void(const sss::subframe::Subframe& a, const sss::subframe::Subframe& b,
+                                             int association_round, const PairMatch& match)>;
+
 class MatcherEngine {
  public:
   explicit MatcherEngine(const MatcherEngineOptions& options);
+
+  // Called after each pair is matched; it does not change what the engine does.
+  void setPairMatchObserver(PairMatchObserver observer) { pair_observer_ = std::move(observer); }
 
   // Stores the subframe and matches it against the stored subframes it overlaps under the latest
   // corrections (largest overlap first, at most overlap.max_candidates).
@@ -178,6 +187,7 @@ class MatcherEngine {
   std::map<PairKey, PairState> pairs_;
   MatcherEngineCounters counters_;
   MatcherStateStore* store_ = nullptr;  // none: nothing persisted
+  PairMatchObserver pair_observer_;
   std::string state_error_;
 };
 

@@ -1,9 +1,11 @@
 // sss-bench-matcher: speed and accuracy of the matcher on simulated subframe pairs. Renders a
-// lawnmower survey (lines 40 m apart: neighbours anti-parallel, every second line parallel),
-// adds 3 m along-track and 2 m lateral DR error between the two subframes of each overlapping
-// full pair, runs dense matching + relative pose, and checks both against the ray-cast truth.
-// Prints a line per pair, a summary, and as its last line one JSON object.
-//   sss-bench-matcher [--lines N] [--line-length-m M] [--repeat K]
+// lawnmower survey (lines 40 m apart: neighbours anti-parallel, every second line parallel), or
+// with --pattern cross the same followed by two crossing lines, adds 3 m along-track and 2 m
+// lateral DR error between the two subframes of each overlapping full pair, runs dense matching +
+// relative pose, and checks both against the ray-cast truth. Pairs are typed by their centre
+// headings (parallel, anti-parallel, crossing). Prints a line per pair, a summary, and as its last
+// line one JSON object.
+//   sss-bench-matcher [--pattern lawnmower|cross] [--lines N] [--line-length-m M] [--repeat K]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -32,16 +34,20 @@ double percentile(std::vector<double> v, double q) {
 int main(int argc, char** argv) {
   int lines = 3, repeat = 1;
   double line_length_m = 300.0;
+  std::string pattern = "lawnmower";
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg == "--lines" && i + 1 < argc) {
+    if (arg == "--pattern" && i + 1 < argc && (std::string(argv[i + 1]) == "lawnmower" || std::string(argv[i + 1]) == "cross")) {
+      pattern = argv[++i];
+    } else if (arg == "--lines" && i + 1 < argc) {
       lines = std::atoi(argv[++i]);
     } else if (arg == "--line-length-m" && i + 1 < argc) {
       line_length_m = std::atof(argv[++i]);
     } else if (arg == "--repeat" && i + 1 < argc) {
       repeat = std::max(1, std::atoi(argv[++i]));
     } else {
-      std::fprintf(stderr, "usage: %s [--lines N] [--line-length-m M] [--repeat K]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--pattern lawnmower|cross] [--lines N] [--line-length-m M] [--repeat K]\n",
+                   argv[0]);
       return arg == "--help" ? 0 : 2;
     }
   }
@@ -49,7 +55,9 @@ int main(int argc, char** argv) {
   sim.trajectory.lines = std::max(2, lines);
   sim.trajectory.line_length_m = line_length_m;
   sim.trajectory.line_spacing_m = 40.0;
-  std::printf("rendering %d lines of %.0f m ...\n", sim.trajectory.lines, line_length_m);
+  sim.trajectory.pattern = pattern;
+  std::printf("rendering %d lines of %.0f m%s ...\n", sim.trajectory.lines, line_length_m,
+              pattern == "cross" ? " and 2 lines crossing them" : "");
   const sss::sim::SimulatedSurvey survey = sss::sim::simulateSurvey(sim);
   const sss::sim::SubframeTruth truth(*survey.mission);
 
@@ -65,8 +73,13 @@ int main(int argc, char** argv) {
   }
 
   std::vector<double> seconds, georef, kd, init, patchmatch, consistency, pose, along_err, lateral_err;
-  long matches = 0, evaluated = 0, within = 0, matchable = 0, accepted = 0, pairs = 0;
-  long parallel_pairs = 0, anti_pairs = 0;
+  long accepted = 0, pairs = 0;
+  using sss::eval::PairType;
+  sss::eval::MatchEvaluation total, by_type[sss::eval::kPairTypes];
+  long pairs_by_type[sss::eval::kPairTypes] = {0, 0, 0};
+  const auto headingOf = [](const sss::subframe::Subframe& s) {
+    return sss::core::eulerFromQuaternion(s.centre().T_world_body.rotation).heading_rad;
+  };
   for (size_t i = 0; i < full.size(); ++i) {
     for (size_t j = i + 1; j < full.size(); ++j) {
       const auto& a = *full[i];
@@ -74,7 +87,7 @@ int main(int argc, char** argv) {
       if (a.line_id == b.line_id) continue;
       const double area = sss::matcher::overlapAreaM2(footprints[i], footprints[j]);
       if (area < overlap.min_overlap_fraction * std::min(footprints[i].area_m2, footprints[j].area_m2)) continue;
-      const bool parallel = (b.line_id - a.line_id) % 2 == 0;
+      const PairType type = sss::eval::classifyPair(headingOf(a), headingOf(b));
       for (int k = 0; k < repeat; ++k) {
         const auto match = sss::matcher::matchPair(a, sss::subframe::drPoses(a), b, sss::sim::posesWithDrError(a, b, 3.0, 2.0), dense,
                                                    options);
@@ -87,13 +100,11 @@ int main(int argc, char** argv) {
         pose.push_back(match.pose.seconds);
         if (k > 0) continue;
         ++pairs;
-        (parallel ? parallel_pairs : anti_pairs) += 1;
+        ++pairs_by_type[static_cast<int>(type)];
         const auto e =
             sss::eval::evaluateMatches(survey, a, b, match.matches, options.dense.stride, match.decimation);
-        matches += e.matches;
-        evaluated += e.evaluated;
-        within += e.within_2px;
-        matchable += e.matchable;
+        total += e;
+        by_type[static_cast<int>(type)] += e;
         const Eigen::Vector3d error = match.pose.T_a_b.translation - truth.trueRelativePose(a, b).translation;
         if (match.accepted) {
           ++accepted;
@@ -101,13 +112,13 @@ int main(int argc, char** argv) {
           lateral_err.push_back(std::abs(error.y()));
         }
         std::printf("pair %lld-%lld (%s, lines %d-%d): %.3f s (georef %.3f, kd %.3f, init %.3f, patchmatch %.3f, "
-                    "consistency %.3f, pose %.3f); %ld matches, within 2 px %.3f, recall %.3f; %s, error along %.3f "
-                    "lateral %.3f m\n",
-                    (long long)a.id, (long long)b.id, parallel ? "parallel" : "anti-parallel", a.line_id, b.line_id,
+                    "consistency %.3f, pose %.3f); %ld matches, within 2 px %.3f, recall %.3f, EPE %.2f px; %s, "
+                    "error along %.3f lateral %.3f m\n",
+                    (long long)a.id, (long long)b.id, sss::eval::pairTypeName(type), a.line_id, b.line_id,
                     match.seconds, match.georeference_s, match.dense_timings.kd_tree_s,
                     match.dense_timings.initialisation_s, match.dense_timings.patch_match_s,
                     match.dense_timings.consistency_s, match.pose.seconds, e.matches, e.withinFraction(), e.recall(),
-                    match.accepted ? "accepted" : match.reason.c_str(), error.x(), error.y());
+                    e.meanErrorPx(), match.accepted ? "accepted" : match.reason.c_str(), error.x(), error.y());
       }
     }
   }
@@ -120,21 +131,41 @@ int main(int argc, char** argv) {
     for (double x : v) s += x;
     return v.empty() ? 0.0 : s / static_cast<double>(v.size());
   };
-  const double within_fraction = evaluated ? double(within) / evaluated : 0.0;
-  const double recall = matchable ? double(within) / matchable : 0.0;
-  std::printf("%ld pairs (%ld parallel, %ld anti-parallel), %ld accepted; %.3f s per pair (p95 %.3f); breakdown: "
-              "georeference %.3f, kd-tree %.3f, initialisation %.3f, PatchMatch %.3f, consistency %.3f, RANSAC+pose "
-              "%.3f s; within 2 px %.3f, recall %.3f; |error| p95 along %.3f lateral %.3f m\n",
-              pairs, parallel_pairs, anti_pairs, accepted, mean(seconds), percentile(seconds, 0.95), mean(georef),
-              mean(kd), mean(init), mean(patchmatch), mean(consistency), mean(pose), within_fraction, recall,
-              percentile(along_err, 0.95), percentile(lateral_err, 0.95));
+  const long parallel_pairs = pairs_by_type[0], anti_pairs = pairs_by_type[1], crossing_pairs = pairs_by_type[2];
+  std::printf("%ld pairs (%ld parallel, %ld anti-parallel, %ld crossing), %ld accepted; %.3f s per pair (p95 %.3f); "
+              "breakdown: georeference %.3f, kd-tree %.3f, initialisation %.3f, PatchMatch %.3f, consistency %.3f, "
+              "RANSAC+pose %.3f s; within 2 px %.3f, recall %.3f, EPE %.2f px; |error| p95 along %.3f lateral %.3f m\n",
+              pairs, parallel_pairs, anti_pairs, crossing_pairs, accepted, mean(seconds), percentile(seconds, 0.95),
+              mean(georef), mean(kd), mean(init), mean(patchmatch), mean(consistency), mean(pose),
+              total.withinFraction(), total.recall(), total.meanErrorPx(), percentile(along_err, 0.95),
+              percentile(lateral_err, 0.95));
+  std::string per_type_json;
+  for (int t = 0; t < sss::eval::kPairTypes; ++t) {
+    const auto& e = by_type[t];
+    const char* name = sss::eval::pairTypeName(static_cast<PairType>(t));
+    if (pairs_by_type[t] > 0) {
+      std::printf("  %-13s %3ld pairs: %ld matches, within 2 px %.3f, recall %.3f, EPE %.2f px (%.3f m)\n", name,
+                  pairs_by_type[t], e.matches, e.withinFraction(), e.recall(), e.meanErrorPx(), e.meanErrorM());
+    }
+    char text[256];
+    if (pairs_by_type[t] > 0) {
+      std::snprintf(text, sizeof text, ", \"within_2px_%s\": %.4f, \"recall_%s\": %.4f, \"mean_error_px_%s\": %.4f",
+                    name, e.withinFraction(), name, e.recall(), name, e.meanErrorPx());
+    } else {  // no pair of this type: null, not a misleading 0
+      std::snprintf(text, sizeof text, ", \"within_2px_%s\": null, \"recall_%s\": null, \"mean_error_px_%s\": null",
+                    name, name, name);
+    }
+    per_type_json += text;
+  }
   std::printf("{\"seconds_per_pair\": %.4f, \"seconds_p95\": %.4f, \"within_2px\": %.4f, \"recall\": %.4f, "
-              "\"pairs\": %ld, \"parallel_pairs\": %ld, \"anti_parallel_pairs\": %ld, \"accepted\": %ld, "
+              "\"mean_error_px\": %.4f, \"pairs\": %ld, \"parallel_pairs\": %ld, \"anti_parallel_pairs\": %ld, "
+              "\"crossing_pairs\": %ld, \"accepted\": %ld, "
               "\"georeference_s\": %.4f, \"kd_tree_s\": %.4f, \"initialisation_s\": %.4f, \"patch_match_s\": %.4f, "
               "\"consistency_s\": %.4f, \"relative_pose_s\": %.4f, \"along_error_p95_m\": %.4f, "
-              "\"lateral_error_p95_m\": %.4f, \"matches_per_pair\": %ld, \"dr_error_m\": [3.0, 2.0]}\n",
-              mean(seconds), percentile(seconds, 0.95), within_fraction, recall, pairs, parallel_pairs, anti_pairs,
-              accepted, mean(georef), mean(kd), mean(init), mean(patchmatch), mean(consistency), mean(pose),
-              percentile(along_err, 0.95), percentile(lateral_err, 0.95), matches / pairs);
+              "\"lateral_error_p95_m\": %.4f, \"matches_per_pair\": %ld%s, \"pattern\": \"%s\", \"dr_error_m\": [3.0, 2.0]}\n",
+              mean(seconds), percentile(seconds, 0.95), total.withinFraction(), total.recall(), total.meanErrorPx(), pairs,
+              parallel_pairs, anti_pairs, crossing_pairs, accepted, mean(georef), mean(kd), mean(init), mean(patchmatch),
+              mean(consistency), mean(pose), percentile(along_err, 0.95), percentile(lateral_err, 0.95),
+              total.matches / pairs, per_type_json.c_str(), pattern.c_str());
   return 0;
 }

@@ -39,8 +39,8 @@ bool parseInteger64(const std::string& text, int64_t& value) {
   return !text.empty() && end == text.c_str() + text.size() && errno != ERANGE;
 }
 
-bool readCsvTable(const std::string& path, const std::vector<std::string>& required, const std::string& expected,
-                  CsvTable& table, std::string& error) {
+bool forEachCsvRow(const std::string& path, const std::vector<std::string>& required, const std::string& expected,
+                   CsvTable& table, const CsvRowHandler& on_row, std::string& error) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     error = path + ": cannot open; check the path";
@@ -72,13 +72,24 @@ bool readCsvTable(const std::string& path, const std::vector<std::string>& requi
               std::to_string(table.column.size());
       return false;
     }
-    table.rows.push_back(std::move(row));
+    if (!on_row(table, row, error)) return false;
   }
   if (!have_header) {
     error = path + ": no header line (expected " + expected + ")";
     return false;
   }
   return true;
+}
+
+bool readCsvTable(const std::string& path, const std::vector<std::string>& required, const std::string& expected,
+                  CsvTable& table, std::string& error) {
+  std::vector<CsvRow> rows;
+  const bool ok = forEachCsvRow(path, required, expected, table, [&](const CsvTable&, const CsvRow& row, std::string&) {
+    rows.push_back(row);
+    return true;
+  }, error);
+  table.rows = std::move(rows);
+  return ok;
 }
 
 }  // namespace sss::eval

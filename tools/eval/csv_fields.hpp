@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -40,5 +41,11 @@ struct CsvTable {
 // in the header messages.
 bool readCsvTable(const std::string& path, const std::vector<std::string>& required, const std::string& expected,
                   CsvTable& table, std::string& error);
+
+// The same reading, row by row, for files too large to hold as text (matches.csv): `table` has the
+// header and no rows; each row goes to on_row, which returns false with an error to stop.
+using CsvRowHandler = std::function<bool(const CsvTable& table, const CsvRow& row, std::string& error)>;
+bool forEachCsvRow(const std::string& path, const std::vector<std::string>& required, const std::string& expected,
+                   CsvTable& table, const CsvRowHandler& on_row, std::string& error);
 
 }  // namespace sss::eval

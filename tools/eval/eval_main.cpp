@@ -1,5 +1,5 @@
-// sss-eval: trajectory (ATE, RPE, per survey line, LCE), loop-closure and heightmap accuracy against
-// the simulator's ground truth; prints a table, writes the JSON report (keys in report.hpp) and PNG figures.
+// sss-eval: trajectory (ATE, RPE, per survey line, LCE), loop-closure, heightmap and matching accuracy
+// against the simulator's ground truth; prints a table, writes the JSON report (keys in report.hpp) and PNG figures.
 #include "tools/eval/report.hpp"
 
 #include <cerrno>
@@ -20,6 +20,7 @@ const char* kUsage =
     "                [--time-tolerance-s S] [--max-gap-s S] [--no-interpolation] [--rpe-windows-m 10,50,100]\n"
     "                [--closures loop_closures.csv [--closures-dr DR.tum] [--closure-table]]\n"
     "                [--lce [--lce-swath-m 10,70] [--lce-grid-m 5] [--lce-max-pairs 20000] [--lce-seabed-depth-m D]]\n"
+    "                [--matches matches.csv --mission MISSION_DIR [--match-table]]\n"
     "TUM lines: 'sec.usec x y z qx qy qz qw' in local NED metres (as sss-sim writes them).\n"
     "--label names the estimates in order (default: file name); the first estimate is the baseline\n"
     "  of the 'vs first' column (horizontal ATE RMSE improvement, %).\n"
@@ -39,6 +40,12 @@ const char* kUsage =
     "  sightings from different lines make a pair (at most --lce-max-pairs, thinned evenly). Flat\n"
     "  seabed at --lce-seabed-depth-m, else the mean depth of --seabed, else the truth's median depth\n"
     "  + 18 m (the simulator's default altitude); without pitch the result does not depend on it.\n"
+    "--matches: the dense matches of sss-process --write-matches against the truth of the sss-sim mission\n"
+    "  in --mission (rebuilt from its mission.yaml): end-point error of each match in pixels of the\n"
+    "  matching image (rows = pings, columns = decimation bins) and in metres, the fraction within 2 px and\n"
+    "  recall at 2 px (matches within 2 px over the matchable probe pixels, scaled to the matching grid),\n"
+    "  per pair type by centre-heading difference (parallel <= 30 deg, anti-parallel >= 150 deg, else\n"
+    "  crossing) and overall; --match-table also lists every pair and round.\n"
     "Exit codes: 0 ok, 1 an output could not be written, 2 bad arguments or input files.\n";
 
 bool parsePositive(const std::string& flag, const std::string& text, double& value) {
@@ -80,6 +87,10 @@ int main(int argc, char** argv) {
       options.closure_table = true;
       continue;
     }
+    if (arg == "--match-table") {
+      options.match_table = true;
+      continue;
+    }
     if (arg.rfind("--", 0) != 0 || i + 1 >= argc) {
       std::cerr << "sss-eval: unexpected argument '" << arg << "' (or a flag without its value)\n" << kUsage;
       return 2;
@@ -97,6 +108,8 @@ int main(int argc, char** argv) {
     else if (arg == "--error-map") request.error_map_prefix = value;
     else if (arg == "--closures") request.closures_path = value;
     else if (arg == "--closures-dr") request.closures_dr_path = value;
+    else if (arg == "--matches") request.matches_path = value;
+    else if (arg == "--mission") request.mission_dir = value;
     else if (arg == "--lce-swath-m") {
       const size_t comma = value.find(',');
       double max_m = 0.0;
@@ -149,10 +162,15 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  if (estimates.empty() && heightmaps.empty() && request.closures_path.empty() && !request.lce) {
+  if (estimates.empty() && heightmaps.empty() && request.closures_path.empty() && !request.lce &&
+      request.matches_path.empty()) {
     std::cerr << "sss-eval: nothing to evaluate: give --gt TRUTH.tum with --est EST.tum, --closures C.csv or --lce,\n"
-                 "  and/or --seabed S.yaml --heightmap H.yaml\n"
+                 "  and/or --seabed S.yaml --heightmap H.yaml, and/or --matches M.csv --mission DIR\n"
               << kUsage;
+    return 2;
+  }
+  if (request.matches_path.empty() != request.mission_dir.empty()) {
+    std::cerr << "sss-eval: --matches matches.csv and --mission MISSION_DIR go together (the truth comes from the mission)\n";
     return 2;
   }
   if ((!estimates.empty() || !request.closures_path.empty() || request.lce) && request.truth_path.empty()) {
@@ -198,6 +216,14 @@ int main(int argc, char** argv) {
     if (!sss::eval::runEvaluation(request, options, report, error)) {
       std::cerr << "sss-eval: " << error << "\n";
       return 2;
+    }
+    if (!request.matches_path.empty()) {
+      // Apart from runEvaluation: it needs the simulator to rebuild the truth.
+      if (!sss::eval::evaluateMatchFile(request.matches_path, request.mission_dir, report.matches, error)) {
+        std::cerr << "sss-eval: " << error << "\n";
+        return 2;
+      }
+      report.has_matches = true;
     }
     std::cout << sss::eval::formatTable(report);
     if (!sss::eval::writeFigures(request, report, error)) {

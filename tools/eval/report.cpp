@@ -411,6 +411,94 @@ bool writeFigures(const EvalRequest& request, EvalReport& report, std::string& e
   return true;
 }
 
+namespace {
+
+std::vector<std::string> matchRow(const std::string& label, long pairs, const MatchEvaluation& e) {
+  return {label, std::to_string(pairs), std::to_string(e.matches), std::to_string(e.evaluated),
+          e.evaluated ? cell(e.meanErrorPx(), 2) : "-", e.evaluated ? cell(e.meanErrorM(), 3) : "-",
+          e.evaluated ? cell(e.withinFraction(), 3) : "-", e.matchable ? cell(e.recall(), 3) : "-"};
+}
+
+std::string formatMatchTable(const MatchFileEvaluation& m, bool per_pair) {
+  std::ostringstream out;
+  char title[512];
+  std::snprintf(title, sizeof title,
+                "matches %s against %s: %zu pairs (all rounds), %zu subframes; px of the matching image "
+                "(1 ping x %.2f m)\n",
+                m.path.c_str(), m.mission_dir.c_str(), m.pairs.size(), m.subframes, m.matching_pixel_m);
+  out << title;
+  std::vector<std::vector<std::string>> rows = {
+      {"pair type", "pairs", "matches", "evaluated", "mean EPE", "mean EPE", "within", "recall"},
+      {"", "", "", "", "px", "m", "2 px", "2 px"}};
+  for (int t = 0; t < kPairTypes; ++t) {
+    rows.push_back(matchRow(pairTypeName(static_cast<PairType>(t)), m.pairs_by_type[t], m.by_type[t]));
+  }
+  rows.push_back(matchRow("all", static_cast<long>(m.pairs.size()), m.overall));
+  out << formatColumns(rows);
+  if (per_pair && !m.pairs.empty()) {
+    std::vector<std::vector<std::string>> pair_rows = {
+        {"pair", "round", "type", "matches", "evaluated", "EPE px", "EPE m", "within 2 px", "recall 2 px"}};
+    for (const PairMatchReport& p : m.pairs) {
+      // matchRow's pair count becomes the round, followed by the type.
+      std::vector<std::string> row = matchRow(std::to_string(p.subframe_a) + "-" + std::to_string(p.subframe_b), 0,
+                                              p.evaluation);
+      row[1] = std::to_string(p.round);
+      row.insert(row.begin() + 2, pairTypeName(p.type));
+      pair_rows.push_back(row);
+    }
+    out << "\n" << formatColumns(pair_rows);
+  }
+  return out.str();
+}
+
+void writeMatchTotals(JsonWriter& json, const MatchEvaluation& e) {
+  json.key("matches").value(static_cast<int64_t>(e.matches));
+  json.key("evaluated").value(static_cast<int64_t>(e.evaluated));
+  json.key("within_2px").value(e.evaluated ? e.withinFraction() : std::numeric_limits<double>::quiet_NaN());
+  json.key("recall_2px").value(e.matchable ? e.recall() : std::numeric_limits<double>::quiet_NaN());
+  json.key("mean_error_px").value(e.evaluated ? e.meanErrorPx() : std::numeric_limits<double>::quiet_NaN());
+  json.key("mean_error_m").value(e.evaluated ? e.meanErrorM() : std::numeric_limits<double>::quiet_NaN());
+  json.key("probes").value(static_cast<int64_t>(e.probes));
+  json.key("matchable").value(static_cast<int64_t>(e.matchable));
+}
+
+void writeMatchesJson(JsonWriter& json, const MatchFileEvaluation& m) {
+  json.key("matches").beginObject();
+  json.key("path").value(m.path);
+  json.key("mission").value(m.mission_dir);
+  json.key("decimation").value(m.decimation);
+  json.key("stride").value(m.stride);
+  json.key("probe_step").value(m.probe_step);
+  json.key("matching_pixel_m").value(m.matching_pixel_m);
+  json.key("subframes").value(static_cast<uint64_t>(m.subframes));
+  json.key("overall").beginObject();
+  json.key("pairs").value(static_cast<uint64_t>(m.pairs.size()));
+  writeMatchTotals(json, m.overall);
+  json.endObject();
+  for (int t = 0; t < kPairTypes; ++t) {
+    json.key(pairTypeName(static_cast<PairType>(t))).beginObject();
+    json.key("pairs").value(static_cast<int64_t>(m.pairs_by_type[t]));
+    writeMatchTotals(json, m.by_type[t]);
+    json.endObject();
+  }
+  json.key("pairs").beginArray();
+  for (const PairMatchReport& p : m.pairs) {
+    json.beginObject();
+    json.key("subframe_id_a").value(p.subframe_a);
+    json.key("subframe_id_b").value(p.subframe_b);
+    json.key("round").value(p.round);
+    json.key("type").value(pairTypeName(p.type));
+    json.key("heading_difference_deg")
+        .value(std::abs(sss::core::wrapAngle(p.heading_b_rad - p.heading_a_rad)) * 180.0 / 3.14159265358979323846);
+    writeMatchTotals(json, p.evaluation);
+    json.endObject();
+  }
+  json.endArray();
+  json.endObject();
+}
+
+}  // namespace
+
 std::string formatTable(const EvalReport& report) {
   std::ostringstream out;
   if (!report.truth.empty()) {
@@ -474,6 +562,7 @@ std::string formatTable(const EvalReport& report) {
   }
   if (report.has_closures) out << "\n" << formatClosureTable(report);
   if (report.has_lce) out << "\n" << formatLceTable(report.lce, report.options.lce);
+  if (report.has_matches) out << "\n" << formatMatchTable(report.matches, report.options.match_table);
   return out.str();
 }
 
@@ -622,6 +711,8 @@ std::string reportJson(const EvalReport& report) {
   else json.key("closures").null();
   if (report.has_lce) writeLceJson(json, report.lce, report.options.lce);
   else json.key("lce").null();
+  if (report.has_matches) writeMatchesJson(json, report.matches);
+  else json.key("matches").null();
 
   json.key("outputs").beginObject();
   json.key("json").value(report.json_path);

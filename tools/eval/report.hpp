@@ -41,6 +41,13 @@
 //     "max_correspondences", "sightings", "seabed_points", "candidate_pairs", "correspondences",
 //     "truth": {"horizontal_m": stats, "skipped"} (the self-check, ~0),
 //     "estimates": [{"label", "horizontal_m": stats, "skipped"}]},
+//   "matches": null | {  (--matches matches.csv --mission DIR; end-point error against the simulator's truth,
+//                         px of the matching image: rows = pings, columns = decimation bins)
+//     "path", "mission", "decimation", "stride", "probe_step", "matching_pixel_m", "subframes",
+//     "overall": totals, "parallel": totals, "anti_parallel": totals, "crossing": totals (each + "pairs"),
+//     "pairs": [{"subframe_id_a", "subframe_id_b", "round", "type", "heading_difference_deg", totals}]},
+//     totals = {"matches", "evaluated", "within_2px" (fraction of evaluated), "recall_2px", "mean_error_px",
+//               "mean_error_m", "probes", "matchable"}
 //   "outputs": {"json", "plots": [...]}
 // }
 #pragma once
@@ -49,6 +56,7 @@
 #include "tools/eval/heightmap_metrics.hpp"
 #include "tools/eval/landmark_consistency.hpp"
 #include "tools/eval/json_writer.hpp"
+#include "tools/eval/match_metrics.hpp"
 #include "tools/eval/plots.hpp"
 #include "tools/eval/trajectory_io.hpp"
 #include "tools/eval/trajectory_metrics.hpp"
@@ -75,6 +83,8 @@ struct EvalRequest {
   std::string closures_path;           // loop_closures.csv of sss-process; needs the truth
   std::string closures_dr_path;        // DR trajectory for the closures' baseline; empty: the first estimate
   bool lce = false;                    // landmark consistency of the truth and every estimate
+  std::string matches_path;            // matches.csv of sss-process --write-matches; needs mission_dir
+  std::string mission_dir;             // the sss-sim folder (mission.yaml) the matches are evaluated against
 };
 
 struct EvalOptions {
@@ -82,6 +92,7 @@ struct EvalOptions {
   double table_rpe_window_m = 50.0;  // the table shows the configured window closest to this
   ErrorMapPngOptions error_map_png;
   bool closure_table = false;  // the table lists every closure (else only the statistics)
+  bool match_table = false;    // the table lists every matched pair (else per pair type)
   TrueCorrespondenceOptions lce;
   // Depth of the flat seabed of the LCE model: this when finite, else flatSeabedDepthM() with the
   // request's seabed raster if any and lce_default_altitude_m (the simulator's default altitude).
@@ -133,6 +144,8 @@ struct EvalReport {
   ClosureReport closures;
   bool has_lce = false;
   LceReport lce;
+  bool has_matches = false;  // filled by evaluateMatchFile (sss-eval), not runEvaluation
+  MatchFileEvaluation matches;
   std::vector<std::string> plots;  // figure files written
   std::string json_path;
 };
@@ -148,7 +161,8 @@ bool writeFigures(const EvalRequest& request, EvalReport& report, std::string& e
 
 // The aligned terminal table: one row per estimate (ATE RMSE raw and aligned, horizontal ATE RMSE
 // and max, RPE, improvement vs the first estimate), per-line horizontal RMSE, heightmaps, closure
-// errors per status (and per closure with options.closure_table), LCE per trajectory.
+// errors per status (and per closure with options.closure_table), LCE per trajectory, match accuracy per
+// pair type (and per pair with options.match_table).
 std::string formatTable(const EvalReport& report);
 
 // The JSON report described at the top of this file.

@@ -32,6 +32,7 @@
 #include "pipeline/subframe/subframe_buffer.hpp"
 #include "pipeline/subframe/subframe_message.hpp"
 #include "tools/eval/json_writer.hpp"
+#include "tools/process/match_writer.hpp"
 
 namespace sss::offline {
 
@@ -434,6 +435,16 @@ class Runner {
 
   bool writeOutputs(std::string& error);
   OfflineSummary& summary() { return summary_; }
+
+  // matches.csv: the matcher engine shows every matched pair to the writer.
+  bool openMatchWriter(std::string& error) {
+    if (!match_writer_.open(request_.out_dir + "/matches.csv", options_.matcher.pair.dense.stride, 4, error)) return false;
+    matcher_.setPairMatchObserver([this](const sss::subframe::Subframe& a, const sss::subframe::Subframe& b, int round,
+                                         const sss::matcher::PairMatch& match) {
+      match_writer_.addPair(a, b, round, match);
+    });
+    return true;
+  }
   double startSeconds() const { return start_s_; }
   double missionSeconds() const {
     return first_ping_us_ >= 0 ? 1e-6 * static_cast<double>(last_ping_us_ - first_ping_us_) : 0.0;
@@ -491,6 +502,7 @@ class Runner {
   std::vector<sss::optimiser::StampedPose> dr_per_ping_;
   int mosaic_factor_ = 1;
   OfflineSummary summary_;
+  MatchCsvWriter match_writer_;  // open only with request_.write_matches
   int64_t first_ping_us_ = -1;
   int64_t last_ping_us_ = 0;
   double start_s_ = wallSeconds();
@@ -509,6 +521,7 @@ bool Runner::writeOutputs(std::string& error) {
   if (!sss::optimiser::writeTum(dir + "/dead_reckoning.tum", dr_per_ping_, "sss-process: dead reckoning at every ping", error)) return false;
   if (!sss::optimiser::writeTum(dir + "/slam.tum", slam, "sss-process: SLAM-corrected pose at every ping", error)) return false;
   if (!writeClosuresCsv(dir + "/loop_closures.csv", optimiser_, error)) return false;
+  if (!match_writer_.close(error)) return false;
 
   const auto& counters = optimiser_.graph().counters();
   summary_.closures_accepted = counters.closures_accepted;
@@ -584,6 +597,10 @@ OfflineResult runOffline(const OfflineRequest& request) {
   }
 
   Runner runner(request, options);
+  if (request.write_matches && !runner.openMatchWriter(result.error)) {
+    result.exit_code = 1;
+    return result;
+  }
   uint64_t faults = 0;
   if (from_log) {
     lcm::LogFile log(request.lcm_log_path, "r");

@@ -26,6 +26,9 @@ struct OfflineRequest {
   // made from the sonar's embedded navigation are not in it (give --ins for a complete log).
   std::string record_lcm_log_path;
   bool write_mosaics = true;
+  // Also write out_dir/matches.csv: every dense match, subframe row and recall probe of every pair the
+  // matcher tried (for sss-eval --matches; format in match_writer.hpp).
+  bool write_matches = false;
   std::FILE* progress = nullptr;  // progress lines every progress_period_s of wall time; null: quiet
   double progress_period_s = 2.0;
 };

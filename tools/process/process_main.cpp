@@ -12,9 +12,12 @@ namespace {
 void usage(std::FILE* out) {
   std::fprintf(out,
                "usage: sss-process --sonar FILE.jsf|FILE.xtf [--ins FILE.nmea] [--config FILE] --out DIR [--quiet]\n"
+               "                   [--write-matches]\n"
                "       sss-process --lcm-log FILE [--ping-channel C] [--nav-channel C] [--config FILE] --out DIR\n"
                "                   [--no-mosaics] [--quiet]\n"
                "  --record-lcm-log FILE  also write the SSS_PING and SSS_NAV messages fed to the chain to an LCM log\n"
+               "  --write-matches        also write matches.csv: every dense match, subframe row and recall probe of\n"
+               "                         every pair the matcher tried (for sss-eval --matches FILE --mission DIR)\n"
                "Writes to DIR: dead_reckoning.tum, slam.tum (every ping, TUM, local NED of the mission origin),\n"
                "loop_closures.csv, bathymetry.ply (+ bathymetry_dr.ply), heightmap.yaml/.png (+ heightmap_dr),\n"
                "mosaic_dr.png, mosaic_slam.png (+ .yaml geo-references) and summary.json.\n");
@@ -41,6 +44,7 @@ int main(int argc, char** argv) {
     else if (arg == "--nav-channel") ok = value(request.nav_channel);
     else if (arg == "--record-lcm-log") ok = value(request.record_lcm_log_path);
     else if (arg == "--no-mosaics") request.write_mosaics = false;
+    else if (arg == "--write-matches") request.write_matches = true;
     else if (arg == "--quiet") request.progress = nullptr;
     else if (arg == "--help" || arg == "-h") {
       usage(stdout);

@@ -102,11 +102,19 @@ std::optional<Eigen::Vector3d> SubframeTruth::seabedPoint(const Subframe& subfra
   return hit->position_ned_m;
 }
 
+std::vector<sss::core::Pose> SubframeTruth::sonarPoses(const Subframe& subframe) const {
+  std::vector<sss::core::Pose> sonar = truePoses(mission_, subframe);
+  for (auto& pose : sonar) pose = pose * subframe.geometry.T_body_sonar;
+  return sonar;
+}
+
 std::optional<Eigen::Vector2d> SubframeTruth::pixelOf(const Subframe& subframe, const Eigen::Vector3d& point) const {
-  const std::vector<sss::core::Pose> body = truePoses(mission_, subframe);
-  std::vector<sss::core::Pose> sonar;
-  sonar.reserve(body.size());
-  for (const auto& pose : body) sonar.push_back(pose * subframe.geometry.T_body_sonar);
+  return pixelOf(subframe, point, sonarPoses(subframe));
+}
+
+std::optional<Eigen::Vector2d> SubframeTruth::pixelOf(const Subframe& subframe, const Eigen::Vector3d& point,
+                                                      const std::vector<sss::core::Pose>& sonar) const {
+  if (sonar.empty()) return std::nullopt;
   // The fan-plane crossing (no visibility test: a shadowed point is rare and the ray cast of a
   // profile per query would dominate an evaluation of 10^5 matches).
   const auto signedDistance = [&](const sss::core::Pose& pose) {

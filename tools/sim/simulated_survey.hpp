@@ -48,6 +48,11 @@ class SubframeTruth {
   // The (fractional) row and column of the subframe whose fan plane and slant range contain the
   // point; nullopt when no ping of the subframe passes it within range.
   std::optional<Eigen::Vector2d> pixelOf(const sss::subframe::Subframe& subframe, const Eigen::Vector3d& point) const;
+  // The same with the subframe's true sonar poses given (sonarPoses), for many points of one subframe.
+  std::optional<Eigen::Vector2d> pixelOf(const sss::subframe::Subframe& subframe, const Eigen::Vector3d& point,
+                                         const std::vector<sss::core::Pose>& sonar_poses) const;
+  // True T_world_sonar of every row of the subframe.
+  std::vector<sss::core::Pose> sonarPoses(const sss::subframe::Subframe& subframe) const;
 
   // True relative pose of the centre pings: B's centre body frame in A's.
   sss::core::Pose trueRelativePose(const sss::subframe::Subframe& a, const sss::subframe::Subframe& b) const;
