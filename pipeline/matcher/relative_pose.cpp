@@ -164,9 +164,11 @@ struct Solved {
 
 // Builds and solves eq. (3) over the given measurements; optionally the pose covariance, taken
 // after re-anchoring at the solution so that delta = 0 is exactly our [dt, dr] tangent there.
+// `robust`: the Cauchy loss on the bin residuals (the final refinement; a RANSAC hypothesis is
+// six matches started from DR, metres from the truth, where a robust loss would stall).
 Solved solve(const std::vector<Measurement>& measurements, const std::vector<int>& subset, const Pose& initial,
              const Pose& dr, const Eigen::Matrix<double, 6, 6>& sqrt_information, const RelativePoseOptions& options,
-             int max_iterations, double max_seconds, bool with_covariance) {
+             int max_iterations, double max_seconds, bool with_covariance, bool robust) {
   Pose anchor = initial;
   double delta[6] = {0, 0, 0, 0, 0, 0};
   std::vector<Eigen::Vector3d> landmarks;
@@ -180,12 +182,15 @@ Solved solve(const std::vector<Measurement>& measurements, const std::vector<int
   for (size_t i = 0; i < subset.size(); ++i) {
     const Measurement& m = measurements[subset[i]];
     double* x = landmarks[i].data();
+    auto loss = [&]() -> ceres::LossFunction* {
+      return robust && options.robust_loss_scale > 0.0 ? new ceres::CauchyLoss(options.robust_loss_scale) : nullptr;
+    };
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BinResidualA, 2, 3>(new BinResidualA{
                                  m.a, options.range_sigma_m, m.a.slant_range_m * options.beam_width_rad}),
-                             nullptr, x);
+                             loss(), x);
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BinResidualB, 2, 6, 3>(new BinResidualB{
                                  m.b, &anchor, options.range_sigma_m, m.b.slant_range_m * options.beam_width_rad}),
-                             nullptr, delta, x);
+                             loss(), delta, x);
     if (options.use_seabed_prior) {
       problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SeabedResidual, 1, 3>(
                                    new SeabedResidual{m.down_a, m.seabed_depth_a_m, options.seabed_sigma_m}),
@@ -432,7 +437,7 @@ RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const Re
       }
     }
     const Solved hypothesis = solve(measurements, subset, T_a_b_dr, T_a_b_dr, sqrt_information, options,
-                                    hypothesis_iterations, ransac_budget_s - elapsed(), false);
+                                    hypothesis_iterations, ransac_budget_s - elapsed(), false, false);
     if (hypothesis.usable) {
       const Score score = scoreHypothesis(measurements, score_sample, hypothesis.T_a_b, options, &in_subset);
       if (score.plane_cost < best_plane && score.range_cost < best_range && hypothesis.final_cost < best_optimisation) {
@@ -475,7 +480,7 @@ RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const Re
     const std::vector<int> used = sampleEvenly(inliers);
     const double remaining_s = capped ? std::max(options.time_limit_s - elapsed(), 0.05) : 1e9;
     refined = solve(measurements, used, pose, T_a_b_dr, sqrt_information, options, options.max_solver_iterations,
-                    pass == 0 ? 0.5 * remaining_s : remaining_s, pass == 1);
+                    pass == 0 ? 0.5 * remaining_s : remaining_s, pass == 1, true);
     if (!refined.usable) break;
     pose = refined.T_a_b;
     result.inlier_indices.clear();
@@ -532,6 +537,7 @@ std::vector<std::string> validateRelativePoseOptions(const RelativePoseOptions& 
   if (o.ransac_score_sample < 1) problems.push_back("ransac_score_sample must be >= 1");
   if (o.max_correspondences < o.ransac_subset) problems.push_back("max_correspondences must be >= ransac_subset");
   if (!(o.inlier_threshold_sigma > 0.0)) problems.push_back("inlier_threshold_sigma must be > 0");
+  if (!(o.robust_loss_scale >= 0.0)) problems.push_back("robust_loss_scale must be >= 0 (0: plain least squares)");
   if (o.min_inliers < 0) problems.push_back("min_inliers must be >= 0");
   if (o.min_inlier_fraction < 0.0 || o.min_inlier_fraction > 1.0) problems.push_back("min_inlier_fraction in [0, 1]");
   if (!(o.max_mean_cost > 0.0)) problems.push_back("max_mean_cost must be > 0");
@@ -553,6 +559,7 @@ void readRelativePoseOptions(sss::core::ConfigSection& section, RelativePoseOpti
   section.optional("max_correspondences", options.max_correspondences, {inRange(3, 100000)});
   section.optional("ransac_score_sample", options.ransac_score_sample, {inRange(1, 1000000)});
   section.optional("inlier_threshold_sigma", options.inlier_threshold_sigma, {greaterThan(0.0)});
+  section.optional("robust_loss_scale", options.robust_loss_scale, {sss::core::atLeast(0.0)});
   section.optional("min_inliers", options.min_inliers, {atLeast(0)});
   section.optional("min_inlier_fraction", options.min_inlier_fraction, {inRange(0.0, 1.0)});
   section.optional("max_mean_cost", options.max_mean_cost, {greaterThan(0.0)});

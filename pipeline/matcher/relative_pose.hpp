@@ -31,6 +31,12 @@ struct RelativePoseOptions {
   int ransac_score_sample = 300;    // matches each hypothesis is scored on (evenly sampled)
   int max_correspondences = 400;    // inliers used in the final refinement, sampled evenly
   double inlier_threshold_sigma = 3.0;
+  // Cauchy loss on each match's range + plane residuals in the solves (whitened units; 0: plain
+  // least squares, as the paper). Dense matches have heavy-tailed errors: shadows seen from the
+  // other side and oblique trawl marks shift a patch by a pixel or more in a direction that varies
+  // from pair to pair, and the RANSAC inlier band (3 sigma) keeps many of them; their mean biases
+  // a least-squares pose, a Cauchy loss follows the bulk.
+  double robust_loss_scale = 0.0;
   // Acceptance: inlier count and fraction, and the mean squared whitened range and plane
   // residuals of the final refinement (about 1 for a consistent model).
   int min_inliers = 30;

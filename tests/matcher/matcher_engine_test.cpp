@@ -235,12 +235,14 @@ TEST_F(MatcherEngineRestartTest, RestoredEngineKeepsSubframesCorrectionsAndDoneP
   const PairIds ids = pairIds(outcomes);
   EXPECT_TRUE(ids.count({0, 4}) && ids.count({2, 4})) << outcomes.size() << " pairs";
   int accepted_against_old = 0;
+  std::string reasons;
   for (const PairOutcome& o : outcomes) {
     EXPECT_EQ(o.subframe_id_b, 4);
     EXPECT_EQ(o.association_round, 0);
     if (o.accepted && o.subframe_id_a <= 3) ++accepted_against_old;
+    if (!o.accepted) reasons += std::to_string(o.subframe_id_a) + "-4: " + o.reason + "; ";
   }
-  EXPECT_GE(accepted_against_old, 2);
+  EXPECT_GE(accepted_against_old, 2) << reasons;
   EXPECT_EQ(engine.counters().pairs_attempted, outcomes.size());
   EXPECT_TRUE(fs::exists(store.subframePath(4)));
 }
