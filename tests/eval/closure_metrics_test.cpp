@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -184,6 +185,46 @@ TEST_F(ClosureMetrics, ReaderNamesFileAndLineOfAProblem) {
   EXPECT_EQ(closures[0].status, "unknown");
   EXPECT_EQ(closures[0].round, -1);
   EXPECT_DOUBLE_EQ(closures[0].translation_m.z(), 3.0);
+}
+
+TEST_F(ClosureMetrics, HorizontalNeesUsesTheClosuresOwnCovariance) {
+  // The columns sss-process writes after east_b_m; closure 0 (error along 0.3, lateral -0.2) with
+  // sigmas 0.3 and 0.1 m and no correlation: NEES = 1 + 4 = 5; closure 1 (-0.3, 0.2) with a
+  // correlated covariance [[0.09, 0.02], [0.02, 0.04]]: e^T C^-1 e = 2.3529...; a closure without
+  // a usable covariance (zero) has none.
+  std::string text = kHeader;
+  text.insert(text.rfind("east_b_m") + 8, ",cov_xx_m2,cov_xy_m2,cov_yy_m2,sigma_heading_rad");
+  const char* covariances[] = {",0.09,0,0.01,0.001\n", ",0.09,0.02,0.04,0.001\n", ",0,0,0,0\n"};
+  for (size_t k = 0; k < perturbations_.size(); ++k) {
+    std::string row = closureRow(truth_, perturbations_[k], truth_[perturbations_[k].a].utime_us,
+                                 truth_[perturbations_[k].b].utime_us);
+    row.pop_back();  // the newline
+    text += row + covariances[k];
+  }
+  write(text);
+  std::vector<ClosureRecord> closures;
+  std::string error;
+  ASSERT_TRUE(readClosureCsv(path_, closures, error)) << error;
+  ASSERT_EQ(closures.size(), 3u);
+  EXPECT_TRUE(closures[0].has_covariance);
+  EXPECT_DOUBLE_EQ(closures[1].horizontal_covariance_m2(0, 1), 0.02);
+  const ClosureEvaluation ev = evaluateClosures(closures, truth_, nullptr, 1.0);
+  EXPECT_NEAR(ev.closures[0].horizontal_nees, 5.0, 1e-6);
+  const Eigen::Vector2d e(-0.3, 0.2);
+  Eigen::Matrix2d c;
+  c << 0.09, 0.02, 0.02, 0.04;
+  EXPECT_NEAR(ev.closures[1].horizontal_nees, e.dot(c.inverse() * e), 1e-6);
+  EXPECT_TRUE(std::isnan(ev.closures[2].horizontal_nees));
+  ASSERT_EQ(ev.groups.size(), 2u);
+  EXPECT_EQ(ev.groups[0].nees_count, 2u);
+  EXPECT_NEAR(ev.groups[0].mean_horizontal_nees, 0.5 * (5.0 + e.dot(c.inverse() * e)), 1e-6);
+  EXPECT_EQ(ev.groups[1].nees_count, 0u);
+  EXPECT_TRUE(std::isnan(ev.groups[1].mean_horizontal_nees));
+
+  // A covariance column that is not a number: refused with the line.
+  write(text.substr(0, text.rfind(",0,0,0,0")) + ",x,0,0,0\n");
+  EXPECT_FALSE(readClosureCsv(path_, closures, error));
+  EXPECT_NE(error.find("cov_xx_m2"), std::string::npos) << error;
 }
 
 }  // namespace

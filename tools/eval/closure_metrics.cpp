@@ -1,6 +1,8 @@
 // Loop-closure accuracy against ground truth. See closure_metrics.hpp.
 #include "tools/eval/closure_metrics.hpp"
 
+#include <Eigen/Cholesky>
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
@@ -79,6 +81,19 @@ bool readClosureCsv(const std::string& path, std::vector<ClosureRecord>& closure
     record.status = table.has("status") ? table.field(row, "status") : "unknown";
     if (record.status.empty()) record.status = "unknown";
     if (table.has("rejection")) record.rejection = table.field(row, "rejection");
+    if (table.has("cov_xx_m2") && table.has("cov_xy_m2") && table.has("cov_yy_m2")) {
+      static const char* kCovariance[] = {"cov_xx_m2", "cov_xy_m2", "cov_yy_m2"};
+      double c[3];
+      for (int k = 0; k < 3; ++k) {
+        const std::string& field = table.field(row, kCovariance[k]);
+        if (!parseFiniteDouble(field, c[k])) {
+          error = table.where(row) + kCovariance[k] + " '" + field + "' is not a finite number";
+          return false;
+        }
+      }
+      record.horizontal_covariance_m2 << c[0], c[1], c[1], c[2];
+      record.has_covariance = true;
+    }
     closures.push_back(std::move(record));
   }
   return true;
@@ -125,6 +140,12 @@ ClosureEvaluation evaluateClosures(const std::vector<ClosureRecord>& closures, c
       entry.has_truth = true;
       entry.truth = relativePose(*truth_a, *truth_b);
       entry.closure_error = relativePoseError({record.translation_m, record.heading_rad}, entry.truth);
+      if (record.has_covariance) {
+        const Eigen::Vector2d e(entry.closure_error.along_m, entry.closure_error.lateral_m);
+        const Eigen::LDLT<Eigen::Matrix2d> ldlt(record.horizontal_covariance_m2);
+        if (ldlt.info() == Eigen::Success && ldlt.isPositive() && record.horizontal_covariance_m2.determinant() > 0.0)
+          entry.horizontal_nees = e.dot(ldlt.solve(e));
+      }
       if (dr) {
         const std::optional<sss::core::Pose> dr_a = poseAtTime(*dr, record.utime_a_us, max_gap_s);
         const std::optional<sss::core::Pose> dr_b = poseAtTime(*dr, record.utime_b_us, max_gap_s);
@@ -150,10 +171,16 @@ ClosureEvaluation evaluateClosures(const std::vector<ClosureRecord>& closures, c
   }
   for (const std::string& status : statuses) {
     std::vector<RelativePoseError> closure_errors, dr_errors;
+    double nees_sum = 0.0;
+    size_t nees_count = 0;
     for (const ClosureError& e : result.closures) {
       if (e.closure.status != status || !e.has_truth) continue;
       closure_errors.push_back(e.closure_error);
       if (e.has_dr) dr_errors.push_back(e.dr_error);
+      if (std::isfinite(e.horizontal_nees)) {
+        nees_sum += e.horizontal_nees;
+        ++nees_count;
+      }
     }
     if (closure_errors.empty()) continue;
     ClosureGroup group;
@@ -161,6 +188,8 @@ ClosureEvaluation evaluateClosures(const std::vector<ClosureRecord>& closures, c
     group.count = closure_errors.size();
     group.closure = relativePoseErrorStatistics(closure_errors);
     group.dr = relativePoseErrorStatistics(dr_errors);
+    group.nees_count = nees_count;
+    if (nees_count) group.mean_horizontal_nees = nees_sum / static_cast<double>(nees_count);
     result.groups.push_back(group);
   }
   return result;

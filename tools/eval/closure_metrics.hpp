@@ -26,11 +26,15 @@ struct ClosureRecord {
   int64_t utime_b_us = 0;
   Eigen::Vector3d translation_m = Eigen::Vector3d::Zero();  // dx, dy, dz: B's centre in A's body frame
   double heading_rad = 0.0;                                 // dheading: heading of T_a_b's rotation
+  // The closure's own horizontal covariance (cov_xx_m2, cov_xy_m2, cov_yy_m2: B's centre in A's
+  // frame), when the file has the columns.
+  bool has_covariance = false;
+  Eigen::Matrix2d horizontal_covariance_m2 = Eigen::Matrix2d::Zero();
 };
 
 // Header line first (columns found by name in any order, extra columns ignored; needed:
 // subframe_id_a, subframe_id_b, utime_a_us, utime_b_us, dx_m, dy_m, dz_m, dheading_rad; optional:
-// round, status, rejection), then one closure per line; '#' and blank lines are skipped. False
+// round, status, rejection, cov_xx_m2 + cov_xy_m2 + cov_yy_m2), then one closure per line; '#' and blank lines are skipped. False
 // with "FILE:LINE: ..." on the first problem.
 bool readClosureCsv(const std::string& path, std::vector<ClosureRecord>& closures, std::string& error);
 
@@ -59,6 +63,9 @@ struct ClosureError {
   RelativePoseError closure_error;  // the closure's relative pose - the truth's
   bool has_dr = false;              // a DR trajectory was given and covers both times
   RelativePoseError dr_error;       // DR's relative pose - the truth's
+  // Normalised estimation error squared of the horizontal error under the closure's covariance
+  // (2 dof: about 2 on average when the covariance is consistent); NaN without one.
+  double horizontal_nees = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Statistics of one signed error component: of its absolute value, plus the mean signed value.
@@ -82,6 +89,8 @@ struct ClosureGroup {
   size_t count = 0;
   RelativePoseErrorStatistics closure;
   RelativePoseErrorStatistics dr;  // over the closures DR covers (count 0 without DR)
+  size_t nees_count = 0;           // closures with a covariance
+  double mean_horizontal_nees = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct ClosureEvaluation {

@@ -69,6 +69,11 @@ std::string formatClosureTable(const EvalReport& report) {
     rows.push_back(row);
   }
   out << formatColumns(rows);
+  std::string nees;
+  for (const ClosureGroup& g : ev.groups) {
+    if (g.nees_count) nees += " " + g.status + " " + cell(g.mean_horizontal_nees, 2) + " (" + std::to_string(g.nees_count) + ")";
+  }
+  if (!nees.empty()) out << "mean horizontal NEES under the closures' own covariance (2 when consistent):" << nees << "\n";
   if (report.options.closure_table) {
     std::vector<std::vector<std::string>> list = {
         {"closure a-b", "round", "status", "true dx", "true dy", "along", "lateral", "depth", "heading"},
@@ -154,6 +159,13 @@ void writeClosuresJson(JsonWriter& json, const ClosureReport& closures) {
     json.key("count").value(static_cast<uint64_t>(g.count));
     writeRelativePoseErrorStatistics(json, "closure", g.closure);
     writeRelativePoseErrorStatistics(json, "dr", g.dr);
+    json.key("nees_count").value(static_cast<uint64_t>(g.nees_count));
+    json.key("mean_horizontal_nees");
+    if (g.nees_count) {
+      json.value(g.mean_horizontal_nees);
+    } else {
+      json.null();
+    }
     json.endObject();
   }
   json.endArray();

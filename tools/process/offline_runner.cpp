@@ -279,19 +279,32 @@ bool writeClosuresCsv(const std::string& path, const sss::optimiser::OptimiserEn
     return false;
   }
   std::fprintf(f, "# loop closures from the matcher and the optimiser's decision; T_a_b maps B's centre body frame into A's;\n"
-                  "# north/east: the two subframe centres under the final SLAM estimate (local NED, m)\n");
+                  "# north/east: the two subframe centres under the final SLAM estimate (local NED, m);\n"
+                  "# cov_*: the closure's published covariance of B's centre position, in A's body frame (m^2);\n"
+                  "# sigma_heading_rad: of its heading\n");
   std::fprintf(f, "subframe_id_a,subframe_id_b,utime_a_us,utime_b_us,round,status,rejection,dx_m,dy_m,dz_m,droll_rad,"
-                  "dpitch_rad,dheading_rad,num_inliers,mean_zncc,north_a_m,east_a_m,north_b_m,east_b_m\n");
+                  "dpitch_rad,dheading_rad,num_inliers,mean_zncc,north_a_m,east_a_m,north_b_m,east_b_m,cov_xx_m2,"
+                  "cov_xy_m2,cov_yy_m2,sigma_heading_rad\n");
   for (const auto& summary : engine.closureSummaries()) {
     const auto& c = summary.record.closure;
     const sss::core::EulerAngles euler = sss::core::eulerFromQuaternion(c.T_a_b.rotation);
-    std::fprintf(f, "%lld,%lld,%lld,%lld,%d,%s,%s,%.4f,%.4f,%.4f,%.6f,%.6f,%.6f,%d,%.4f,%.3f,%.3f,%.3f,%.3f\n",
+    // The covariance is over the tangent of T_a_b * Exp(delta): its translation part is in B's
+    // frame; to first order B's position moves by R_a_b dt, so rotate it into A's.
+    const Eigen::Matrix3d R_a_b = c.T_a_b.rotation.toRotationMatrix();
+    const Eigen::Matrix3d position_covariance = R_a_b * c.covariance.topLeftCorner<3, 3>() * R_a_b.transpose();
+    // Heading variance: of the rotation about A's down axis, from the rotation block (B's frame).
+    const Eigen::Vector3d down_in_b = R_a_b.transpose() * Eigen::Vector3d::UnitZ();
+    const double heading_variance = down_in_b.dot(c.covariance.bottomRightCorner<3, 3>() * down_in_b);
+    std::fprintf(f, "%lld,%lld,%lld,%lld,%d,%s,%s,%.4f,%.4f,%.4f,%.6f,%.6f,%.6f,%d,%.4f,%.3f,%.3f,%.3f,%.3f,%.6g,%.6g,"
+                    "%.6g,%.6g\n",
                  static_cast<long long>(c.subframe_id_a), static_cast<long long>(c.subframe_id_b),
                  static_cast<long long>(utime_of[c.subframe_id_a]), static_cast<long long>(utime_of[c.subframe_id_b]),
                  c.association_round, statusName(summary.record.status), rejectionName(summary.record.rejection),
                  c.T_a_b.translation.x(), c.T_a_b.translation.y(), c.T_a_b.translation.z(), euler.roll_rad,
                  euler.pitch_rad, euler.heading_rad, c.num_inliers, summary.mean_zncc, summary.centre_a_ned_m.x(),
-                 summary.centre_a_ned_m.y(), summary.centre_b_ned_m.x(), summary.centre_b_ned_m.y());
+                 summary.centre_a_ned_m.y(), summary.centre_b_ned_m.x(), summary.centre_b_ned_m.y(),
+                 position_covariance(0, 0), position_covariance(0, 1), position_covariance(1, 1),
+                 std::sqrt(std::max(heading_variance, 0.0)));
   }
   const bool ok = std::fclose(f) == 0;
   if (!ok) error = "cannot write " + path;
