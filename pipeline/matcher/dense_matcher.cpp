@@ -123,6 +123,30 @@ struct GridImage {
 };
 enum PatchState : std::uint8_t { kPartial = 0, kFull = 1, kFlat = 2 };
 
+// Per pixel, the ratio of the small to the large eigenvalue of the structure tensor (intensity
+// gradient outer products summed over a patch_size box): ~0 for one straight edge or line, up to
+// 1 for texture that varies in every direction.
+cv::Mat1f structureRatio(const cv::Mat1f& image, int patch_size) {
+  cv::Mat1f gx, gy;
+  cv::Sobel(image, gx, CV_32F, 1, 0, 3);
+  cv::Sobel(image, gy, CV_32F, 0, 1, 3);
+  cv::Mat1f jxx, jyy, jxy;
+  const cv::Size box(patch_size, patch_size);
+  cv::boxFilter(gx.mul(gx), jxx, CV_32F, box);
+  cv::boxFilter(gy.mul(gy), jyy, CV_32F, box);
+  cv::boxFilter(gx.mul(gy), jxy, CV_32F, box);
+  cv::Mat1f ratio(image.size(), 0.0f);
+  for (int r = 0; r < image.rows; ++r) {
+    for (int c = 0; c < image.cols; ++c) {
+      const float trace = jxx(r, c) + jyy(r, c);
+      const float det = jxx(r, c) * jyy(r, c) - jxy(r, c) * jxy(r, c);
+      const float root = std::sqrt(std::max(trace * trace - 4.0f * det, 0.0f));
+      if (trace + root > 1e-12f) ratio(r, c) = std::max(trace - root, 0.0f) / (trace + root);
+    }
+  }
+  return ratio;
+}
+
 void computePatchStatistics(GridImage& image, int half, double min_stddev) {
   cv::Mat1d sum, sum_sq, count;
   const cv::Mat1f weighted = image.value.mul(image.weight);
@@ -358,6 +382,8 @@ std::vector<std::string> validateDenseMatcherOptions(const DenseMatcherOptions& 
   if (!(o.max_fb_error_px >= 0.0)) problems.push_back("max_fb_error_px must be >= 0");
   if (!(o.random_search_ratio > 0.0 && o.random_search_ratio < 1.0))
     problems.push_back("random_search_ratio must be in (0, 1)");
+  if (!(o.min_structure_ratio >= 0.0 && o.min_structure_ratio <= 1.0))
+    problems.push_back("min_structure_ratio must be in [0, 1]");
   if (o.min_coherent_neighbours < 0 || o.min_coherent_neighbours > 8)
     problems.push_back("min_coherent_neighbours must be in [0, 8]");
   if (o.stride < 1 || o.stride > 64) problems.push_back("stride must be in [1, 64]");
@@ -384,6 +410,7 @@ void readDenseMatcherOptions(sss::core::ConfigSection& section, DenseMatcherOpti
   section.optional("max_fb_error_px", options.max_fb_error_px, {atLeast(0.0)});
   section.optional("subpixel", options.subpixel);
   section.optional("min_coherent_neighbours", options.min_coherent_neighbours, {inRange(0, 8)});
+  section.optional("min_structure_ratio", options.min_structure_ratio, {inRange(0.0, 1.0)});
   section.optional("random_search_ratio", options.random_search_ratio,
                    {sss::core::satisfies<double>([](double v) { return v > 0.0 && v < 1.0; }, "a value in (0, 1)")});
   section.optional("stride", options.stride, {inRange(1, 64)});
@@ -504,6 +531,8 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
   });
   computePatchStatistics(grid_a, half, o.min_patch_stddev);
   computePatchStatistics(grid_b, half, o.min_patch_stddev);
+  const cv::Mat1f structure_ratio_a =
+      o.min_structure_ratio > 0.0 ? structureRatio(grid_a.value, 2 * half + 1) : cv::Mat1f();
 
   // Forward field: every stride-th valid pixel of A that has a geo-referenced B pixel nearby.
   Field forward;
@@ -583,6 +612,7 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
       const int k = forward.index(i, j);
       if (!forward.active[k] || forward.score[k] < o.min_zncc) continue;
       const int sr = forward.gridRow(i), sc = forward.gridCol(j);
+      if (!structure_ratio_a.empty() && structure_ratio_a(sr, sc) < o.min_structure_ratio) continue;
       const int tr = sr + forward.d_row[k], tc = sc + forward.d_col[k];
       if (o.forward_backward_check) {
         const int bi = std::clamp(static_cast<int>(std::lround(double(tr - backward.row0) / o.stride)), 0,

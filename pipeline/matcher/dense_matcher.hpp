@@ -43,6 +43,11 @@ struct DenseMatcherOptions {
   double max_fb_error_px = 1.5;
   // Of a match's 8 lattice neighbours, how many must have an offset within 1 px of its own.
   int min_coherent_neighbours = 4;
+  // Aperture problem: a patch whose texture is one straight feature (a trawl mark, a sediment
+  // edge) matches equally well anywhere along it, and the forward-backward and coherence checks
+  // cannot tell (the whole field slides along it). Such patches are not matched: the ratio of the
+  // small to the large eigenvalue of A's patch structure tensor must reach this (0: no check).
+  double min_structure_ratio = 0.0;
   bool subpixel = true;              // parabola fit of ZNCC around the integer optimum
   double random_search_ratio = 0.5;  // Barnes et al.: window shrinks by this factor per sample
   int stride = 2;                    // match every stride-th row and column of A

@@ -83,6 +83,40 @@ TEST(DenseMatcher, TextureFreeSeabedYieldsFewMatches) {
   EXPECT_LT(static_cast<double>(matches.size()), 0.01 * timings.overlapping_pixels);
 }
 
+TEST(DenseMatcher, PatchesOfOneStraightFeatureAreNotMatchedWithTheApertureCheck) {
+  // One straight diagonal line on a flat bed, the same in both images, B geo-referenced 2 m off
+  // along the line: every patch on it fits anywhere along the line (the aperture problem), so a
+  // match there says nothing about the offset. Without the check they match; with it they do not.
+  GeoImage a;
+  const int rows = 80, cols = 80;
+  a.intensity = cv::Mat1f(rows, cols, 0.5f);
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      const float distance = std::abs(static_cast<float>(r - c)) / std::sqrt(2.0f);
+      a.intensity(r, c) += 0.5f * std::exp(-distance * distance / 2.0f);
+    }
+  }
+  a.valid = cv::Mat1b(rows, cols, 255);
+  a.position_ne_m = cv::Mat2f(rows, cols);
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) a.position_ne_m(r, c) = cv::Vec2f(0.5f * r, 0.5f * c);
+  a.heading_rad = cv::Mat1f(rows, 1, 0.0f);
+  GeoImage b = a;
+  b.intensity = a.intensity.clone();
+  b.position_ne_m = a.position_ne_m.clone();
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) b.position_ne_m(r, c) += cv::Vec2f(1.41f, 1.41f);  // 2 m along the line
+  DenseMatcherOptions options;
+  options.patch_size = 13;
+  options.max_dr_error_m = 3.0;
+  const size_t without_check = DenseMatcher(options).match(a, b).size();
+  options.min_structure_ratio = 0.2;
+  const size_t with_check = DenseMatcher(options).match(a, b).size();
+  std::printf("straight feature: %zu matches without the aperture check, %zu with it\n", without_check, with_check);
+  EXPECT_GT(without_check, 50u);
+  EXPECT_EQ(with_check, 0u);
+}
+
 TEST(DenseMatcher, WrongPairWithClaimedOverlapYieldsFewMatches) {
   // The geo-references say the images overlap, but B shows a different piece of seabed.
   // Known limit (see report): chance correlations that are locally coherent survive ZNCC, FB and

@@ -47,10 +47,13 @@ void expectPairRecoversDrError(const PairCase& pair_case) {
               match.dense_timings.total_s, match.pose.seconds);
   // Issue 6 acceptance: >= 80 % of the returned matches within 2 px of the true match.
   // The pairs overlap by 50 m along track; at stride 2 on 0.5 m pixels a few hundred matches is
-  // what a textured stretch gives (measured 474 anti-parallel, 1576 parallel).
-  EXPECT_GT(e.evaluated, 300);
+  // what a textured stretch gives: 474 anti-parallel, 1576 parallel (recall 0.16-0.31) before the
+  // aperture check (min_structure_ratio 0.2), which drops patches of one straight feature on
+  // purpose: 225 and 1279 after it (recall 0.095-0.22). The floor is set under those: it
+  // catches a matcher that stops finding matches, not that trade of recall for precision.
+  EXPECT_GT(e.evaluated, 200);
   EXPECT_GE(e.withinFraction(), 0.8);
-  EXPECT_GT(e.recall(), 0.15);
+  EXPECT_GT(e.recall(), 0.08);
   // Issue 6 acceptance: relative translation within 0.3 m of the truth along and across track.
   ASSERT_TRUE(match.accepted) << match.reason;
   EXPECT_GT(dr_error.head<2>().norm(), 3.0);  // the error to remove is really there
