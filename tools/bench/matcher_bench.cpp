@@ -4,8 +4,10 @@
 // lateral DR error between the two subframes of each overlapping full pair, runs dense matching +
 // relative pose, and checks both against the ray-cast truth. Pairs are typed by their centre
 // headings (parallel, anti-parallel, crossing). Prints a line per pair, a summary, and as its last
-// line one JSON object.
-//   sss-bench-matcher [--pattern lawnmower|cross] [--lines N] [--line-length-m M] [--repeat K]
+// line one JSON object. --config FILE takes the matcher settings from a deployment file's matcher
+// section (as sss-matcher reads them) instead of the built-in defaults.
+//   sss-bench-matcher [--pattern lawnmower|cross] [--lines N] [--line-length-m M] [--line-spacing-m M]
+//                     [--repeat K] [--config FILE]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -13,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/core/config.hpp"
+#include "pipeline/matcher/matcher_engine.hpp"
 #include "pipeline/matcher/overlap.hpp"
 #include "pipeline/matcher/pair_matcher.hpp"
 #include "pipeline/subframe/georeference.hpp"
@@ -33,7 +37,8 @@ double percentile(std::vector<double> v, double q) {
 
 int main(int argc, char** argv) {
   int lines = 3, repeat = 1;
-  double line_length_m = 300.0;
+  double line_length_m = 300.0, line_spacing_m = 40.0;
+  std::string config_path;
   std::string pattern = "lawnmower";
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -45,8 +50,13 @@ int main(int argc, char** argv) {
       line_length_m = std::atof(argv[++i]);
     } else if (arg == "--repeat" && i + 1 < argc) {
       repeat = std::max(1, std::atoi(argv[++i]));
+    } else if (arg == "--line-spacing-m" && i + 1 < argc) {
+      line_spacing_m = std::atof(argv[++i]);
+    } else if (arg == "--config" && i + 1 < argc) {
+      config_path = argv[++i];
     } else {
-      std::fprintf(stderr, "usage: %s [--pattern lawnmower|cross] [--lines N] [--line-length-m M] [--repeat K]\n",
+      std::fprintf(stderr, "usage: %s [--pattern lawnmower|cross] [--lines N] [--line-length-m M] [--line-spacing-m M] [--repeat K]\n"
+                   "          [--config FILE (its matcher section; default: the built-in defaults)]\n",
                    argv[0]);
       return arg == "--help" ? 0 : 2;
     }
@@ -54,7 +64,7 @@ int main(int argc, char** argv) {
   sss::sim::SimOptions sim;
   sim.trajectory.lines = std::max(2, lines);
   sim.trajectory.line_length_m = line_length_m;
-  sim.trajectory.line_spacing_m = 40.0;
+  sim.trajectory.line_spacing_m = line_spacing_m;
   sim.trajectory.pattern = pattern;
   std::printf("rendering %d lines of %.0f m%s ...\n", sim.trajectory.lines, line_length_m,
               pattern == "cross" ? " and 2 lines crossing them" : "");
@@ -62,6 +72,18 @@ int main(int argc, char** argv) {
   const sss::sim::SubframeTruth truth(*survey.mission);
 
   sss::matcher::PairMatcherOptions options;
+  if (!config_path.empty()) {
+    // The deployed matcher settings, read as sss-matcher reads them.
+    sss::core::Config config = sss::core::Config::fromFile(config_path);
+    sss::core::ConfigSection section = config.section("matcher");
+    sss::matcher::MatcherEngineOptions engine;
+    sss::matcher::readMatcherEngineOptions(section, engine);
+    if (!config.ok()) {
+      std::fprintf(stderr, "invalid configuration %s: %s\n", config_path.c_str(), config.problemReport().c_str());
+      return 2;
+    }
+    options = engine.pair;
+  }
   const sss::matcher::DenseMatcher dense(options.dense);
   sss::matcher::OverlapOptions overlap;
   std::vector<const sss::subframe::Subframe*> full;
