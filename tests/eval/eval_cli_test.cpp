@@ -259,6 +259,11 @@ TEST_F(EvalCli, BadInputsExitWithCodeTwoAndAClearMessage) {
   result = run("--gt " + path("truth.tum") + " --closures " + path("truth.tum"));  // not a closure file
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_NE(result.err.find("the header has no column"), std::string::npos) << result.err;
+  EXPECT_EQ(run("--matches " + path("truth.tum")).exit_code, 2);  // no --mission
+  result = run("--matches " + path("truth.tum") + " --mission " + dir_.string());  // not a matches file
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.err.find(path("truth.tum") + ":1:"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("'kind'"), std::string::npos) << result.err;
   EXPECT_EQ(run("--help").exit_code, 0);
 }
 

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "tools/eval/heightmap_metrics.hpp"
+#include "tools/eval/match_metrics.hpp"
 #include "tools/eval/trajectory_io.hpp"
 #include "tools/eval/trajectory_metrics.hpp"
 #include "tools/process/offline_runner.hpp"
@@ -134,6 +135,34 @@ TEST_F(OfflineRunnerTest, SonarAndInsFilesGiveEveryOutputAndBeatDeadReckoning) {
   EXPECT_EQ(replayed.summary.pings, s.pings);
   EXPECT_EQ(readFile(replay.out_dir + "/slam.tum"), readFile(r.out_dir + "/slam.tum"));
   EXPECT_EQ(readFile(replay.out_dir + "/loop_closures.csv"), csv);
+}
+
+TEST_F(OfflineRunnerTest, WrittenMatchesAreEvaluatedAgainstTheTruth) {
+  // --write-matches end to end: every pair the matcher tried is in matches.csv, and the file read
+  // back against the mission's truth gives the matcher's accuracy (sss-eval --matches).
+  auto r = request("matches");
+  r.write_matches = true;
+  r.write_mosaics = false;
+  const auto result = sss::offline::runOffline(r);
+  ASSERT_TRUE(result.ok) << result.error;
+  sss::eval::MatchFileEvaluation evaluation;
+  std::string error;
+  ASSERT_TRUE(sss::eval::evaluateMatchFile(r.out_dir + "/matches.csv", root_ + "/mission", evaluation, error)) << error;
+  std::printf("matches.csv: %zu pair rounds, %ld matches, within 2 px %.3f, recall %.3f, EPE %.2f px\n",
+              evaluation.pairs.size(), evaluation.overall.matches, evaluation.overall.withinFraction(),
+              evaluation.overall.recall(), evaluation.overall.meanErrorPx());
+  EXPECT_GE(evaluation.pairs.size(), result.summary.pairs_attempted);  // every attempt, any round
+  EXPECT_EQ(evaluation.subframes, result.summary.subframes);
+  // Adjacent lines of a lawnmower fly opposite ways: anti-parallel pairs, no crossing ones.
+  EXPECT_GT(evaluation.pairs_by_type[static_cast<int>(sss::eval::PairType::kAntiParallel)], 0);
+  EXPECT_EQ(evaluation.pairs_by_type[static_cast<int>(sss::eval::PairType::kCrossing)], 0);
+  EXPECT_GT(evaluation.overall.evaluated, 1000);
+  EXPECT_GE(evaluation.overall.withinFraction(), 0.75);
+  EXPECT_GT(evaluation.overall.recall(), 0.05);
+
+  // A matches file against a folder without the mission is refused with a reason.
+  EXPECT_FALSE(sss::eval::evaluateMatchFile(r.out_dir + "/matches.csv", r.out_dir, evaluation, error));
+  EXPECT_NE(error.find("mission.yaml"), std::string::npos) << error;
 }
 
 TEST_F(OfflineRunnerTest, EmbeddedNavigationOfTheSonarFileIsUsedWithoutAnInsFile) {
