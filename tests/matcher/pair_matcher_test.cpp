@@ -40,7 +40,7 @@ void expectPairRecoversDrError(const PairCase& pair_case) {
   std::printf("%s: decimation %d, %ld matches (%ld with truth), within 2 px %.3f, recall %.3f, mean error %.2f px; DR error "
               "[%.2f %.2f %.2f] m -> estimate error [%.3f %.3f %.3f] m, sigma [%.3f %.3f] m, %d inliers, %s; "
               "%.2f s (georef %.2f, dense %.2f, pose %.2f)\n",
-              pair_case.name, match.decimation, e.matches, e.evaluated, e.withinFraction(), e.recall(), e.mean_error_px, dr_error.x(),
+              pair_case.name, match.decimation, e.matches, e.evaluated, e.withinFraction(), e.recall(), e.meanErrorPx(), dr_error.x(),
               dr_error.y(), dr_error.z(), error.x(), error.y(), error.z(), std::sqrt(match.pose.covariance(0, 0)),
               std::sqrt(match.pose.covariance(1, 1)), match.pose.num_inliers,
               match.accepted ? "accepted" : match.reason.c_str(), match.seconds, match.georeference_s,

@@ -33,10 +33,11 @@ SignedErrorStatistics signedStatistics(const std::vector<double>& values) {
 }  // namespace
 
 bool readClosureCsv(const std::string& path, std::vector<ClosureRecord>& closures, std::string& error) {
-  static const char* kIntegers[] = {"subframe_id_a", "subframe_id_b", "utime_a_us", "utime_b_us"};
-  static const char* kNumbers[] = {"dx_m", "dy_m", "dz_m", "dheading_rad"};
-  std::vector<std::string> required(std::begin(kIntegers), std::end(kIntegers));
-  required.insert(required.end(), std::begin(kNumbers), std::end(kNumbers));
+  const std::vector<const char*> kIntegers = {"subframe_id_a", "subframe_id_b", "utime_a_us", "utime_b_us"};
+  const std::vector<const char*> kNumbers = {"dx_m", "dy_m", "dz_m", "dheading_rad"};
+  const std::vector<const char*> kCovariance = {"cov_xx_m2", "cov_xy_m2", "cov_yy_m2"};
+  std::vector<std::string> required(kIntegers.begin(), kIntegers.end());
+  required.insert(required.end(), kNumbers.begin(), kNumbers.end());
   CsvTable table;
   if (!readCsvTable(path, required,
                     "the loop_closures.csv of sss-process: subframe_id_a,subframe_id_b,utime_a_us,utime_b_us,round,"
@@ -44,53 +45,33 @@ bool readClosureCsv(const std::string& path, std::vector<ClosureRecord>& closure
                     table, error)) {
     return false;
   }
+  const bool has_covariance = table.has("cov_xx_m2") && table.has("cov_xy_m2") && table.has("cov_yy_m2");
   closures.clear();
   for (const CsvRow& row : table.rows) {
     ClosureRecord record;
     record.line = row.line;
     int64_t integers[4];
-    for (int k = 0; k < 4; ++k) {
-      const std::string& field = table.field(row, kIntegers[k]);
-      if (!parseInteger64(field, integers[k])) {
-        error = table.where(row) + kIntegers[k] + " '" + field + "' is not an integer";
-        return false;
-      }
-    }
+    double numbers[4];
+    if (!parseIntegerColumns(table, row, kIntegers, integers, error) ||
+        !parseNumberColumns(table, row, kNumbers, numbers, error))
+      return false;
     record.subframe_id_a = integers[0];
     record.subframe_id_b = integers[1];
     record.utime_a_us = integers[2];
     record.utime_b_us = integers[3];
-    double numbers[4];
-    for (int k = 0; k < 4; ++k) {
-      const std::string& field = table.field(row, kNumbers[k]);
-      if (!parseFiniteDouble(field, numbers[k])) {
-        error = table.where(row) + kNumbers[k] + " '" + field + "' is not a finite number";
-        return false;
-      }
-    }
     record.translation_m = Eigen::Vector3d(numbers[0], numbers[1], numbers[2]);
     record.heading_rad = numbers[3];
     if (table.has("round")) {
       int64_t round = 0;
-      if (!parseInteger64(table.field(row, "round"), round)) {
-        error = table.where(row) + "round '" + table.field(row, "round") + "' is not an integer";
-        return false;
-      }
+      if (!parseIntegerColumns(table, row, {"round"}, &round, error)) return false;
       record.round = static_cast<int>(round);
     }
     record.status = table.has("status") ? table.field(row, "status") : "unknown";
     if (record.status.empty()) record.status = "unknown";
     if (table.has("rejection")) record.rejection = table.field(row, "rejection");
-    if (table.has("cov_xx_m2") && table.has("cov_xy_m2") && table.has("cov_yy_m2")) {
-      static const char* kCovariance[] = {"cov_xx_m2", "cov_xy_m2", "cov_yy_m2"};
+    if (has_covariance) {
       double c[3];
-      for (int k = 0; k < 3; ++k) {
-        const std::string& field = table.field(row, kCovariance[k]);
-        if (!parseFiniteDouble(field, c[k])) {
-          error = table.where(row) + kCovariance[k] + " '" + field + "' is not a finite number";
-          return false;
-        }
-      }
+      if (!parseNumberColumns(table, row, kCovariance, c, error)) return false;
       record.horizontal_covariance_m2 << c[0], c[1], c[1], c[2];
       record.has_covariance = true;
     }

@@ -81,11 +81,35 @@ bool forEachCsvRow(const std::string& path, const std::vector<std::string>& requ
   return true;
 }
 
+bool parseNumberColumns(const CsvTable& table, const CsvRow& row, const std::vector<const char*>& names,
+                        double* values, std::string& error) {
+  for (size_t k = 0; k < names.size(); ++k) {
+    const std::string& field = table.field(row, names[k]);
+    if (!parseFiniteDouble(field, values[k])) {
+      error = table.where(row) + names[k] + " '" + field + "' is not a finite number";
+      return false;
+    }
+  }
+  return true;
+}
+
+bool parseIntegerColumns(const CsvTable& table, const CsvRow& row, const std::vector<const char*>& names,
+                         int64_t* values, std::string& error) {
+  for (size_t k = 0; k < names.size(); ++k) {
+    const std::string& field = table.field(row, names[k]);
+    if (!parseInteger64(field, values[k])) {
+      error = table.where(row) + names[k] + " '" + field + "' is not an integer";
+      return false;
+    }
+  }
+  return true;
+}
+
 bool readCsvTable(const std::string& path, const std::vector<std::string>& required, const std::string& expected,
                   CsvTable& table, std::string& error) {
   std::vector<CsvRow> rows;
-  const bool ok = forEachCsvRow(path, required, expected, table, [&](const CsvTable&, const CsvRow& row, std::string&) {
-    rows.push_back(row);
+  const bool ok = forEachCsvRow(path, required, expected, table, [&](const CsvTable&, CsvRow& row, std::string&) {
+    rows.push_back(std::move(row));
     return true;
   }, error);
   table.rows = std::move(rows);

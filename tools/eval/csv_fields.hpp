@@ -35,6 +35,13 @@ struct CsvTable {
   std::string where(const CsvRow& row) const { return path + ":" + std::to_string(row.line) + ": "; }
 };
 
+// The named fields of a row as numbers / integers, in the order of `names`; false with
+// "PATH:LINE: NAME 'TEXT' is not a finite number" (or "an integer") for the first that is not.
+bool parseNumberColumns(const CsvTable& table, const CsvRow& row, const std::vector<const char*>& names,
+                        double* values, std::string& error);
+bool parseIntegerColumns(const CsvTable& table, const CsvRow& row, const std::vector<const char*>& names,
+                         int64_t* values, std::string& error);
+
 // Reads path: '#' and blank lines skipped, the first other line is the header, every row must have
 // as many fields as the header. False with "PATH[:LINE]: ..." on a missing file, a missing
 // required column or header, or a row of another length; `expected` (e.g. "a,b,...") is quoted
@@ -43,8 +50,9 @@ bool readCsvTable(const std::string& path, const std::vector<std::string>& requi
                   CsvTable& table, std::string& error);
 
 // The same reading, row by row, for files too large to hold as text (matches.csv): `table` has the
-// header and no rows; each row goes to on_row, which returns false with an error to stop.
-using CsvRowHandler = std::function<bool(const CsvTable& table, const CsvRow& row, std::string& error)>;
+// header and no rows; each row goes to on_row (which may move it away), which returns false with an
+// error to stop.
+using CsvRowHandler = std::function<bool(const CsvTable& table, CsvRow& row, std::string& error)>;
 bool forEachCsvRow(const std::string& path, const std::vector<std::string>& required, const std::string& expected,
                    CsvTable& table, const CsvRowHandler& on_row, std::string& error);
 

@@ -46,7 +46,6 @@ MatchEvaluation& MatchEvaluation::operator+=(const MatchEvaluation& other) {
   matchable += other.matchable;
   error_sum_px += other.error_sum_px;
   error_sum_m += other.error_sum_m;
-  mean_error_px = meanErrorPx();
   return *this;
 }
 
@@ -71,7 +70,6 @@ MatchEvaluation evaluateMatches(const sss::sim::Mission& mission, const sss::sub
                                 b.geometry.signedGroundRangeM(pixel->y()) - b.geometry.signedGroundRangeM(m.col_b));
     if (error <= 2.0) ++e.within_2px;
   }
-  e.mean_error_px = e.meanErrorPx();
   long sampled = 0;
   for (const auto& [r, c] : probes) {
     const auto point = truth.seabedPoint(a, r, c);

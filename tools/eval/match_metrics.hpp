@@ -47,7 +47,6 @@ struct MatchEvaluation {
   long matchable = 0;      // probes whose true B pixel is valid with a full patch, times recall_step^2
   double error_sum_px = 0.0;
   double error_sum_m = 0.0;
-  double mean_error_px = 0.0;  // error_sum_px / evaluated, kept up to date
   double withinFraction() const { return evaluated ? double(within_2px) / evaluated : 0.0; }
   double recall() const { return matchable ? double(within_2px) / matchable : 0.0; }
   double meanErrorPx() const { return evaluated ? error_sum_px / evaluated : 0.0; }

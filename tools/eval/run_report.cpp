@@ -795,7 +795,7 @@ bool writeText(const std::string& path, const std::string& text, std::string& er
 // ---- loop closures and summary -----------------------------------------------------------
 
 bool readLoopClosures(const std::string& path, std::vector<LoopClosureRecord>& closures, std::string& error) {
-  static const char* kCentres[] = {"north_a_m", "east_a_m", "north_b_m", "east_b_m"};
+  const std::vector<const char*> kCentres = {"north_a_m", "east_a_m", "north_b_m", "east_b_m"};
   CsvTable table;
   if (!readCsvTable(path, {"status", kCentres[0], kCentres[1], kCentres[2], kCentres[3]},
                     "subframe_id_a,subframe_id_b,...,status,...,north_a_m,east_a_m,north_b_m,east_b_m", table, error)) {
@@ -813,13 +813,7 @@ bool readLoopClosures(const std::string& path, std::vector<LoopClosureRecord>& c
     }
     if (table.has("rejection")) record.rejection = table.field(row, "rejection");
     double values[4];
-    for (int k = 0; k < 4; ++k) {
-      const std::string& field = table.field(row, kCentres[k]);
-      if (!parseFiniteDouble(field, values[k])) {
-        error = table.where(row) + kCentres[k] + " '" + field + "' is not a finite number";
-        return false;
-      }
-    }
+    if (!parseNumberColumns(table, row, kCentres, values, error)) return false;
     record.centre_a_north_east_m = Eigen::Vector2d(values[0], values[1]);
     record.centre_b_north_east_m = Eigen::Vector2d(values[2], values[3]);
     closures.push_back(std::move(record));
