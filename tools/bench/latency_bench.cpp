@@ -5,8 +5,14 @@
 // quiet) and "loaded" (subframes of realistic size and closures keep arriving, so the worker
 // thread solves while nav flows). Prints p50/p95/p99/max per phase and a JSON summary last.
 //   sss-bench-latency [--samples 5000] [--rate-hz 200] [--dds-rate-hz 10] [--update-period-s 0.2]
-//                     [--no-load] [--optimiser PATH] [--keep]
+//                     [--no-load] [--realtime] [--optimiser PATH] [--keep]
+// --realtime measures the deployed scheduling (systemd/): the optimiser's loop SCHED_FIFO 10 with
+// its other threads ordinary (reset on fork), the nav publisher and the DDS reader SCHED_FIFO 20
+// as the INS bridge and a navigation computer would run them; the subframe/closure feeder, which
+// stands for the matcher, stays ordinary. Needs CAP_SYS_NICE.
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // lcm-gen decode() false positive at -O3
+#include <pthread.h>
+#include <sched.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -16,7 +22,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -67,11 +75,13 @@ constexpr double kSpeedMS = 2.0;
 void usage() {
   std::fprintf(stderr,
                "usage: sss-bench-latency [--samples N] [--rate-hz HZ] [--dds-rate-hz HZ] [--update-period-s S]\n"
-               "                         [--bins-per-side N] [--no-load] [--optimiser PATH] [--keep]\n"
+               "                         [--bins-per-side N] [--no-load] [--realtime] [--optimiser PATH] [--keep]\n"
                "Runs sss-optimiser on a private LCM port and loopback DDS domain, publishes N (default 5000)\n"
                "SSS_NAV at HZ (default 200) and times SSS_POSE and the DDS correction; first with a solved,\n"
                "quiet graph, then (unless --no-load) while subframes of 2 x N bins (default 1250) and closures\n"
-               "arrive and the graph is solved every S s (default 0.2). Last line: JSON summary.\n");
+               "arrive and the graph is solved every S s (default 0.2). --realtime: the deployed scheduling\n"
+               "(optimiser loop SCHED_FIFO 10, nav publisher and DDS reader SCHED_FIFO 20; needs CAP_SYS_NICE).\n"
+               "Last line: JSON summary.\n");
 }
 
 double percentile(std::vector<double> values, double percent) {
@@ -269,7 +279,7 @@ int main(int argc, char** argv) {
   int samples = 5000;
   double rate_hz = 200.0, dds_rate_hz = 10.0, update_period_s = 0.2;
   int bins_per_side = 1250;
-  bool load = true, keep = false;
+  bool load = true, keep = false, realtime = false;
   std::string optimiser_path = SSS_OPTIMISER_PATH;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -286,6 +296,7 @@ int main(int argc, char** argv) {
     else if (arg == "--update-period-s") update_period_s = std::atof(next());
     else if (arg == "--bins-per-side") bins_per_side = std::atoi(next());
     else if (arg == "--no-load") load = false;
+    else if (arg == "--realtime") realtime = true;
     else if (arg == "--optimiser") optimiser_path = next();
     else if (arg == "--keep") keep = true;
     else {
@@ -297,6 +308,18 @@ int main(int argc, char** argv) {
       !(update_period_s >= 0.0) || bins_per_side < 1) {
     usage();
     return 2;
+  }
+
+  // The publisher thread first, before any thread is started, so the DDS reader's threads (ours and
+  // Cyclone's) inherit it.
+  if (realtime) {
+    sched_param priority{};
+    priority.sched_priority = 20;
+    if (sched_setscheduler(0, SCHED_FIFO, &priority) != 0) {
+      std::fprintf(stderr, "sss-bench-latency: --realtime: SCHED_FIFO refused (%s); run as root or with CAP_SYS_NICE\n",
+                   std::strerror(errno));
+      return 2;
+    }
   }
 
   // ---- private bus, domain and state directory ------------------------------------------------------
@@ -396,7 +419,11 @@ int main(int argc, char** argv) {
     return code;
   };
 
-  child = sss::test::spawnProcess({optimiser_path, "--config", config});
+  // As systemd starts it (sss-optimiser.service): the loop SCHED_FIFO 10, every thread it starts
+  // (solver, Cyclone's) ordinary.
+  child = realtime ? sss::test::spawnProcess({"/usr/bin/chrt", "--fifo", "--reset-on-fork", "10", optimiser_path,
+                                              "--config", config})
+                   : sss::test::spawnProcess({optimiser_path, "--config", config});
   if (child <= 0 || !waitFor([&] { return status_messages > 0; }, 15.0)) {
     std::fprintf(stderr, "sss-bench-latency: %s did not start (no SSS_STATUS)\n", optimiser_path.c_str());
     return cleanup(1);
@@ -460,6 +487,10 @@ int main(int argc, char** argv) {
     std::thread feeder;
     if (with_load) {
       feeder = std::thread([&] {
+        if (realtime) {  // the matcher's stand-in: ordinary scheduling
+          sched_param ordinary{};
+          pthread_setschedparam(pthread_self(), SCHED_OTHER, &ordinary);
+        }
         const size_t first = next_node, count = mission.nodes.size() - first;
         for (size_t i = 0; i < count; ++i) {
           const int64_t due = start + static_cast<int64_t>(i) * duration_us / static_cast<int64_t>(count);
@@ -536,7 +567,8 @@ int main(int argc, char** argv) {
     report("loaded", loaded);
   }
   const double load_after = loadAverage();
-  std::printf("host load average (1 min, %ld cores): %.2f before, %.2f after\n", sysconf(_SC_NPROCESSORS_ONLN),
+  std::printf("scheduling: %s; host load average (1 min, %ld cores): %.2f before, %.2f after\n",
+              realtime ? "SCHED_FIFO as deployed (--realtime)" : "normal", sysconf(_SC_NPROCESSORS_ONLN),
               load_before, load_after);
   std::printf("LCM: the time from publishing SSS_NAV to receiving its SSS_POSE (decode, correction, encode, two\n"
               "  udpm hops). DDS: the optimiser writes the corrected pose of a nav sample as it answers it, at most\n"
@@ -570,7 +602,7 @@ int main(int argc, char** argv) {
               "\"loaded_lcm_p50_ms\":%s,\"loaded_lcm_p99_ms\":%s,\"loaded_lcm_max_ms\":%s,"
               "\"loaded_dds_p50_ms\":%s,\"loaded_dds_p99_ms\":%s,\"loaded_dds_write_to_read_p99_ms\":%s,"
               "\"loaded_updates\":%.0f,\"samples\":%d,\"rate_hz\":%.1f,\"dds_rate_hz\":%.1f,\"dds_samples\":%zu,"
-              "\"missing\":%d,\"load_average\":%.2f}\n",
+              "\"missing\":%d,\"load_average\":%.2f,\"scheduling\":\"%s\"}\n",
               num(idle.lcm_ms.p50).c_str(), num(idle.lcm_ms.p95).c_str(), num(idle.lcm_ms.p99).c_str(),
               num(idle.lcm_ms.max).c_str(), num(idle.dds_nav_ms.p50).c_str(), num(idle.dds_nav_ms.p95).c_str(),
               num(idle.dds_nav_ms.p99).c_str(), num(idle.dds_nav_ms.max).c_str(), num(idle.dds_write_ms.p50).c_str(),
@@ -579,6 +611,6 @@ int main(int argc, char** argv) {
               num(load ? loaded.dds_nav_ms.p50 : NAN).c_str(), num(load ? loaded.dds_nav_ms.p99 : NAN).c_str(),
               num(load ? loaded.dds_write_ms.p99 : NAN).c_str(), load ? loaded.updates : 0.0, samples, rate_hz,
               dds_rate_hz, idle.dds_samples, idle.missing_poses + loaded.missing_poses,
-              std::max(load_before, load_after));
+              std::max(load_before, load_after), realtime ? "fifo" : "normal");
   return idle.missing_poses + loaded.missing_poses > 0 || !clean ? 1 : 0;
 }
