@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <sstream>
 
 #include "pipeline/subframe/canonical_transform.hpp"
@@ -37,6 +38,7 @@ void readPairMatcherOptions(sss::core::ConfigSection& section, PairMatcherOption
   section.optional("min_matches", options.min_matches, {atLeast(0)});
   section.optional("matching_bin_size_m", options.matching_bin_size_m, {inRange(0.0, 10.0)});
   section.optional("smoothing_sigma_px", options.smoothing_sigma_px, {inRange(0.0, 20.0)});
+  section.optional("rectify_sigma_px", options.rectify_sigma_px, {inRange(0.0, 100.0)});
   section.optional("covariance_scale", options.covariance_scale, {inRange(1e-3, 1e6)});
   section.optional("min_translation_sigma_m", options.min_translation_sigma_m, {inRange(0.0, 100.0)});
   section.optional("min_rotation_sigma_rad", options.min_rotation_sigma_rad, {inRange(0.0, 1.0)});
@@ -54,6 +56,7 @@ std::vector<std::string> validatePairMatcherOptions(const PairMatcherOptions& o)
   if (o.min_matches < 0) problems.push_back("min_matches must be >= 0");
   if (!(o.matching_bin_size_m >= 0.0)) problems.push_back("matching_bin_size_m must be >= 0");
   if (!(o.smoothing_sigma_px >= 0.0)) problems.push_back("smoothing_sigma_px must be >= 0");
+  if (!(o.rectify_sigma_px >= 0.0)) problems.push_back("rectify_sigma_px must be >= 0");
   return problems;
 }
 
@@ -81,6 +84,56 @@ double fullResolutionColumn(const sss::subframe::SubframeGeometry& geometry, int
   const double centre = 0.5 * (decimation - 1);
   if (k < per - 0.5) return geometry.bins_per_side - per * decimation + k * decimation + centre;
   return geometry.bins_per_side + (k - per) * decimation + centre;
+}
+
+namespace {
+
+// Gaussian of the valid pixels only (normalised convolution: smoothed intensity x mask over the
+// smoothed mask).
+cv::Mat1f maskedGaussian(const GeoImage& image, double sigma_px) {
+  cv::Mat1f weight, weighted;
+  image.valid.convertTo(weight, CV_32F, 1.0 / 255.0);
+  weighted = image.intensity.mul(weight);
+  cv::GaussianBlur(weighted, weighted, cv::Size(0, 0), sigma_px, sigma_px, cv::BORDER_REPLICATE);
+  cv::GaussianBlur(weight, weight, cv::Size(0, 0), sigma_px, sigma_px, cv::BORDER_REPLICATE);
+  return weighted / cv::max(weight, 1e-6f);
+}
+
+void addTimings(MatchTimings& total, const MatchTimings& pass) {
+  total.kd_tree_s += pass.kd_tree_s;
+  total.initialisation_s += pass.initialisation_s;
+  total.patch_match_s += pass.patch_match_s;
+  total.consistency_s += pass.consistency_s;
+  total.total_s += pass.total_s;
+  total.overlapping_pixels = std::max(total.overlapping_pixels, pass.overlapping_pixels);
+}
+
+}  // namespace
+
+GeoImage rectifiedContrast(const GeoImage& image, double sigma_px) {
+  GeoImage rectified = image;
+  rectified.intensity = image.intensity.clone();
+  const cv::Mat1f local_mean = maskedGaussian(image, sigma_px);
+  for (int r = 0; r < image.intensity.rows; ++r) {
+    for (int c = 0; c < image.intensity.cols; ++c) {
+      if (image.valid(r, c)) rectified.intensity(r, c) = std::abs(image.intensity(r, c) - local_mean(r, c));
+    }
+  }
+  return rectified;
+}
+
+std::vector<Correspondence> mergeMatches(const std::vector<Correspondence>& raw,
+                                         const std::vector<Correspondence>& rectified) {
+  std::map<std::pair<float, float>, Correspondence> by_pixel_a;  // the stride lattice: exact values
+  for (const Correspondence& m : raw) by_pixel_a[{m.row_a, m.col_a}] = m;
+  for (const Correspondence& m : rectified) {
+    const auto [it, inserted] = by_pixel_a.try_emplace({m.row_a, m.col_a}, m);
+    if (!inserted && std::hypot(it->second.row_b - m.row_b, it->second.col_b - m.col_b) > 1.0f) it->second = m;
+  }
+  std::vector<Correspondence> merged;
+  merged.reserve(by_pixel_a.size());
+  for (const auto& entry : by_pixel_a) merged.push_back(entry.second);
+  return merged;
 }
 
 GeoImage toGeoImage(const sss::subframe::Subframe& subframe, const std::vector<sss::core::Pose>& T_world_body,
@@ -119,16 +172,11 @@ GeoImage toGeoImage(const sss::subframe::Subframe& subframe, const std::vector<s
     }
   }
   if (smoothing_sigma_px > 0.0) {
-    // Normalised convolution: smooth intensity * mask and the mask, divide, so masked pixels
-    // (nadir, far range) do not bleed into valid ones.
-    cv::Mat1f weight, weighted;
-    image.valid.convertTo(weight, CV_32F, 1.0 / 255.0);
-    weighted = image.intensity.mul(weight);
-    cv::GaussianBlur(weighted, weighted, cv::Size(0, 0), smoothing_sigma_px, smoothing_sigma_px, cv::BORDER_REPLICATE);
-    cv::GaussianBlur(weight, weight, cv::Size(0, 0), smoothing_sigma_px, smoothing_sigma_px, cv::BORDER_REPLICATE);
+    // Normalised convolution: masked pixels (nadir, far range) do not bleed into valid ones.
+    const cv::Mat1f smooth = maskedGaussian(image, smoothing_sigma_px);
     for (int r = 0; r < rows; ++r) {
       for (int k = 0; k < cols; ++k) {
-        if (image.valid(r, k)) image.intensity(r, k) = weighted(r, k) / std::max(weight(r, k), 1e-6f);
+        if (image.valid(r, k)) image.intensity(r, k) = smooth(r, k);
       }
     }
   }
@@ -155,6 +203,15 @@ PairMatch matchPair(const sss::subframe::Subframe& a, const std::vector<sss::cor
   const GeoImage image_b = toGeoImage(b, poses_b, result.decimation, options.smoothing_sigma_px);
   result.georeference_s = secondsSince(start);
   result.matches = dense.match(image_a, image_b, &result.dense_timings);
+  if (options.rectify_sigma_px > 0.0) {
+    MatchTimings rectified_timings;
+    const std::vector<Correspondence> rectified =
+        dense.match(rectifiedContrast(image_a, options.rectify_sigma_px),
+                    rectifiedContrast(image_b, options.rectify_sigma_px), &rectified_timings);
+    addTimings(result.dense_timings, rectified_timings);
+    result.matches = mergeMatches(result.matches, rectified);
+    result.dense_timings.matches = static_cast<long>(result.matches.size());
+  }
   for (Correspondence& m : result.matches) {
     m.col_a = static_cast<float>(fullResolutionColumn(a.geometry, result.decimation, m.col_a));
     m.col_b = static_cast<float>(fullResolutionColumn(b.geometry, result.decimation, m.col_b));

@@ -50,6 +50,19 @@ struct PairMatcherOptions {
   // pairs: ZNCC at the true match rises from ~0 (native bins) to a median of ~0.65.
   double matching_bin_size_m = 0.5;   // ~ the ping spacing at 2 m/s and 4 pings/s
   double smoothing_sigma_px = 1.5;
+  // Relief looks inverted from its two sides: a trawl mark or a boulder seen from the other line
+  // has its highlight and its shadow swapped, and matching raw intensity aligns highlight with
+  // highlight, a wall's width (1-3 px) off the true match. A second dense pass matches the
+  // rectified contrast |I - local mean| (masked Gaussian mean of this sigma, after smoothing),
+  // which a highlight-shadow pair gives alike from either side but which drops the sign that
+  // sediment texture carries. The two are merged per pixel of A: one match kept as it is, two
+  // that agree within 1 px kept as the raw one, two that disagree as the rectified one.
+  // Measured on whole simulated missions (sss-process --write-matches, sss-eval --matches),
+  // within 2 px / recall: 40 m line spacing, parallel 0.78 / 0.21 -> 0.83 / 0.29, anti-parallel
+  // 0.88 / 0.17 -> 0.88 / 0.21; default mission 0.86 / 0.30 -> 0.89 / 0.41; 3 lines + 2 cross
+  // lines, crossing 0.85 / 0.26 -> 0.86 / 0.34. Without the simulator's trawl marks raw
+  // intensity alone gave 0.89 / 0.95 within 2 px. 0: raw intensity only.
+  double rectify_sigma_px = 8.0;
   // DR uncertainty of the relative pose between two centre pings (1 sigma), from the distance d
   // travelled between them: horizontal sqrt(fixed^2 + (per_m * d)^2). A conservative INS/DVL
   // drifts 0.1-0.5 % of distance; 1 % keeps the prior weak, so the sonar decides.
@@ -91,12 +104,22 @@ double fullResolutionColumn(const sss::subframe::SubframeGeometry& geometry, int
 GeoImage toGeoImage(const sss::subframe::Subframe& subframe, const std::vector<sss::core::Pose>& T_world_body,
                     int decimation = 1, double smoothing_sigma_px = 0.0);
 
+// The image with its intensity replaced by the rectified contrast |I - masked Gaussian mean of
+// sigma_px| on valid pixels (see PairMatcherOptions::rectify_sigma_px).
+GeoImage rectifiedContrast(const GeoImage& image, double sigma_px);
+
+// Raw-intensity and rectified-contrast matches of the same pair merged per pixel of A (see
+// PairMatcherOptions::rectify_sigma_px): a pixel matched once keeps its match, twice within 1 px
+// the raw one, twice further apart the rectified one. Sorted by A's row, then column.
+std::vector<Correspondence> mergeMatches(const std::vector<Correspondence>& raw,
+                                         const std::vector<Correspondence>& rectified);
+
 struct PairMatch {
   bool accepted = false;
   std::string reason;                  // why rejected
   std::vector<Correspondence> matches; // dense matches A -> B, full-resolution columns
   int decimation = 1;                  // bins per matching pixel
-  MatchTimings dense_timings;
+  MatchTimings dense_timings;          // both dense passes (raw and rectified contrast) summed
   RelativePoseResult pose;             // T_a_b between the centre pings, covariance, inliers
   double mean_zncc = 0.0;
   double georeference_s = 0.0;
