@@ -1,13 +1,13 @@
 // sss-bench-matcher: speed and accuracy of the matcher on simulated subframe pairs. Renders a
 // lawnmower survey (lines 40 m apart: neighbours anti-parallel, every second line parallel), or
 // with --pattern cross the same followed by two crossing lines, adds 3 m along-track and 2 m
-// lateral DR error between the two subframes of each overlapping full pair, runs dense matching +
+// lateral DR error (--dr-error-m ALONG,LATERAL) between the two subframes of each overlapping full pair, runs dense matching +
 // relative pose, and checks both against the ray-cast truth. Pairs are typed by their centre
 // headings (parallel, anti-parallel, crossing). Prints a line per pair, a summary, and as its last
 // line one JSON object. --config FILE takes the matcher settings from a deployment file's matcher
 // section (as sss-matcher reads them) instead of the built-in defaults.
 //   sss-bench-matcher [--pattern lawnmower|cross] [--lines N] [--line-length-m M] [--line-spacing-m M]
-//                     [--repeat K] [--config FILE]
+//                     [--repeat K] [--config FILE] [--dr-error-m ALONG,LATERAL]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -39,6 +39,7 @@ int main(int argc, char** argv) {
   int lines = 3, repeat = 1;
   double line_length_m = 300.0, line_spacing_m = 40.0;
   std::string config_path;
+  double dr_along_m = 3.0, dr_lateral_m = 2.0;
   std::string pattern = "lawnmower";
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -52,11 +53,15 @@ int main(int argc, char** argv) {
       repeat = std::max(1, std::atoi(argv[++i]));
     } else if (arg == "--line-spacing-m" && i + 1 < argc) {
       line_spacing_m = std::atof(argv[++i]);
+    } else if (arg == "--dr-error-m" && i + 1 < argc &&
+               std::sscanf(argv[i + 1], "%lf,%lf", &dr_along_m, &dr_lateral_m) == 2 && std::isfinite(dr_along_m) &&
+               std::isfinite(dr_lateral_m) && std::hypot(dr_along_m, dr_lateral_m) <= 50.0) {
+      ++i;
     } else if (arg == "--config" && i + 1 < argc) {
       config_path = argv[++i];
     } else {
       std::fprintf(stderr, "usage: %s [--pattern lawnmower|cross] [--lines N] [--line-length-m M] [--line-spacing-m M] [--repeat K]\n"
-                   "          [--config FILE (its matcher section; default: the built-in defaults)]\n",
+                   "          [--config FILE (its matcher section; default: the built-in defaults)] [--dr-error-m ALONG,LATERAL (3,2)]\n",
                    argv[0]);
       return arg == "--help" ? 0 : 2;
     }
@@ -111,7 +116,7 @@ int main(int argc, char** argv) {
       if (area < overlap.min_overlap_fraction * std::min(footprints[i].area_m2, footprints[j].area_m2)) continue;
       const PairType type = sss::eval::classifyPair(headingOf(a), headingOf(b));
       for (int k = 0; k < repeat; ++k) {
-        const auto match = sss::matcher::matchPair(a, sss::subframe::drPoses(a), b, sss::sim::posesWithDrError(a, b, 3.0, 2.0), dense,
+        const auto match = sss::matcher::matchPair(a, sss::subframe::drPoses(a), b, sss::sim::posesWithDrError(a, b, dr_along_m, dr_lateral_m), dense,
                                                    options);
         seconds.push_back(match.seconds);
         georef.push_back(match.georeference_s);
@@ -184,10 +189,10 @@ int main(int argc, char** argv) {
               "\"crossing_pairs\": %ld, \"accepted\": %ld, "
               "\"georeference_s\": %.4f, \"kd_tree_s\": %.4f, \"initialisation_s\": %.4f, \"patch_match_s\": %.4f, "
               "\"consistency_s\": %.4f, \"relative_pose_s\": %.4f, \"along_error_p95_m\": %.4f, "
-              "\"lateral_error_p95_m\": %.4f, \"matches_per_pair\": %ld%s, \"pattern\": \"%s\", \"dr_error_m\": [3.0, 2.0]}\n",
+              "\"lateral_error_p95_m\": %.4f, \"matches_per_pair\": %ld%s, \"pattern\": \"%s\", \"dr_error_m\": [%.2f, %.2f]}\n",
               mean(seconds), percentile(seconds, 0.95), total.withinFraction(), total.recall(), total.meanErrorPx(), pairs,
               parallel_pairs, anti_pairs, crossing_pairs, accepted, mean(georef), mean(kd), mean(init), mean(patchmatch),
               mean(consistency), mean(pose), percentile(along_err, 0.95), percentile(lateral_err, 0.95),
-              total.matches / pairs, per_type_json.c_str(), pattern.c_str());
+              total.matches / pairs, per_type_json.c_str(), pattern.c_str(), dr_along_m, dr_lateral_m);
   return 0;
 }
