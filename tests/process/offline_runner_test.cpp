@@ -6,12 +6,14 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
 
+#include "tools/eval/closure_metrics.hpp"
 #include "tools/eval/heightmap_metrics.hpp"
 #include "tools/eval/match_metrics.hpp"
 #include "tools/eval/trajectory_io.hpp"
@@ -163,6 +165,49 @@ TEST_F(OfflineRunnerTest, WrittenMatchesAreEvaluatedAgainstTheTruth) {
   // A matches file against a folder without the mission is refused with a reason.
   EXPECT_FALSE(sss::eval::evaluateMatchFile(r.out_dir + "/matches.csv", r.out_dir, evaluation, error));
   EXPECT_NE(error.find("mission.yaml"), std::string::npos) << error;
+}
+
+TEST_F(OfflineRunnerTest, InjectedFalseClosuresAreAllRejectedAndSlamStillBeatsDr) {
+  // Issue 7: a share of the matched pairs get a relative pose 3-10 m and 2-10 deg wrong, with the
+  // matcher's covariance left as it was; the optimiser's defences must keep every one of them out.
+  auto r = request("false_closures");
+  r.write_mosaics = false;
+  r.false_closure_fraction = 0.3;
+  r.false_closure_seed = 1;
+  const auto result = sss::offline::runOffline(r);
+  ASSERT_TRUE(result.ok) << result.error;
+  const auto& s = result.summary;
+  ASSERT_GT(s.false_closures_injected, 0u) << "the test needs false closures to mean anything";
+  EXPECT_LT(s.false_closures_injected, s.matcher_closures);
+
+  std::vector<sss::eval::ClosureRecord> closures;
+  std::string error;
+  ASSERT_TRUE(sss::eval::readClosureCsv(r.out_dir + "/loop_closures.csv", closures, error)) << error;
+  const auto truth = sss::eval::readTum(root_ + "/mission/ground_truth.tum");
+  ASSERT_TRUE(truth.ok);
+  const auto evaluation = sss::eval::evaluateClosures(closures, truth.poses, nullptr, 1.0);
+  // The matcher's own closures are within ~0.6 m of the truth; an injected one is >= 2.4 m off.
+  size_t false_rows = 0, false_accepted = 0, true_accepted = 0;
+  for (const auto& c : evaluation.closures) {
+    ASSERT_TRUE(c.has_truth);
+    const bool is_false = std::hypot(c.closure_error.along_m, c.closure_error.lateral_m) > 2.0;
+    false_rows += is_false ? 1 : 0;
+    false_accepted += is_false && c.closure.status == "accepted" ? 1 : 0;
+    true_accepted += !is_false && c.closure.status == "accepted" ? 1 : 0;
+  }
+  std::printf("%llu of %llu closures made false: %zu rows off by > 2 m, %zu of them accepted; %zu true closures "
+              "accepted\n",
+              static_cast<unsigned long long>(s.false_closures_injected),
+              static_cast<unsigned long long>(s.matcher_closures), false_rows, false_accepted, true_accepted);
+  EXPECT_EQ(false_rows, s.false_closures_injected);
+  EXPECT_EQ(false_accepted, 0u);
+  EXPECT_GE(true_accepted, 3u);
+
+  // Measured: DR 0.57 m, SLAM 0.24 m (clean run 0.22 m): the pairs made false are lost, not harmful.
+  const double ate_dr = horizontalAte(r.out_dir + "/dead_reckoning.tum");
+  const double ate_slam = horizontalAte(r.out_dir + "/slam.tum");
+  std::printf("with false closures: horizontal ATE RMSE DR %.3f m, SLAM %.3f m\n", ate_dr, ate_slam);
+  EXPECT_LT(ate_slam, 0.67 * ate_dr);
 }
 
 TEST_F(OfflineRunnerTest, EmbeddedNavigationOfTheSonarFileIsUsedWithoutAnInsFile) {

@@ -17,6 +17,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <random>
 #include <vector>
 
 #include "drivers/edgetech/ping_message.hpp"
@@ -326,6 +327,7 @@ bool writeSummaryJson(const std::string& path, const OfflineRequest& request, co
       {"nav_samples", s.nav_samples},         {"pings", s.pings},
       {"pings_with_pose", s.pings_with_pose}, {"subframes", s.subframes},
       {"pairs_attempted", s.pairs_attempted}, {"matcher_closures", s.matcher_closures},
+      {"false_closures_injected", s.false_closures_injected},
       {"closures_accepted", s.closures_accepted}, {"closures_rejected", s.closures_rejected},
       {"closures_superseded", s.closures_superseded}, {"seabed_points", s.seabed_points},
       {"input_faults", s.input_faults}};
@@ -479,9 +481,28 @@ class Runner {
       ++summary_.pairs_attempted;
       if (!outcome.accepted) continue;
       ++summary_.matcher_closures;
-      added = optimiser_.addLoopClosure(outcome.closure).ok || added;
+      sss::matcher::LoopClosure closure = outcome.closure;
+      if (injectFalseClosure(closure)) ++summary_.false_closures_injected;
+      added = optimiser_.addLoopClosure(closure).ok || added;
     }
     return added;
+  }
+
+  // --inject-false-closures (OfflineRequest::false_closure_fraction): the draw depends only on the
+  // pair and the seed, so every association round of a chosen pair gets the same wrong pose.
+  bool injectFalseClosure(sss::matcher::LoopClosure& closure) const {
+    if (!(request_.false_closure_fraction > 0.0)) return false;
+    std::mt19937_64 random(request_.false_closure_seed * 0x9E3779B97F4A7C15ULL ^
+                           static_cast<uint64_t>(closure.subframe_id_a) * 0x100000001B3ULL ^
+                           static_cast<uint64_t>(closure.subframe_id_b));
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    if (uniform(random) >= request_.false_closure_fraction) return false;
+    const double distance_m = 3.0 + 7.0 * uniform(random);
+    const double direction_rad = 2.0 * M_PI * uniform(random);
+    const double heading_rad = (2.0 + 8.0 * uniform(random)) * M_PI / 180.0 * (uniform(random) < 0.5 ? -1.0 : 1.0);
+    closure.T_a_b.translation += Eigen::Vector3d(distance_m * std::cos(direction_rad), distance_m * std::sin(direction_rad), 0.0);
+    closure.T_a_b.rotation = Eigen::Quaterniond(Eigen::AngleAxisd(heading_rad, Eigen::Vector3d::UnitZ())) * closure.T_a_b.rotation;
+    return true;
   }
 
   void update() {

@@ -29,6 +29,12 @@ struct OfflineRequest {
   // Also write out_dir/matches.csv: every dense match, subframe row and recall probe of every pair the
   // matcher tried (for sss-eval --matches; format in match_writer.hpp).
   bool write_matches = false;
+  // Evaluation of the optimiser's defences (issue 7): this fraction of the matched pairs, drawn
+  // with false_closure_seed, get a wrong relative pose (3-10 m and 2-10 deg off, the same for
+  // every association round of the pair) with the matcher's covariance and costs left as they
+  // were, as a matcher fooled by repetitive seabed would send. 0: the closures as matched.
+  double false_closure_fraction = 0.0;
+  uint64_t false_closure_seed = 1;
   std::FILE* progress = nullptr;  // progress lines every progress_period_s of wall time; null: quiet
   double progress_period_s = 2.0;
 };
@@ -40,6 +46,7 @@ struct OfflineSummary {
   uint64_t subframes = 0;
   uint64_t pairs_attempted = 0;
   uint64_t matcher_closures = 0;   // closures the matcher produced (all rounds)
+  uint64_t false_closures_injected = 0;  // of those, made wrong on purpose (false_closure_fraction)
   uint64_t closures_accepted = 0;  // by the optimiser, after full smoothing
   uint64_t closures_rejected = 0;
   uint64_t closures_superseded = 0;

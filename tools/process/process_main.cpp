@@ -3,6 +3,7 @@
 //   sss-process --lcm-log FILE [--config FILE] --out DIR
 // Without --ins the navigation in the sonar file's ping headers is used. Exit 0 ok, 2 bad input.
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <string>
 
@@ -12,12 +13,15 @@ namespace {
 void usage(std::FILE* out) {
   std::fprintf(out,
                "usage: sss-process --sonar FILE.jsf|FILE.xtf [--ins FILE.nmea] [--config FILE] --out DIR [--quiet]\n"
-               "                   [--write-matches]\n"
+               "                   [--write-matches] [--inject-false-closures FRACTION [--inject-seed N]]\n"
                "       sss-process --lcm-log FILE [--ping-channel C] [--nav-channel C] [--config FILE] --out DIR\n"
                "                   [--no-mosaics] [--quiet]\n"
                "  --record-lcm-log FILE  also write the SSS_PING and SSS_NAV messages fed to the chain to an LCM log\n"
                "  --write-matches        also write matches.csv: every dense match, subframe row and recall probe of\n"
                "                         every pair the matcher tried (for sss-eval --matches FILE --mission DIR)\n"
+               "  --inject-false-closures FRACTION  evaluation: that fraction of the matched pairs (drawn with\n"
+               "                         --inject-seed, default 1) get a relative pose 3-10 m and 2-10 deg wrong\n"
+               "                         before the optimiser (summary.json: false_closures_injected)\n"
                "Writes to DIR: dead_reckoning.tum, slam.tum (every ping, TUM, local NED of the mission origin),\n"
                "loop_closures.csv, bathymetry.ply (+ bathymetry_dr.ply), heightmap.yaml/.png (+ heightmap_dr),\n"
                "mosaic_dr.png, mosaic_slam.png (+ .yaml geo-references) and summary.json.\n");
@@ -45,6 +49,19 @@ int main(int argc, char** argv) {
     else if (arg == "--record-lcm-log") ok = value(request.record_lcm_log_path);
     else if (arg == "--no-mosaics") request.write_mosaics = false;
     else if (arg == "--write-matches") request.write_matches = true;
+    else if (arg == "--inject-false-closures" || arg == "--inject-seed") {
+      std::string text;
+      char* end = nullptr;
+      ok = value(text);
+      if (ok && arg == "--inject-false-closures") {
+        request.false_closure_fraction = std::strtod(text.c_str(), &end);
+        ok = end != text.c_str() && *end == '\0' && request.false_closure_fraction >= 0.0 &&
+             request.false_closure_fraction <= 1.0;
+      } else if (ok) {
+        request.false_closure_seed = std::strtoull(text.c_str(), &end, 10);
+        ok = end != text.c_str() && *end == '\0' && text[0] != '-';
+      }
+    }
     else if (arg == "--quiet") request.progress = nullptr;
     else if (arg == "--help" || arg == "-h") {
       usage(stdout);
@@ -64,6 +81,9 @@ int main(int argc, char** argv) {
     return result.exit_code;
   }
   const auto& s = result.summary;
+  if (s.false_closures_injected > 0)
+    std::printf("sss-process: %llu of the matcher's closures made false on purpose (--inject-false-closures)\n",
+                static_cast<unsigned long long>(s.false_closures_injected));
   std::printf("sss-process: %llu pings, %llu subframes, %llu pairs, %llu closures (%llu accepted, %llu rejected), "
               "%llu seabed points; mission %.0f s in %.1f s (%.1fx real time), peak %.0f MiB -> %s\n",
               static_cast<unsigned long long>(s.pings), static_cast<unsigned long long>(s.subframes),
