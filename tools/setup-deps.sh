@@ -12,7 +12,7 @@ PACKAGES=(
   # middleware: LCM (lcm-gen, lcm-logger, lcm-logplayer) and Cyclone DDS (idlc)
   liblcm-dev liblcm-bin libglib2.0-dev cyclonedds-dev cyclonedds-tools
   # configuration, logging, service integration
-  libyaml-cpp-dev libspdlog-dev libfmt-dev libsystemd-dev systemd
+  libyaml-cpp-dev libspdlog-dev libfmt-dev libsystemd-dev systemd nlohmann-json3-dev
   # tests, benchmarks, fuzzing (clang's libFuzzer runtime)
   libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
   # tools: python for the report and plotting scripts

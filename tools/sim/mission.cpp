@@ -38,6 +38,7 @@ sss::core::ConfigSection subsection(sss::core::ConfigSection& parent, const std:
 
 void readSimOptions(sss::core::ConfigSection section, SimOptions& o) {
   section.optional("seed", o.seed, {atLeast<int64_t>(0)});
+  section.optional("family", o.family);
   section.optional("origin_latitude_deg", o.origin_latitude_deg, {inRange(-89.0, 89.0)});
   section.optional("origin_longitude_deg", o.origin_longitude_deg, {inRange(-180.0, 180.0)});
   section.optional("start_utime_us", o.start_utime_us, {inRange<int64_t>(946684800000000, 4102444800000000)});
@@ -68,6 +69,14 @@ void readSimOptions(sss::core::ConfigSection section, SimOptions& o) {
   seabed.optional("boulder_min_radius_m", s.boulder_min_radius_m, {inRange(0.05, 20.0)});
   seabed.optional("boulder_max_radius_m", s.boulder_max_radius_m, {inRange(0.05, 20.0)});
   seabed.optional("sediment_patch_scale_m", s.sediment_patch_scale_m, {inRange(1.0, 1000.0)});
+  seabed.optional("reflectivity_scale", s.reflectivity_scale, {inRange(0.05, 5.0)});
+  seabed.optional("patch_contrast", s.patch_contrast, {inRange(0.0, 3.0)});
+  seabed.optional("texture_contrast", s.texture_contrast, {inRange(0.0, 1.0)});
+  seabed.optional("megaripple_amplitude_m", s.megaripple_amplitude_m, {inRange(0.0, 2.0)});
+  seabed.optional("megaripple_wavelength_m", s.megaripple_wavelength_m, {inRange(1.0, 50.0)});
+  seabed.optional("outcrop_fraction", s.outcrop_fraction, {inRange(0.0, 1.0)});
+  seabed.optional("outcrop_relief_m", s.outcrop_relief_m, {inRange(0.0, 10.0)});
+  seabed.optional("outcrop_scale_m", s.outcrop_scale_m, {inRange(5.0, 1000.0)});
   seabed.optional("enable_texture", s.enable_texture);
   seabed.rejectUnknownKeys();
 
@@ -89,6 +98,8 @@ void readSimOptions(sss::core::ConfigSection section, SimOptions& o) {
   vehicle.optional("yaw_amplitude_rad", t.yaw_amplitude_rad, {inRange(0.0, 0.5)});
   vehicle.optional("yaw_period_s", t.yaw_period_s, {greaterThan(0.0)});
   vehicle.optional("altitude_wobble_m", t.altitude_wobble_m, {inRange(0.0, 10.0)});
+  vehicle.optional("altitude_variation_m", t.altitude_variation_m, {inRange(0.0, 50.0)});
+  vehicle.optional("altitude_variation_length_m", t.altitude_variation_length_m, {inRange(10.0, 10000.0)});
   vehicle.optional("max_turn_bank_rad", t.max_turn_bank_rad, {inRange(0.0, 0.5)});
   vehicle.rejectUnknownKeys();
 
@@ -126,6 +137,13 @@ void readSimOptions(sss::core::ConfigSection section, SimOptions& o) {
   sonar.optional("absorption_db_per_km", n.absorption_db_per_km, {inRange(0.0, 1000.0)});
   sonar.optional("noise_intensity_at_max_range", n.noise_intensity_at_max_range, {inRange(0.0, 10.0)});
   sonar.optional("tvg_spreading_db_per_decade", n.tvg_spreading_db_per_decade, {inRange(0.0, 40.0)});
+  sonar.optional("tvg_absorption_db_per_km", n.tvg_absorption_db_per_km, {inRange(-1.0, 1000.0)});
+  sonar.optional("speckle_shape", n.speckle_shape, {inRange(0.0, 1000.0)});
+  sonar.optional("speckle_looks", n.speckle_looks, {inRange(1.0, 100.0)});
+  sonar.optional("gain_step_interval_s", n.gain_step_interval_s, {inRange(0.0, 1e6)});
+  sonar.optional("gain_step_sigma_db", n.gain_step_sigma_db, {inRange(0.0, 20.0)});
+  sonar.optional("jsf_subsystem", n.jsf_subsystem, {inRange(-1, 255)});
+  sonar.optional("volume_backscatter", n.volume_backscatter, {inRange(0.0, 10.0)});
   sonar.optional("ground_step_m", n.ground_step_m, {inRange(0.005, 1.0)});
   sonar.optional("output_scale", n.output_scale, {greaterThan(0.0)});
   sonar.rejectUnknownKeys();
@@ -174,6 +192,7 @@ std::string simOptionsYaml(const SimOptions& o) {
   out.SetDoublePrecision(10);
   out << YAML::BeginMap;
   out << YAML::Key << "seed" << YAML::Value << o.seed;
+  out << YAML::Key << "family" << YAML::Value << o.family;
   out << YAML::Key << "origin_latitude_deg" << YAML::Value << o.origin_latitude_deg;
   out << YAML::Key << "origin_longitude_deg" << YAML::Value << o.origin_longitude_deg;
   out << YAML::Key << "start_utime_us" << YAML::Value << o.start_utime_us;
@@ -196,7 +215,12 @@ std::string simOptionsYaml(const SimOptions& o) {
       << YAML::Key << "boulders_per_hectare" << YAML::Value << s.boulders_per_hectare << YAML::Key << "boulder_min_radius_m"
       << YAML::Value << s.boulder_min_radius_m << YAML::Key << "boulder_max_radius_m" << YAML::Value << s.boulder_max_radius_m
       << YAML::Key << "sediment_patch_scale_m" << YAML::Value << s.sediment_patch_scale_m << YAML::Key << "enable_texture"
-      << YAML::Value << s.enable_texture;
+      << YAML::Value << s.enable_texture << YAML::Key << "reflectivity_scale" << YAML::Value << s.reflectivity_scale
+      << YAML::Key << "patch_contrast" << YAML::Value << s.patch_contrast << YAML::Key << "texture_contrast" << YAML::Value
+      << s.texture_contrast << YAML::Key << "megaripple_amplitude_m" << YAML::Value << s.megaripple_amplitude_m << YAML::Key
+      << "megaripple_wavelength_m" << YAML::Value << s.megaripple_wavelength_m << YAML::Key << "outcrop_fraction"
+      << YAML::Value << s.outcrop_fraction << YAML::Key << "outcrop_relief_m" << YAML::Value << s.outcrop_relief_m
+      << YAML::Key << "outcrop_scale_m" << YAML::Value << s.outcrop_scale_m;
   out << YAML::EndMap;
   const TrajectoryOptions& t = o.trajectory;
   out << YAML::Key << "vehicle" << YAML::Value << YAML::BeginMap;
@@ -210,7 +234,9 @@ std::string simOptionsYaml(const SimOptions& o) {
       << "pitch_amplitude_rad" << YAML::Value << t.pitch_amplitude_rad << YAML::Key << "pitch_period_s" << YAML::Value
       << t.pitch_period_s << YAML::Key << "yaw_amplitude_rad" << YAML::Value << t.yaw_amplitude_rad << YAML::Key
       << "yaw_period_s" << YAML::Value << t.yaw_period_s << YAML::Key << "altitude_wobble_m" << YAML::Value
-      << t.altitude_wobble_m << YAML::Key << "max_turn_bank_rad" << YAML::Value << t.max_turn_bank_rad;
+      << t.altitude_wobble_m << YAML::Key << "max_turn_bank_rad" << YAML::Value << t.max_turn_bank_rad << YAML::Key
+      << "altitude_variation_m" << YAML::Value << t.altitude_variation_m << YAML::Key << "altitude_variation_length_m"
+      << YAML::Value << t.altitude_variation_length_m;
   out << YAML::EndMap;
   const DeadReckoningOptions& d = o.dead_reckoning;
   out << YAML::Key << "dead_reckoning" << YAML::Value << YAML::BeginMap;
@@ -238,7 +264,11 @@ std::string simOptionsYaml(const SimOptions& o) {
       << n.sidelobe_level << YAML::Key << "absorption_db_per_km" << YAML::Value << n.absorption_db_per_km << YAML::Key
       << "noise_intensity_at_max_range" << YAML::Value << n.noise_intensity_at_max_range << YAML::Key
       << "tvg_spreading_db_per_decade" << YAML::Value << n.tvg_spreading_db_per_decade << YAML::Key << "ground_step_m"
-      << YAML::Value << n.ground_step_m << YAML::Key << "output_scale" << YAML::Value << n.output_scale;
+      << YAML::Value << n.ground_step_m << YAML::Key << "output_scale" << YAML::Value << n.output_scale << YAML::Key
+      << "tvg_absorption_db_per_km" << YAML::Value << n.tvg_absorption_db_per_km << YAML::Key << "speckle_shape"
+      << YAML::Value << n.speckle_shape << YAML::Key << "speckle_looks" << YAML::Value << n.speckle_looks << YAML::Key << "gain_step_interval_s" << YAML::Value << n.gain_step_interval_s
+      << YAML::Key << "gain_step_sigma_db" << YAML::Value << n.gain_step_sigma_db << YAML::Key << "jsf_subsystem"
+      << YAML::Value << n.jsf_subsystem << YAML::Key << "volume_backscatter" << YAML::Value << n.volume_backscatter;
   out << YAML::EndMap;
   out << YAML::EndMap;
   return out.c_str();
@@ -292,7 +322,9 @@ std::vector<uint8_t> Mission::encodePingJsf(size_t ping, const PingSamples& samp
   const NavSample nav = dead_reckoning_->sampleAt(pingTimeS(ping));
   const sss::core::GeodeticPosition geo = plane_.toGeodetic(nav.T_world_body.translation);
   jsf::SonarChannelRecord record;
-  record.subsystem = options_.sonar.frequency_hz < 600e3 ? jsf::kSubsystemSideScanLow : jsf::kSubsystemSideScanHigh;
+  record.subsystem = options_.sonar.jsf_subsystem >= 0 ? static_cast<uint8_t>(options_.sonar.jsf_subsystem)
+                     : options_.sonar.frequency_hz < 600e3 ? jsf::kSubsystemSideScanLow
+                                                             : jsf::kSubsystemSideScanHigh;
   record.ping_time_us = pingUtimeUs(ping);
   record.ping_number = static_cast<uint32_t>(ping);
   record.start_depth_samples = 0;

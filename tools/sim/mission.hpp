@@ -18,6 +18,7 @@ namespace sss::sim {
 
 struct SimOptions {
   int64_t seed = 1;                         // one seed for everything; modules derive their own
+  std::string family = "default";           // the seabed family drawn by --randomise (a label)
   double origin_latitude_deg = 59.35;       // mission origin = NED origin
   double origin_longitude_deg = 18.07;
   int64_t start_utime_us = 1780300800000000;  // 2026-06-01T08:00:00Z

@@ -124,9 +124,11 @@ Seabed::Seabed(const SeabedOptions& options) : options_(options) {
       // Sediment patches: mud, sand and gravel with soft boundaries.
       const double patch =
           fractalNoise2d(mixSeed(seed, 3), north / options.sediment_patch_scale_m, east / options.sediment_patch_scale_m, 4);
-      double reflect = 0.15 + 0.22 * smoothstep(-0.35, -0.2, patch) + 0.25 * smoothstep(0.25, 0.4, patch);
+      const double contrast = options.patch_contrast;
+      double reflect = options.reflectivity_scale * (0.15 + contrast * 0.22 * smoothstep(-0.35, -0.2, patch) +
+                                                     contrast * 0.25 * smoothstep(0.25, 0.4, patch));
       // Grain-scale texture from 4 m down to the grid.
-      reflect *= 1.0 + 0.3 * fractalNoise2d(mixSeed(seed, 4), north / 4.0, east / 4.0, 4);
+      reflect *= 1.0 + options.texture_contrast * fractalNoise2d(mixSeed(seed, 4), north / 4.0, east / 4.0, 4);
       // Ripple fields: where a slow noise exceeds a threshold set by the covered fraction.
       const double field = fractalNoise2d(mixSeed(seed, 5), north / 120.0, east / 120.0, 2);
       const double threshold = 0.6 - 1.2 * options.ripple_fraction;
@@ -138,7 +140,29 @@ Seabed::Seabed(const SeabedOptions& options) : options_(options) {
         const double phase = 2.0 * kPi * along / options.ripple_wavelength_m;
         // Asymmetric ripple crest: the lee side is steeper, as on a real current-formed ripple.
         depth -= ripple_weight * options.ripple_amplitude_m * (std::sin(phase) + 0.25 * std::sin(2.0 * phase));
+        if (options.megaripple_amplitude_m > 0.0) {
+          // Megaripples lie a little askew of the small ripples riding on them.
+          const double angle2 = angle + 0.3;
+          const double along2 = north * std::cos(angle2) + east * std::sin(angle2) +
+                                4.0 * valueNoise2d(mixSeed(seed, 11), north / 40.0, east / 40.0);
+          const double phase2 = 2.0 * kPi * along2 / options.megaripple_wavelength_m;
+          depth -= ripple_weight * options.megaripple_amplitude_m * (std::sin(phase2) + 0.3 * std::sin(2.0 * phase2));
+        }
         reflect *= 1.0 + 0.15 * ripple_weight;
+      }
+      if (options.outcrop_fraction > 0.0) {
+        const double field_rock =
+            fractalNoise2d(mixSeed(seed, 8), north / options.outcrop_scale_m, east / options.outcrop_scale_m, 3);
+        const double rock_threshold = 0.6 - 1.2 * options.outcrop_fraction;
+        const double rock = smoothstep(rock_threshold, rock_threshold + 0.08, field_rock);
+        if (rock > 0.0) {
+          // Ridged noise (sharp crests, the bedding of a rock) plus blocky roughness.
+          const double ridged = 1.0 - std::abs(fractalNoise2d(mixSeed(seed, 9), north / 7.0, east / 7.0, 4));
+          const double rough = fractalNoise2d(mixSeed(seed, 10), north / 1.5, east / 1.5, 3);
+          depth -= rock * options.outcrop_relief_m * (0.7 * ridged * ridged + 0.3 * (0.5 + 0.5 * rough));
+          const double rock_reflect = 0.8 * (1.0 + 0.4 * rough);
+          reflect = (1.0 - rock) * reflect + rock * rock_reflect;
+        }
       }
       for (const TrawlMark& mark : marks) {
         const Eigen::Vector2d offset(north - mark.start.x(), east - mark.start.y());

@@ -42,6 +42,20 @@ struct SeabedOptions {
   double boulder_min_radius_m = 0.3;
   double boulder_max_radius_m = 1.5;
   double sediment_patch_scale_m = 40.0;    // size of mud/sand/gravel patches
+  // Sediment backscatter: reflectivity = scale x (mud 0.15 + patch_contrast x (sand/gravel
+  // steps of 0.22 and 0.25)) x (1 + texture_contrast x grain noise). Mud: low scale, weak
+  // contrast and texture.
+  double reflectivity_scale = 1.0;
+  double patch_contrast = 1.0;
+  double texture_contrast = 0.3;
+  // A second, longer ripple set (megaripples, 3-20 m) inside the same ripple fields.
+  double megaripple_amplitude_m = 0.0;
+  double megaripple_wavelength_m = 8.0;
+  // Rock outcrops: bright, rough, ridged relief over this share of the area, in patches of about
+  // outcrop_scale_m.
+  double outcrop_fraction = 0.0;
+  double outcrop_relief_m = 1.0;
+  double outcrop_scale_m = 60.0;
   std::vector<SeabedObject> objects;       // extra hand-placed objects
 
   // Switches for tests that need a clean scene (a flat bed with one object).

@@ -2,6 +2,7 @@
 // into --out DIR. Options: YAML `sim` section via --config, then command-line overrides.
 #include "pipeline/core/config.hpp"
 #include "tools/sim/mission.hpp"
+#include "tools/sim/randomise.hpp"
 
 #include <cstdio>
 #include <cstdlib>
@@ -15,7 +16,12 @@ const char* kUsage =
     "usage: sss-sim --out DIR [--config FILE] [--seed N] [--pattern lawnmower|loop|cross] [--lines N]\n"
     "               [--cross-lines K] [--line-length-m M] [--line-spacing-m M] [--range-m M] [--altitude-m M]\n"
     "               [--ping-rate-hz HZ] [--drift-scale K] [--heading-noise-rad S] [--duration-s S]\n"
+    "               [--randomise [--family NAME]]\n"
     "Defaults make a ~20 minute, 5-line lawnmower at 2 m/s, 18 m altitude, 75 m range per side.\n"
+    "--randomise draws the whole mission from --seed: a seabed family (sand_ripples, mud, rock_outcrops,\n"
+    "  boulder_field, trawled, mixed; --family forces one), relief, sonar range 50-200 m with its\n"
+    "  frequency, absorption, TVG, gain steps and speckle, vehicle motion, survey geometry and DR errors.\n"
+    "  mission.yaml records every drawn value; --config and the flags above then override them.\n"
     "--pattern cross: the lawnmower's --lines, then --cross-lines K (2) lines perpendicular to them\n"
     "  across the block at 1/(K+1) ... K/(K+1) of the line length, one spacing beyond the outer lines.\n"
     "The config file's `sim` section holds every other parameter (see mission.yaml of any run).\n";
@@ -34,11 +40,16 @@ bool parseNumber(const std::string& flag, const std::string& text, double& value
 
 int main(int argc, char** argv) {
   std::map<std::string, std::string> flags;
+  bool randomise = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--help" || arg == "-h") {
       std::cout << kUsage;
       return 0;
+    }
+    if (arg == "--randomise") {
+      randomise = true;
+      continue;
     }
     if (arg.rfind("--", 0) != 0 || i + 1 >= argc) {
       std::cerr << "sss-sim: unexpected argument '" << arg << "' (every flag takes a value)\n" << kUsage;
@@ -52,6 +63,29 @@ int main(int argc, char** argv) {
   }
 
   sss::sim::SimOptions options;
+  if (flags.count("--family") && !randomise) {
+    std::cerr << "sss-sim: --family needs --randomise\n";
+    return 2;
+  }
+  if (randomise) {
+    sss::sim::RandomiseOptions request;
+    double seed = 1.0;
+    if (flags.count("--seed") && (!parseNumber("--seed", flags["--seed"], seed) || seed < 0 ||
+                                  seed != static_cast<double>(static_cast<int64_t>(seed)))) {
+      std::cerr << "sss-sim: --seed expects a non-negative integer, got '" << flags["--seed"] << "'\n";
+      return 2;
+    }
+    request.seed = static_cast<int64_t>(seed);
+    if (flags.count("--family")) {
+      request.family = flags["--family"];
+      if (!sss::sim::isSeabedFamily(request.family)) {
+        std::cerr << "sss-sim: --family " << request.family << " is not one of sand_ripples, mud, rock_outcrops, "
+                  << "boulder_field, trawled, mixed\n";
+        return 2;
+      }
+    }
+    options = sss::sim::randomiseMission(request);
+  }
   if (flags.count("--config")) {
     sss::core::Config config = sss::core::Config::fromFile(flags["--config"]);
     // has() first: ConfigSection::section throws on an absent key (see tools/sim/mission.cpp).
@@ -76,7 +110,7 @@ int main(int argc, char** argv) {
       {"--duration-s", &options.duration_s},
   };
   for (const auto& [flag, value] : flags) {
-    if (flag == "--out" || flag == "--config") continue;
+    if (flag == "--out" || flag == "--config" || flag == "--family") continue;
     double number = 0.0;
     if (flag == "--pattern") {
       options.trajectory.pattern = value;
@@ -104,6 +138,15 @@ int main(int argc, char** argv) {
 
   try {
     const sss::sim::Mission mission(options);
+    if (randomise) {
+      const auto& o = mission.options();
+      std::printf("sss-sim: randomised seed %lld: family %s, range %.0f m at %.0f kHz, altitude %.0f m, %s of %d lines "
+                  "x %.0f m, spacing %.0f m, relief %.1f m / %.0f m, speckle shape %.2f, drift x%.2f\n",
+                  static_cast<long long>(o.seed), o.family.c_str(), o.sonar.range_m, o.sonar.frequency_hz / 1e3,
+                  o.trajectory.altitude_m, o.trajectory.pattern.c_str(), o.trajectory.lines, o.trajectory.line_length_m,
+                  o.trajectory.line_spacing_m, o.seabed.undulation_amplitude_m, o.seabed.undulation_wavelength_m,
+                  o.sonar.speckle_shape, o.dead_reckoning.drift_scale);
+    }
     std::cout << "sss-sim: " << mission.pingCount() << " pings, " << mission.durationS() << " s, seabed "
               << mission.seabed().rows() << " x " << mission.seabed().cols() << " cells\n";
     sss::sim::MissionReport report;

@@ -22,6 +22,21 @@ struct SplitMix {
   }
   // Uniform in (0, 1].
   double uniform() { return (static_cast<double>(next() >> 11) + 1.0) * (1.0 / 9007199254740992.0); }
+  double normal() {  // Box-Muller, one of the pair
+    return std::sqrt(-2.0 * std::log(uniform())) * std::cos(2.0 * 3.14159265358979323846 * uniform());
+  }
+  // Gamma(shape, scale 1/shape): mean 1, variance 1/shape (Marsaglia and Tsang 2000).
+  double unitMeanGamma(double shape) {
+    if (shape < 1.0) return unitMeanGamma(shape + 1.0) * (shape + 1.0) / shape * std::pow(uniform(), 1.0 / shape);
+    const double d = shape - 1.0 / 3.0;
+    const double c = 1.0 / std::sqrt(9.0 * d);
+    for (;;) {
+      const double x = normal();
+      const double v = std::pow(1.0 + c * x, 3);
+      if (v <= 0.0) continue;
+      if (std::log(uniform()) < 0.5 * x * x + d - d * v + d * std::log(v)) return d * v / shape;
+    }
+  }
 };
 
 }  // namespace
@@ -78,15 +93,31 @@ SonarModel::SonarModel(const SonarOptions& options, const Seabed* seabed) : opti
   if (options.range_m <= 0.0 || options.sound_speed_m_s <= 0.0) throw std::invalid_argument("SonarModel: bad range");
   const double bin = options.sampleSpacingM();
   const double alpha_db_per_m = options.absorption_db_per_km / 1000.0;
+  const double tvg_alpha_db_per_m = options.tvgAbsorptionDbPerKm() / 1000.0;
   noise_intensity_.resize(options.samples_per_side);
+  tvg_residual_.resize(options.samples_per_side);
   for (int i = 0; i < options.samples_per_side; ++i) {
     const double r = std::max(i * bin, bin);
     // Receiver noise is flat before the TVG, so after it the noise rises with range exactly as
     // the TVG gain does: dark water column, grainy far range.
     const double tvg_db_rel = options.tvg_spreading_db_per_decade * std::log10(r / options.range_m) +
-                              2.0 * alpha_db_per_m * (r - options.range_m);
+                              2.0 * tvg_alpha_db_per_m * (r - options.range_m);
     noise_intensity_[i] = options.noise_intensity_at_max_range * std::pow(10.0, tvg_db_rel / 10.0);
+    // The signal model below is the echo after a TVG of 30 log r + 2 alpha r (true alpha); a TVG
+    // of another law leaves this much, 0 dB at max range.
+    const double residual_db = (options.tvg_spreading_db_per_decade - 30.0) * std::log10(r / options.range_m) +
+                               2.0 * (tvg_alpha_db_per_m - alpha_db_per_m) * (r - options.range_m);
+    tvg_residual_[i] = std::pow(10.0, residual_db / 10.0);
   }
+}
+
+double SonarModel::gainStepDb(uint32_t ping_number, Side side) const {
+  if (options_.gain_step_interval_s <= 0.0 || options_.gain_step_sigma_db <= 0.0) return 0.0;
+  const double time_s = ping_number / options_.ping_rate_hz;
+  const auto step = static_cast<uint64_t>(std::floor(time_s / options_.gain_step_interval_s));
+  SplitMix common{mixSeed(options_.seed ^ 0x6A1Eull, step)};
+  SplitMix own{mixSeed(options_.seed ^ 0x6A1Full, 2 * step + static_cast<uint64_t>(side))};
+  return options_.gain_step_sigma_db * (common.normal() + own.normal() / 3.0);
 }
 
 std::vector<double> SonarModel::accumulate(const sss::core::Pose& T_world_sonar, Side side) const {
@@ -141,7 +172,7 @@ std::vector<double> SonarModel::accumulate(const sss::core::Pose& T_world_sonar,
     }
   }
   // Energy per metre of range: bright where much seabed falls into one range bin (near nadir).
-  for (double& value : energy) value /= bin;
+  for (int i = 0; i < n; ++i) energy[i] = energy[i] * tvg_residual_[i] / bin + options_.volume_backscatter;
   return energy;
 }
 
@@ -157,12 +188,18 @@ PingSamples SonarModel::render(const sss::core::Pose& T_world_sonar, uint32_t pi
     SplitMix rng{mixSeed(options_.seed, 2ull * ping_number + static_cast<uint64_t>(side))};
     std::vector<float>& out = side == Side::kPort ? ping.port : ping.starboard;
     out.resize(signal.size());
+    const double scale = options_.output_scale * std::pow(10.0, gainStepDb(ping_number, side) / 20.0);
+    const double shape = options_.speckle_shape;
+    const double looks = options_.speckle_looks;
     for (size_t i = 0; i < signal.size(); ++i) {
       const double noise = noise_intensity_[i];
-      // Fully developed speckle: complex Gaussian echo, so intensity is exponential and the
-      // envelope Rayleigh distributed.
-      const double intensity = (signal[i] + noise) * -std::log(rng.uniform());
-      out[i] = static_cast<float>(options_.output_scale * std::sqrt(intensity));
+      // Speckle: complex Gaussian echo, so intensity is exponential and the envelope Rayleigh
+      // distributed (gamma with `looks` averaged); K-distributed clutter modulates the echo's
+      // power (not the receiver noise's) by a gamma texture first.
+      const double texture = shape > 0.0 ? rng.unitMeanGamma(shape) : 1.0;
+      const double speckle = looks == 1.0 ? -std::log(rng.uniform()) : rng.unitMeanGamma(looks);
+      const double intensity = (signal[i] * texture + noise) * speckle;
+      out[i] = static_cast<float>(scale * std::sqrt(intensity));
     }
   }
   return ping;

@@ -31,10 +31,31 @@ struct SonarOptions {
   double noise_intensity_at_max_range = 0.0012;
   double tvg_spreading_db_per_decade = 30.0; // TVG = 30 log r + 2 alpha r; the 10 log r of the
                                              // footprint's along-track growth stays uncorrected
+  // The absorption the sonar's TVG assumes; < 0: the true absorption_db_per_km. A mismatch (a
+  // sound-velocity or temperature guess) leaves a range-dependent brightening or darkening.
+  double tvg_absorption_db_per_km = -1.0;
+  // Speckle statistics: 0 is fully developed speckle (Rayleigh envelope, std/mean 0.52); a
+  // positive value is the shape nu of K-distributed clutter (gamma texture x exponential
+  // intensity: few dominant scatterers per cell), std/mean 0.79 at nu = 1 as on real seabeds.
+  double speckle_shape = 0.0;
+  // Looks averaged into one recorded sample (a sonar that decimates or filters its envelope):
+  // intensity gamma distributed with this shape, envelope std/mean 0.52 at 1 look, 0.36 at 2.
+  double speckle_looks = 1.0;
+  // Gain steps: every gain_step_interval_s (0: never) the operator or the sonar's AGC sets a new
+  // gain, Gaussian in dB with this std (both sides alike, plus a third of it per side).
+  double gain_step_interval_s = 0.0;
+  double gain_step_sigma_db = 0.0;
+  // JSF subsystem of the rendered channel pair: -1 picks it from the frequency (below 600 kHz the
+  // low-frequency side-scan, 20, else 21); the lower band of a dual-frequency sonar is 20.
+  int jsf_subsystem = -1;
+  // Water-column floor after the TVG (volume reverberation, plankton, crosstalk), in the units of
+  // the backscatter, the same at every range: what makes a real water column grey, not black.
+  double volume_backscatter = 0.0;
   double ground_step_m = 0.05;               // ray-cast step along the seabed profile
   double output_scale = 1000.0;              // envelope magnitude per unit amplitude
   uint64_t seed = 1;
 
+  double tvgAbsorptionDbPerKm() const { return tvg_absorption_db_per_km < 0.0 ? absorption_db_per_km : tvg_absorption_db_per_km; }
   double sampleIntervalS() const { return 2.0 * range_m / sound_speed_m_s / samples_per_side; }
   double sampleSpacingM() const { return 0.5 * sampleIntervalS() * sound_speed_m_s; }
 };
@@ -73,6 +94,8 @@ class SonarModel {
   PingSamples render(const sss::core::Pose& T_world_sonar, uint32_t ping_number) const;
   // One side without speckle or noise: the expected TVG-corrected intensity (tests, previews).
   std::vector<float> expectedIntensity(const sss::core::Pose& T_world_sonar, Side side) const;
+  // The gain step (dB) in force at ping_number on one side; 0 without gain steps.
+  double gainStepDb(uint32_t ping_number, Side side) const;
 
   const SonarOptions& options() const { return options_; }
 
@@ -82,6 +105,7 @@ class SonarModel {
   SonarOptions options_;
   const Seabed* seabed_;
   std::vector<double> noise_intensity_;  // per sample, after TVG
+  std::vector<double> tvg_residual_;     // per sample: what the TVG leaves of spreading/absorption
 };
 
 }  // namespace sss::sim

@@ -241,16 +241,21 @@ TrajectorySample Trajectory::sample(double time_s) const {
   planarState(distance, planar, path_heading, curvature, line);
 
   const double t = time_s;
-  const auto depthAt = [&](const Eigen::Vector2d& p, double time) {
-    return seabed_->smoothDepthM(p.x(), p.y()) - options_.altitude_m +
-           options_.altitude_wobble_m * std::sin(2.0 * kPi * time / 31.0 + phase_altitude_);
+  const auto depthAt = [&](const Eigen::Vector2d& p, double path_m, double time) {
+    double depth_m = seabed_->smoothDepthM(p.x(), p.y()) - options_.altitude_m +
+                     options_.altitude_wobble_m * std::sin(2.0 * kPi * time / 31.0 + phase_altitude_);
+    if (options_.altitude_variation_m > 0.0) {
+      depth_m -= options_.altitude_variation_m *
+                 fractalNoise2d(mixSeed(options_.seed, 2002), path_m / options_.altitude_variation_length_m, 0.5, 2);
+    }
+    return depth_m;
   };
-  const double depth = depthAt(planar, t);
+  const double depth = depthAt(planar, distance, t);
   // Slope of the flown depth along track gives the mean pitch (bow up when climbing).
   const double ds = 1.0;
   const Eigen::Vector2d ahead = planar + headingVector(path_heading) * ds;
   const Eigen::Vector2d behind = planar - headingVector(path_heading) * ds;
-  const double dz_ds = (depthAt(ahead, t) - depthAt(behind, t)) / (2.0 * ds);
+  const double dz_ds = (depthAt(ahead, distance + ds, t) - depthAt(behind, distance - ds, t)) / (2.0 * ds);
 
   const double roll = options_.roll_amplitude_rad * std::sin(2.0 * kPi * t / options_.roll_period_s + phase_roll_) +
                       std::clamp(curvature * 35.0, -1.0, 1.0) * options_.max_turn_bank_rad;

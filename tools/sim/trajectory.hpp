@@ -32,6 +32,10 @@ struct TrajectoryOptions {
   double yaw_amplitude_rad = 0.004;    // heading hunting of the autopilot around the line
   double yaw_period_s = 40.0;
   double altitude_wobble_m = 0.3;      // terrain following is not perfect
+  // Slow altitude changes along the path (commanded steps, a sluggish terrain follower): smooth
+  // noise of this amplitude over this path length; 0 keeps the altitude constant.
+  double altitude_variation_m = 0.0;
+  double altitude_variation_length_m = 300.0;
   double max_turn_bank_rad = 0.08;     // roll into turns
   uint64_t seed = 1;
 };

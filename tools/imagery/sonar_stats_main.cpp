@@ -1,0 +1,194 @@
+// sss-sonar-stats: the image statistics of a side-scan file (JSF or XTF) that a person compares
+// between simulated and real data: speckle, dynamic range, across-track fall-off, water column,
+// nadir. Prints a few lines; --json FILE writes them as JSON.
+#include "drivers/edgetech/sonar_driver.hpp"
+#include "drivers/xtf/xtf_reader.hpp"
+#include "tools/imagery/sonar_statistics.hpp"
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <vector>
+
+namespace {
+
+const char* kUsage =
+    "usage: sss-sonar-stats --sonar FILE.jsf|FILE.xtf [--json OUT.json] [--subsystem N] [--pair K] [--max-pings N]\n"
+    "                       [--block PINGS,SAMPLES] [--max-quarter-deviation F] [--far-range MIN,MAX]\n"
+    "                       [--waterfall OUT.png]\n"
+    "Image statistics of the raw envelope samples: speckle (median std/mean of homogeneous far-range\n"
+    "blocks), dynamic range, across-track fall-off, water column and nadir re the seabed mean.\n"
+    "--subsystem: JSF side-scan subsystem (20 low, 21 high; default 20); --pair: XTF channel pair\n"
+    "(0 = lowest frequency). --waterfall: the raw slant-range waterfall (port mirrored left, first ping\n"
+    "at the top, samples averaged to at most 1000 columns per side, white at the 99th percentile).\n"
+    "Exit 2 on bad arguments or an unreadable file, 1 when it holds no ping.\n";
+
+bool endsWith(const std::string& text, const std::string& suffix) {
+  if (text.size() < suffix.size()) return false;
+  std::string tail = text.substr(text.size() - suffix.size());
+  for (char& c : tail) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return tail == suffix;
+}
+
+// Samples from slant range 0: a recording window that starts later is padded with zeros.
+std::vector<float> fromRangeZero(const sss::edgetech::SonarChannelRecord& side) {
+  std::vector<float> samples(side.start_depth_samples, 0.0f);
+  samples.insert(samples.end(), side.samples.begin(), side.samples.end());
+  return samples;
+}
+
+sss::imagery::StatisticsPing toStatisticsPing(const sss::edgetech::AssembledPing& ping) {
+  sss::imagery::StatisticsPing out;
+  const sss::edgetech::SonarChannelRecord& any = ping.port ? *ping.port : *ping.starboard;
+  if (ping.port) out.port = fromRangeZero(*ping.port);
+  if (ping.starboard) out.starboard = fromRangeZero(*ping.starboard);
+  out.sample_spacing_m = any.slantRangeM(1) - any.slantRangeM(0);
+  if ((any.validity & sss::edgetech::kValidAltitude) && any.altitude_m > 0.0) out.altitude_m = any.altitude_m;
+  return out;
+}
+
+// The raw waterfall as a person first looks at a file: slant range, both sides, no correction.
+bool writeWaterfall(const std::vector<sss::imagery::StatisticsPing>& pings, const std::string& path) {
+  size_t samples = 0;
+  for (const auto& ping : pings) samples = std::max({samples, ping.port.size(), ping.starboard.size()});
+  const size_t bins = std::min<size_t>(1000, samples);
+  if (bins == 0) return false;
+  cv::Mat image(static_cast<int>(pings.size()), static_cast<int>(2 * bins), CV_32FC1, cv::Scalar(0.0f));
+  for (size_t row = 0; row < pings.size(); ++row) {
+    for (int side = 0; side < 2; ++side) {
+      const std::vector<float>& values = side == 0 ? pings[row].port : pings[row].starboard;
+      for (size_t j = 0; j < bins; ++j) {
+        const size_t s0 = j * samples / bins, s1 = std::max(s0 + 1, (j + 1) * samples / bins);
+        double sum = 0.0;
+        size_t n = 0;
+        for (size_t s = s0; s < s1 && s < values.size(); ++s) sum += values[s], ++n;
+        const size_t column = side == 0 ? bins - 1 - j : bins + j;
+        image.at<float>(static_cast<int>(row), static_cast<int>(column)) = n ? static_cast<float>(sum / n) : 0.0f;
+      }
+    }
+  }
+  std::vector<float> sorted(image.begin<float>(), image.end<float>());
+  const size_t k = sorted.size() * 99 / 100;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(k), sorted.end());
+  const double white = std::max(1e-6f, sorted[k]);
+  cv::Mat out;
+  image.convertTo(out, CV_8UC1, 255.0 / white);
+  try {
+    return cv::imwrite(path, out);
+  } catch (const cv::Exception&) {
+    return false;
+  }
+}
+
+bool parseCount(const std::string& text, long& value) {
+  char* end = nullptr;
+  value = std::strtol(text.c_str(), &end, 10);
+  return end != text.c_str() && *end == '\0' && value >= 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string sonar_path, json_path, waterfall_path;
+  long subsystem = sss::edgetech::kSubsystemSideScanLow, pair = 0, max_pings = 0;
+  sss::imagery::SonarStatisticsOptions stats_options;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") {
+      std::cout << kUsage;
+      return 0;
+    }
+    if (i + 1 >= argc) {
+      std::cerr << "sss-sonar-stats: " << arg << " needs a value\n" << kUsage;
+      return 2;
+    }
+    const std::string value = argv[++i];
+    double a = 0.0, b = 0.0;
+    char tail = 0;
+    const bool two_numbers = std::sscanf(value.c_str(), "%lf,%lf%c", &a, &b, &tail) == 2;
+    if (arg == "--block" && two_numbers && a >= 2 && b >= 2) {
+      stats_options.block_pings = static_cast<int>(a), stats_options.block_samples = static_cast<int>(b);
+    } else if (arg == "--far-range" && two_numbers && a >= 0.0 && a < b && b <= 1.0) {
+      stats_options.far_range_min_fraction = a, stats_options.far_range_max_fraction = b;
+    } else if (arg == "--max-quarter-deviation" && std::sscanf(value.c_str(), "%lf%c", &a, &tail) == 1 && a > 0.0) {
+      stats_options.max_quarter_deviation = a;
+    } else if (arg == "--sonar") sonar_path = value;
+    else if (arg == "--json") json_path = value;
+    else if (arg == "--waterfall") waterfall_path = value;
+    else if ((arg == "--subsystem" && parseCount(value, subsystem) && subsystem < 256) ||
+             (arg == "--pair" && parseCount(value, pair)) || (arg == "--max-pings" && parseCount(value, max_pings))) {
+    } else {
+      std::cerr << "sss-sonar-stats: bad argument " << arg << " " << value << "\n" << kUsage;
+      return 2;
+    }
+  }
+  if (sonar_path.empty()) {
+    std::cerr << "sss-sonar-stats: --sonar FILE is required\n" << kUsage;
+    return 2;
+  }
+
+  std::vector<sss::imagery::StatisticsPing> pings;
+  const auto full = [&] { return max_pings > 0 && pings.size() >= static_cast<size_t>(max_pings); };
+  if (endsWith(sonar_path, ".xtf")) {
+    sss::xtf::XtfReaderOptions options;
+    options.pair_index = static_cast<int>(pair);
+    sss::xtf::XtfReader reader(sonar_path, options);
+    if (!reader.isOpen()) {
+      std::cerr << "sss-sonar-stats: " << reader.error() << "\n";
+      return 2;
+    }
+    sss::edgetech::DriverPing ping;
+    while (!full() && reader.next(ping)) pings.push_back(toStatisticsPing(ping.ping));
+    for (const std::string& fault : reader.takeNewFaultMessages()) std::cerr << "sss-sonar-stats: " << fault << "\n";
+  } else {
+    std::ifstream file(sonar_path, std::ios::binary);
+    if (!file) {
+      std::cerr << "sss-sonar-stats: cannot open " << sonar_path << "\n";
+      return 2;
+    }
+    sss::edgetech::SonarDriverOptions options;
+    options.assembler.subsystem = static_cast<uint8_t>(subsystem);
+    options.time_source = sss::edgetech::TimeSource::kSonarClock;
+    sss::edgetech::SonarDriver driver(options);
+    std::vector<char> chunk(1 << 20);
+    std::vector<sss::edgetech::DriverPing> out;
+    while (!full() && file) {
+      file.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+      const std::streamsize n = file.gcount();
+      out.clear();
+      if (n > 0) driver.onBytes(reinterpret_cast<const uint8_t*>(chunk.data()), static_cast<size_t>(n), 0, 0, out);
+      if (!file) driver.finish(0, 0, out);
+      for (const auto& ping : out) {
+        if (!full()) pings.push_back(toStatisticsPing(ping.ping));
+      }
+    }
+    for (const std::string& fault : driver.takeNewFaultMessages()) std::cerr << "sss-sonar-stats: " << fault << "\n";
+  }
+  if (pings.empty()) {
+    std::cerr << "sss-sonar-stats: " << sonar_path << " holds no side-scan ping"
+              << (endsWith(sonar_path, ".xtf") ? " (try another --pair)\n" : " of subsystem " + std::to_string(subsystem) +
+                                                                                   " (try --subsystem 21)\n");
+    return 1;
+  }
+  const sss::imagery::SonarStatistics stats = sss::imagery::computeSonarStatistics(pings, stats_options);
+  std::cout << sonar_path << ":\n" << sss::imagery::statisticsText(stats);
+  if (!waterfall_path.empty() && !writeWaterfall(pings, waterfall_path)) {
+    std::cerr << "sss-sonar-stats: cannot write " << waterfall_path << "\n";
+    return 2;
+  }
+  if (!json_path.empty()) {
+    std::ofstream json(json_path);
+    json << sss::imagery::statisticsJson(stats) << "\n";
+    if (!json) {
+      std::cerr << "sss-sonar-stats: cannot write " << json_path << "\n";
+      return 2;
+    }
+  }
+  return 0;
+}
