@@ -44,11 +44,15 @@ void drawSeabedFamily(const std::string& family, double area_km2, double resolut
                       SonarOptions& sonar) {
   // Features every family may carry a little of, overwritten below where the family is about them.
   const double min_ripple_wavelength_m = std::max(0.6, 5.0 * resolution_m);  // resolvable on the grid
+  // Ripple steepness as sand forms it: wavelength / height 8-20 (ripples), 15-30 (megaripples);
+  // the amplitudes here are half the height.
   s.ripple_fraction = draw.uniform(0.0, 0.2);
-  s.ripple_amplitude_m = draw.uniform(0.02, 0.06);
   s.ripple_wavelength_m = draw.uniform(min_ripple_wavelength_m, std::max(2.0, min_ripple_wavelength_m + 0.5));
+  const double ripple_steepness = draw.uniform(1.0 / 40.0, 1.0 / 16.0);
+  s.ripple_amplitude_m = 0.5 * ripple_steepness * s.ripple_wavelength_m;
   s.megaripple_amplitude_m = 0.0;
   s.megaripple_wavelength_m = draw.uniform(4.0, 15.0);
+  const double megaripple_amplitude_m = s.megaripple_wavelength_m * draw.uniform(1.0 / 60.0, 1.0 / 30.0);
   const auto trawl_count = [&](double per_km2) { return static_cast<int>(std::min(60.0, std::round(per_km2 * area_km2))); };
   s.trawl_mark_count = trawl_count(draw.uniform(0.0, 20.0));
   s.trawl_mark_depth_m = draw.uniform(0.1, 0.3);
@@ -67,8 +71,8 @@ void drawSeabedFamily(const std::string& family, double area_km2, double resolut
 
   if (family == "sand_ripples") {
     s.ripple_fraction = draw.uniform(0.5, 0.9);
-    s.ripple_amplitude_m = draw.uniform(0.03, 0.12);
-    s.megaripple_amplitude_m = draw.uniform(0.1, 0.4);
+    s.ripple_amplitude_m *= 2.0;  // well-formed ripples, the steep end
+    s.megaripple_amplitude_m = megaripple_amplitude_m;
     s.reflectivity_scale = draw.uniform(0.9, 1.3);
     speckle_min = 3.0, speckle_max = 15.0;
   } else if (family == "mud") {
@@ -94,7 +98,7 @@ void drawSeabedFamily(const std::string& family, double area_km2, double resolut
     speckle_min = 2.0, speckle_max = 8.0;
   } else if (family == "mixed") {
     s.ripple_fraction = draw.uniform(0.2, 0.5);
-    s.megaripple_amplitude_m = draw.uniform(0.0, 0.3);
+    s.megaripple_amplitude_m = draw.uniform(0.0, 1.0) * megaripple_amplitude_m;
     s.trawl_mark_count = trawl_count(draw.uniform(20.0, 60.0));
     s.boulders_per_hectare = draw.uniform(3.0, 15.0);
     s.outcrop_fraction = draw.uniform(0.0, 0.15);

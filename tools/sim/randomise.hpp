@@ -12,7 +12,8 @@
 namespace sss::sim {
 
 // The seabed families, each a distribution over the seabed parameters:
-//   sand_ripples   ripple fields at two wavelengths (0.6-2 m ripples on 4-15 m megaripples)
+//   sand_ripples   ripple fields at two wavelengths (0.6-2 m ripples on 4-15 m megaripples, with
+//                  the steepness sand forms)
 //   mud            dark, weakly textured sediment, few features (the matcher's hard case)
 //   rock_outcrops  bright ridged rock over 20-50 % of the area, boulders around it
 //   boulder_field  30-120 boulders per hectare with their shadows
