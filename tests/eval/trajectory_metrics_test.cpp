@@ -1,5 +1,6 @@
-// Trajectory metrics: Umeyama recovers a known rigid transform, ATE of a constant offset, RPE of
-// a scale drift, association by time, and survey-line segmentation of simulated surveys.
+// Trajectory metrics: Umeyama recovers a known rigid transform, ATE of a constant offset, the
+// gauge-free ATE (rotation and scale about the start removed, translation kept), RPE of a scale
+// drift, association by time, and survey-line segmentation of simulated surveys.
 #include "tools/eval/trajectory_metrics.hpp"
 
 #include "tests/eval/eval_test_paths.hpp"
@@ -105,6 +106,108 @@ TEST(Ate, RotatedAndShiftedEstimateAlignsToZero) {
   EXPECT_LT(result.ate.aligned_position_m.max, 1e-8);
   EXPECT_NEAR(result.ate.alignment_heading_deg, -0.05 * 180.0 / M_PI, 1e-7);  // undoes the rotation
   EXPECT_NEAR(result.ate.rotation_deg.mean, 0.05 * 180.0 / M_PI, 1e-7);
+}
+
+// Poses at the given north/east positions, one per second, heading north, 30 m deep.
+Trajectory atPositions(const std::vector<Eigen::Vector2d>& north_east_m) {
+  Trajectory poses;
+  for (size_t i = 0; i < north_east_m.size(); ++i) {
+    poses.push_back({test::kStartUtimeUs + static_cast<int64_t>(i) * 1000000,
+                     Pose(Eigen::Quaterniond::Identity(), Eigen::Vector3d(north_east_m[i].x(), north_east_m[i].y(), 30.0))});
+  }
+  return poses;
+}
+
+TEST(GaugeFreeAte, RotationAndScaleAboutTheStartAreRemovedExactly) {
+  // The truth is the estimate turned 2 deg clockwise and scaled by 0.995 about the estimate's first
+  // position (not the origin): what a heading bias and a DVL scale factor do to dead reckoning.
+  Trajectory estimate = test::lawnmower(3, 200.0, 60.0);
+  for (StampedPose& p : estimate) p.T_world_body.translation += Eigen::Vector3d(120.0, -80.0, 0.0);
+  const double rotation_deg = 2.0, scale = 0.995;
+  const Eigen::Vector3d start = estimate.front().T_world_body.translation;
+  const Eigen::Quaterniond turn = sss::core::quaternionFromEuler(0.0, 0.0, rotation_deg * M_PI / 180.0);
+  Trajectory truth = estimate;
+  for (StampedPose& p : truth) {
+    Eigen::Vector3d d = p.T_world_body.translation - start;
+    const double depth_m = p.T_world_body.translation.z();
+    d = scale * (turn * d);
+    p.T_world_body.translation = start + d;
+    p.T_world_body.translation.z() = depth_m;
+  }
+  const TrajectoryEvaluation result = evaluateTrajectory(truth, estimate, segmentSurveyLines(truth));
+  ASSERT_TRUE(result.ok) << result.error;
+  EXPECT_GT(result.ate.horizontal_m.rmse, 3.0);  // 2 deg over ~250 m from the start
+  EXPECT_LT(result.ate.gauge_free_horizontal_m.max, 1e-9);
+  EXPECT_EQ(result.ate.gauge_free_horizontal_m.count, estimate.size());
+  EXPECT_NEAR(result.ate.gauge_free_scale, scale, 1e-12);
+  EXPECT_NEAR(result.ate.gauge_free_rotation_deg, rotation_deg, 1e-9);  // clockwise positive, as a heading
+  // All of the raw error is the gauge's.
+  EXPECT_NEAR(result.ate.gauge_horizontal_m.rmse, result.ate.horizontal_m.rmse, 1e-9);
+  for (const ErrorSample& s : result.series) EXPECT_LT(s.gauge_free_horizontal_m, 1e-9);
+
+  // A heading that reads high turns the estimate clockwise: the fit turns it back (negative).
+  const TrajectoryEvaluation swapped = evaluateTrajectory(estimate, truth, {});
+  ASSERT_TRUE(swapped.ok);
+  EXPECT_NEAR(swapped.ate.gauge_free_rotation_deg, -rotation_deg, 1e-9);
+  EXPECT_NEAR(swapped.ate.gauge_free_scale, 1.0 / scale, 1e-12);
+  EXPECT_LT(swapped.ate.gauge_free_horizontal_m.max, 1e-9);
+}
+
+TEST(GaugeFreeAte, MatchesAHandComputedThreePointCase) {
+  // a = est - est_0 = {0, 2, 2i}; b = truth - est_0 = {1, 3 + i, 2i} (north + i east):
+  // z = (2 (3 + i) + (-2i)(2i)) / 8 = 1.25 + 0.25i; residuals b - z a = {1, 0.5 + 0.5i, 0.5 - 0.5i}.
+  const Trajectory estimate = atPositions({{0.0, 0.0}, {2.0, 0.0}, {0.0, 2.0}});
+  const Trajectory truth = atPositions({{1.0, 0.0}, {3.0, 1.0}, {0.0, 2.0}});
+  const TrajectoryEvaluation result = evaluateTrajectory(truth, estimate, {});
+  ASSERT_TRUE(result.ok) << result.error;
+  const AteResult& ate = result.ate;
+  EXPECT_NEAR(ate.gauge_free_scale, std::sqrt(1.25 * 1.25 + 0.25 * 0.25), 1e-12);
+  EXPECT_NEAR(ate.gauge_free_rotation_deg, std::atan2(0.25, 1.25) * 180.0 / M_PI, 1e-12);  // 11.31 deg
+  EXPECT_NEAR(ate.gauge_free_horizontal_m.rmse, std::sqrt(2.0 / 3.0), 1e-12);
+  EXPECT_NEAR(ate.gauge_free_horizontal_m.mean, (1.0 + 2.0 * std::sqrt(0.5)) / 3.0, 1e-12);
+  EXPECT_NEAR(ate.gauge_free_horizontal_m.max, 1.0, 1e-12);
+  ASSERT_EQ(result.series.size(), 3u);
+  EXPECT_NEAR(result.series[1].gauge_free_horizontal_m, std::sqrt(0.5), 1e-12);
+  // |z - 1| |a| = {0, sqrt(0.5), sqrt(0.5)}; raw^2 = gauge^2 + gauge-free^2 (1 = 1/3 + 2/3).
+  EXPECT_NEAR(ate.gauge_horizontal_m.rmse, std::sqrt(1.0 / 3.0), 1e-12);
+  EXPECT_NEAR(ate.horizontal_m.rmse, 1.0, 1e-12);
+
+  // Degenerate: an estimate that never leaves its start has no rotation or scale to fit.
+  const TrajectoryEvaluation still = evaluateTrajectory(truth, atPositions({{0.0, 0.0}, {0.0, 0.0}, {0.0, 0.0}}), {});
+  ASSERT_TRUE(still.ok);
+  EXPECT_DOUBLE_EQ(still.ate.gauge_free_scale, 1.0);
+  EXPECT_DOUBLE_EQ(still.ate.gauge_free_rotation_deg, 0.0);
+  EXPECT_NEAR(still.ate.gauge_free_horizontal_m.rmse, still.ate.horizontal_m.rmse, 1e-12);
+  EXPECT_NEAR(still.ate.gauge_free_horizontal_m.max, std::sqrt(10.0), 1e-12);
+}
+
+TEST(GaugeFreeAte, KeepsATranslationOffset) {
+  // North 100 m, back through the start to 100 m south and back: positions symmetric about the
+  // start, so an offset has no rotation or scale part and stays whole in every sample.
+  std::vector<Eigen::Vector2d> path;
+  for (int k = 0; k <= 200; ++k) path.emplace_back(0.5 * k, 0.0);
+  for (int k = 199; k >= -200; --k) path.emplace_back(0.5 * k, 0.0);
+  for (int k = -199; k <= 0; ++k) path.emplace_back(0.5 * k, 0.0);
+  const Trajectory truth = atPositions(path);
+  Trajectory estimate = truth;
+  const Eigen::Vector3d offset(3.0, -4.0, 0.0);
+  for (StampedPose& p : estimate) p.T_world_body.translation += offset;
+  const TrajectoryEvaluation result = evaluateTrajectory(truth, estimate, {});
+  ASSERT_TRUE(result.ok) << result.error;
+  EXPECT_NEAR(result.ate.gauge_free_scale, 1.0, 1e-12);
+  EXPECT_NEAR(result.ate.gauge_free_rotation_deg, 0.0, 1e-9);
+  EXPECT_NEAR(result.ate.gauge_free_horizontal_m.rmse, 5.0, 1e-9);
+  EXPECT_NEAR(result.ate.gauge_free_horizontal_m.mean, 5.0, 1e-9);
+  EXPECT_LT(result.ate.aligned_horizontal_m.max, 1e-9);  // which the SE(3) alignment does remove
+
+  // On any path the start keeps the whole offset, and most of it stays elsewhere.
+  const Trajectory lawnmower = test::lawnmower(3, 200.0, 60.0);
+  Trajectory shifted = lawnmower;
+  for (StampedPose& p : shifted) p.T_world_body.translation += offset;
+  const TrajectoryEvaluation on_lawnmower = evaluateTrajectory(lawnmower, shifted, {});
+  ASSERT_TRUE(on_lawnmower.ok);
+  EXPECT_NEAR(on_lawnmower.series.front().gauge_free_horizontal_m, 5.0, 1e-9);
+  EXPECT_GT(on_lawnmower.ate.gauge_free_horizontal_m.rmse, 2.5);
 }
 
 TEST(Rpe, ScaleDriftGivesItsPercentage) {

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 
 namespace sss::eval {
 namespace {
@@ -322,6 +323,28 @@ TrajectoryEvaluation evaluateTrajectory(const Trajectory& truth, const Trajector
   ate.aligned_position_m = errorStatistics(aligned_position);
   ate.aligned_horizontal_m = errorStatistics(aligned_horizontal);
 
+  // ATE gauge-free: rotation and scale about the estimate's first position (see AteResult).
+  const auto northEast = [](const Eigen::Vector3d& p) { return std::complex<double>(p.x(), p.y()); };
+  const std::complex<double> origin = northEast(pairs.front().estimate.translation);
+  std::complex<double> cross(0.0, 0.0);
+  double norm_a = 0.0;
+  for (const AssociatedPose& p : pairs) {
+    const std::complex<double> a = northEast(p.estimate.translation) - origin;
+    cross += std::conj(a) * (northEast(p.truth.translation) - origin);
+    norm_a += std::norm(a);
+  }
+  const std::complex<double> z = norm_a > 0.0 ? cross / norm_a : std::complex<double>(1.0, 0.0);
+  ate.gauge_free_scale = std::abs(z);
+  ate.gauge_free_rotation_deg = std::arg(z) * kRadToDeg;
+  std::vector<double> gauge_free, gauge;
+  for (const AssociatedPose& p : pairs) {
+    const std::complex<double> a = northEast(p.estimate.translation) - origin;
+    gauge_free.push_back(std::abs(northEast(p.truth.translation) - origin - z * a));
+    gauge.push_back(std::abs((z - 1.0) * a));
+  }
+  ate.gauge_free_horizontal_m = errorStatistics(gauge_free);
+  ate.gauge_horizontal_m = errorStatistics(gauge);
+
   // Truth path length at each pair (interpolated on the full truth, so sparse estimates do not
   // shorten the path).
   const std::vector<double> truth_distance = cumulativeDistanceM(truth);
@@ -365,6 +388,7 @@ TrajectoryEvaluation evaluateTrajectory(const Trajectory& truth, const Trajector
     sample.position_m = position[i];
     sample.horizontal_m = horizontal[i];
     sample.aligned_horizontal_m = aligned_horizontal[i];
+    sample.gauge_free_horizontal_m = gauge_free[i];
     const double heading = headingRad(pairs[i].truth.rotation);
     const Eigen::Vector2d forward(std::cos(heading), std::sin(heading));
     const Eigen::Vector2d starboard(-std::sin(heading), std::cos(heading));

@@ -1,6 +1,6 @@
 // Trajectory accuracy against ground truth: time association, SE(3) Umeyama alignment, absolute
-// trajectory error (3D and horizontal, raw and aligned), relative pose error over distance
-// windows, the error along the mission, and the ATE per survey line found in the truth.
+// trajectory error (3D and horizontal, raw, aligned and gauge-free), relative pose error over
+// distance windows, the error along the mission, and the ATE per survey line found in the truth.
 #pragma once
 
 #include "pipeline/core/pose.hpp"
@@ -122,6 +122,22 @@ struct AteResult {
   sss::core::Pose T_truth_estimate;        // the alignment: p_truth ~ T * p_est
   double alignment_rotation_deg = 0.0;     // angle of its rotation
   double alignment_heading_deg = 0.0;      // its heading (yaw) part, signed
+
+  // Gauge-free: the horizontal error left after the best horizontal rotation and scale of the
+  // estimate about its own first position. A constant heading bias turns a dead-reckoned path
+  // about its start and a DVL scale factor stretches it; no relative measurement (loop closure,
+  // landmark seen twice) can see either, so this is the part of the error side-scan can correct.
+  // No translation is removed: DR starts where the vehicle is known to be.
+  // Closed form over the pairs, with complex numbers n + i e (north, east):
+  //   a_i = p_est_i - p_est_0, b_i = p_truth_i - p_est_0, z = sum(conj(a_i) b_i) / sum |a_i|^2,
+  //   error_i = |b_i - z a_i| (z = 1 when every a_i is zero).
+  // The fit is least squares, so raw^2 = gauge^2 + gauge_free^2 in RMSE (horizontal).
+  ErrorStatistics gauge_free_horizontal_m;
+  ErrorStatistics gauge_horizontal_m;   // |z a_i - a_i|: the raw error the rotation and scale explain
+  double gauge_free_scale = 1.0;        // |z|: truth length / estimate length (a DVL reading 1 % long: ~0.99)
+  // arg z in degrees: the heading turn that takes the estimate onto the truth, clockwise from north
+  // positive like a heading (an estimate whose heading reads b too high gives ~ -b).
+  double gauge_free_rotation_deg = 0.0;
 };
 
 // RPE over one window length (paper-independent, after Sturm et al. 2012 / KITTI): pairs (i, j)
@@ -141,6 +157,7 @@ struct ErrorSample {
   double position_m = 0.0;
   double horizontal_m = 0.0;
   double aligned_horizontal_m = 0.0;
+  double gauge_free_horizontal_m = 0.0;  // after the gauge-free rotation and scale (AteResult)
   double along_track_m = 0.0;   // horizontal error along the truth's heading (+ ahead)
   double across_track_m = 0.0;  // and across it (+ starboard)
   int line = -1;                // survey line index, -1 outside lines
