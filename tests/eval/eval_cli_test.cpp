@@ -107,9 +107,24 @@ TEST_F(EvalCli, EvaluatesTwoEstimatesIntoTableJsonAndFigures) {
     EXPECT_TRUE(dr[key]) << key;
   }
   for (const char* key : {"position_m", "horizontal_m", "vertical_m", "rotation_deg", "aligned_position_m",
-                          "aligned_horizontal_m", "alignment"}) {
+                          "aligned_horizontal_m", "alignment", "gauge_free_horizontal_m", "gauge_horizontal_m",
+                          "gauge_free_scale", "gauge_free_rotation_deg"}) {
     EXPECT_TRUE(dr["ate"][key]) << key;
   }
+  for (const char* key : {"count", "rmse", "mean", "median", "max"}) {
+    EXPECT_TRUE(dr["ate"]["gauge_free_horizontal_m"][key]) << key;
+  }
+  // A 2 m shift is not a rotation or scale: the start keeps all of it, and no fit beats raw.
+  EXPECT_NEAR(dr["series"]["gauge_free_horizontal_m"][0].as<double>(), 2.0, 1e-5);
+  EXPECT_LE(dr["ate"]["gauge_free_horizontal_m"]["rmse"].as<double>(), 2.0 + 1e-5);
+  EXPECT_NE(result.out.find("horiz g-free"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("gauge-free horizontal ATE"), std::string::npos) << result.out;
+  // LCE runs by default with --gt and --est, without --lce.
+  ASSERT_TRUE(json["lce"].IsMap());
+  EXPECT_EQ(json["lce"]["estimates"].size(), 2u);
+  EXPECT_GT(json["lce"]["correspondences"].as<size_t>(), 500u);
+  EXPECT_TRUE(json["lce_skipped"].IsNull());
+  EXPECT_NE(result.out.find("truth (self-check)"), std::string::npos) << result.out;
   for (const char* key : {"count", "rmse", "mean", "median", "max"}) EXPECT_TRUE(dr["ate"]["horizontal_m"][key]) << key;
   EXPECT_NEAR(dr["ate"]["horizontal_m"]["rmse"].as<double>(), 2.0, 1e-5);
   EXPECT_NEAR(dr["ate"]["aligned_horizontal_m"]["rmse"].as<double>(), 0.0, 1e-5);
@@ -121,12 +136,38 @@ TEST_F(EvalCli, EvaluatesTwoEstimatesIntoTableJsonAndFigures) {
   EXPECT_DOUBLE_EQ(dr["rpe"][1]["window_m"].as<double>(), 50.0);
   for (const char* key : {"translation_percent", "translation_m", "rotation_deg"}) EXPECT_TRUE(dr["rpe"][1][key]) << key;
   EXPECT_EQ(dr["lines"].size(), 3u);
-  for (const char* key : {"time_s", "distance_m", "position_m", "horizontal_m", "aligned_horizontal_m", "along_track_m",
-                          "across_track_m", "line"}) {
+  for (const char* key : {"time_s", "distance_m", "position_m", "horizontal_m", "aligned_horizontal_m",
+                          "gauge_free_horizontal_m", "along_track_m", "across_track_m", "line"}) {
     EXPECT_EQ(dr["series"][key].size(), truth_.size()) << key;
   }
   EXPECT_EQ(json["heightmaps"].size(), 0u);
   EXPECT_EQ(json["outputs"]["plots"].size(), 2u);
+}
+
+TEST_F(EvalCli, NoLceTurnsTheDefaultLceOffAndATruthWithoutLinesSkipsIt) {
+  ASSERT_EQ(run("--gt " + path("truth.tum") + " --est " + path("dr.tum") + " --no-lce --json " + path("off.json")).exit_code,
+            0);
+  const YAML::Node off = YAML::LoadFile(path("off.json"));
+  EXPECT_TRUE(off["lce"].IsNull());
+  EXPECT_TRUE(off["lce_skipped"].IsNull());
+  // --lce after --no-lce: the last one wins.
+  ASSERT_EQ(run("--gt " + path("truth.tum") + " --est " + path("dr.tum") + " --no-lce --lce --json " + path("on.json"))
+                .exit_code,
+            0);
+  EXPECT_TRUE(YAML::LoadFile(path("on.json"))["lce"].IsMap());
+
+  // A 40 m straight line has no survey line: the default LCE is skipped with a reason, --lce fails.
+  std::string error;
+  ASSERT_TRUE(writeTum(path("short.tum"), test::straightLine(40.0), error)) << error;
+  ProgramRun result = run("--gt " + path("short.tum") + " --est " + path("short.tum") + " --json " + path("short.json"));
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("LCE) skipped"), std::string::npos) << result.out;
+  const YAML::Node skipped = YAML::LoadFile(path("short.json"));
+  EXPECT_TRUE(skipped["lce"].IsNull());
+  EXPECT_NE(skipped["lce_skipped"].as<std::string>().find("no survey lines"), std::string::npos);
+  result = run("--gt " + path("short.tum") + " --est " + path("short.tum") + " --lce");
+  EXPECT_EQ(result.exit_code, 2);
+  EXPECT_NE(result.err.find("no survey lines"), std::string::npos) << result.err;
 }
 
 TEST_F(EvalCli, ComparesHeightmapsAndWritesErrorMaps) {

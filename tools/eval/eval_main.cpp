@@ -1,5 +1,6 @@
-// sss-eval: trajectory (ATE, RPE, per survey line, LCE), loop-closure, heightmap and matching accuracy
-// against the simulator's ground truth; prints a table, writes the JSON report (keys in report.hpp) and PNG figures.
+// sss-eval: trajectory (ATE raw / aligned / gauge-free, RPE, per survey line, LCE), loop-closure,
+// heightmap and matching accuracy against the simulator's ground truth; prints a table, writes the
+// JSON report (keys in report.hpp) and PNG figures.
 #include "tools/eval/report.hpp"
 
 #include <cerrno>
@@ -19,7 +20,8 @@ const char* kUsage =
     "                [--json OUT.json] [--plot OUT.png] [--error-map PREFIX]\n"
     "                [--time-tolerance-s S] [--max-gap-s S] [--no-interpolation] [--rpe-windows-m 10,50,100]\n"
     "                [--closures loop_closures.csv [--closures-dr DR.tum] [--closure-table]]\n"
-    "                [--lce [--lce-swath-m 10,70] [--lce-grid-m 5] [--lce-max-pairs 20000] [--lce-seabed-depth-m D]]\n"
+    "                [--no-lce | [--lce] [--lce-swath-m 10,70] [--lce-grid-m 5] [--lce-max-pairs 20000]\n"
+    "                            [--lce-seabed-depth-m D]]\n"
     "                [--matches matches.csv --mission MISSION_DIR [--match-table]]\n"
     "TUM lines: 'sec.usec x y z qx qy qz qw' in local NED metres (as sss-sim writes them).\n"
     "--label names the estimates in order (default: file name); the first estimate is the baseline\n"
@@ -34,7 +36,12 @@ const char* kUsage =
     "  (x), lateral (y), depth (z) and heading errors; RMS and max per status (accepted, rejected, ...).\n"
     "  The same for DR's relative pose: --closures-dr DR.tum, by default the first --est.\n"
     "  --closure-table also lists every closure.\n"
-    "--lce: landmark consistency error of the truth (a self-check, ~0) and of every --est, on\n"
+    "Horizontal ATE is given raw, SE(3)-aligned and gauge-free: after the best rotation and scale of the\n"
+    "  estimate about its first position (a heading bias and a DVL scale factor, which no relative\n"
+    "  measurement sees; no shift is removed), with the fitted rotation (deg, clockwise +) and scale.\n"
+    "LCE (on whenever --gt and an --est are given; --no-lce turns it off, --lce also runs it without\n"
+    "  --est and fails when the truth has no survey lines, where the default only skips it):\n"
+    "  landmark consistency error of the truth (a self-check, ~0) and of every --est, on\n"
     "  correspondences made from the truth: seabed points every --lce-grid-m metres, each sighted when\n"
     "  a survey line's fan plane passes over it at a ground range within --lce-swath-m MIN,MAX; two\n"
     "  sightings from different lines make a pair (at most --lce-max-pairs, thinned evenly). Flat\n"
@@ -69,6 +76,7 @@ int main(int argc, char** argv) {
   sss::eval::EvalRequest request;
   sss::eval::EvalOptions options;
   std::vector<std::string> labels, heightmap_labels, estimates, heightmaps;
+  int lce_flag = -1;  // -1: neither --lce nor --no-lce
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--help" || arg == "-h") {
@@ -79,8 +87,8 @@ int main(int argc, char** argv) {
       options.trajectory.association.interpolate_truth = false;
       continue;
     }
-    if (arg == "--lce") {
-      request.lce = true;
+    if (arg == "--lce" || arg == "--no-lce") {
+      lce_flag = arg == "--lce" ? 1 : 0;  // the last one given wins
       continue;
     }
     if (arg == "--closure-table") {
@@ -162,6 +170,9 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  // LCE by default with a truth and an estimate: it is the metric of what side-scan can see.
+  request.lce = lce_flag == 1 || (lce_flag == -1 && !request.truth_path.empty() && !estimates.empty());
+  request.lce_optional = lce_flag == -1;
   if (estimates.empty() && heightmaps.empty() && request.closures_path.empty() && !request.lce &&
       request.matches_path.empty()) {
     std::cerr << "sss-eval: nothing to evaluate: give --gt TRUTH.tum with --est EST.tum, --closures C.csv or --lce,\n"

@@ -332,7 +332,9 @@ bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalR
     report.closures.evaluation = evaluateClosures(closures, report.truth, dr.empty() ? nullptr : &dr, max_gap_s);
   }
 
-  if (request.lce) {
+  if (request.lce && report.lines.empty() && request.lce_optional) {
+    report.lce_skipped = "no survey lines found in the truth (LCE needs straight lines seen from both sides)";
+  } else if (request.lce) {
     if (report.lines.empty()) {
       error = request.truth_path + ": no survey lines found in the truth; --lce needs straight lines seen from both sides";
       return false;
@@ -527,18 +529,33 @@ std::string formatTable(const EvalReport& report) {
                                        ? "RPE"
                                        : "RPE " + cell(report.options.trajectory.rpe.windows_m[rpe_index], 0) + " m";
     std::vector<std::vector<std::string>> rows = {
-        {"estimate", "poses", "ATE raw", "ATE aligned", "horiz ATE", "horiz max", rpe_window, rpe_window, "vs first"},
-        {"", "matched", "RMSE m", "RMSE m", "RMSE m", "m", "mean %", "mean deg", "horiz %"}};
+        {"estimate", "poses", "ATE raw", "ATE aligned", "horiz ATE", "horiz max", "horiz al.", "horiz g-free",
+         rpe_window, rpe_window, "vs first"},
+        {"", "matched", "RMSE m", "RMSE m", "RMSE m", "m", "RMSE m", "RMSE m", "mean %", "mean deg", "horiz %"}};
     for (const EstimateReport& e : report.estimates) {
       const TrajectoryEvaluation& ev = e.evaluation;
       const RpeResult* rpe = ev.rpe.empty() ? nullptr : &ev.rpe[rpe_index];
       rows.push_back({e.input.label, std::to_string(ev.association.pairs.size()) + "/" + std::to_string(ev.estimate_poses),
                       cell(ev.ate.position_m.rmse, 3), cell(ev.ate.aligned_position_m.rmse, 3),
                       cell(ev.ate.horizontal_m.rmse, 3), cell(ev.ate.horizontal_m.max, 3),
+                      cell(ev.ate.aligned_horizontal_m.rmse, 3), cell(ev.ate.gauge_free_horizontal_m.rmse, 3),
                       rpe ? cell(rpe->translation_percent.mean, 3) : "-", rpe ? cell(rpe->rotation_deg.mean, 3) : "-",
                       std::isfinite(e.improvement_vs_first_percent) ? cell(e.improvement_vs_first_percent, 1) : "-"});
     }
     out << "\n" << formatColumns(rows);
+    // What no relative measurement sees: the rotation and scale about each estimate's start.
+    out << "\ngauge-free horizontal ATE: after the best rotation (clockwise +) and scale about the estimate's first "
+           "position, no shift;\ngauge = the raw error they explain (raw^2 = gauge^2 + gauge-free^2)\n";
+    std::vector<std::vector<std::string>> gauge_rows = {
+        {"estimate", "rotation", "scale", "gauge", "gauge-free", "gauge-free", "gauge-free"},
+        {"", "deg", "", "RMSE m", "RMSE m", "mean m", "max m"}};
+    for (const EstimateReport& e : report.estimates) {
+      const AteResult& ate = e.evaluation.ate;
+      gauge_rows.push_back({e.input.label, cell(ate.gauge_free_rotation_deg, 4), cell(ate.gauge_free_scale, 5),
+                            cell(ate.gauge_horizontal_m.rmse, 3), cell(ate.gauge_free_horizontal_m.rmse, 3),
+                            cell(ate.gauge_free_horizontal_m.mean, 3), cell(ate.gauge_free_horizontal_m.max, 3)});
+    }
+    out << formatColumns(gauge_rows);
     if (!report.lines.empty()) {
       out << "\nhorizontal ATE RMSE per survey line (m, raw)\n";
       std::vector<std::vector<std::string>> line_rows(1);
@@ -574,6 +591,7 @@ std::string formatTable(const EvalReport& report) {
   }
   if (report.has_closures) out << "\n" << formatClosureTable(report);
   if (report.has_lce) out << "\n" << formatLceTable(report.lce, report.options.lce);
+  if (!report.lce_skipped.empty()) out << "\nlandmark consistency error (LCE) skipped: " << report.lce_skipped << "\n";
   if (report.has_matches) out << "\n" << formatMatchTable(report.matches, report.options.match_table);
   return out.str();
 }
@@ -647,6 +665,10 @@ std::string reportJson(const EvalReport& report) {
     json.key("rotation_deg").value(ev.ate.alignment_rotation_deg);
     json.key("heading_deg").value(ev.ate.alignment_heading_deg);
     json.endObject();
+    writeErrorStatistics(json, "gauge_free_horizontal_m", ev.ate.gauge_free_horizontal_m);
+    writeErrorStatistics(json, "gauge_horizontal_m", ev.ate.gauge_horizontal_m);
+    json.key("gauge_free_scale").value(ev.ate.gauge_free_scale);
+    json.key("gauge_free_rotation_deg").value(ev.ate.gauge_free_rotation_deg);
     json.endObject();
 
     json.key("rpe").beginArray();
@@ -672,7 +694,7 @@ std::string reportJson(const EvalReport& report) {
     json.endArray();
     json.key("improvement_vs_first_percent").value(e.improvement_vs_first_percent);
 
-    std::vector<double> time, distance, position, horizontal, aligned, along, across, line;
+    std::vector<double> time, distance, position, horizontal, aligned, gauge_free, along, across, line;
     const int64_t t0 = report.truth.front().utime_us;
     for (const ErrorSample& s : ev.series) {
       time.push_back(static_cast<double>(s.utime_us - t0) * 1e-6);
@@ -680,6 +702,7 @@ std::string reportJson(const EvalReport& report) {
       position.push_back(s.position_m);
       horizontal.push_back(s.horizontal_m);
       aligned.push_back(s.aligned_horizontal_m);
+      gauge_free.push_back(s.gauge_free_horizontal_m);
       along.push_back(s.along_track_m);
       across.push_back(s.across_track_m);
       line.push_back(s.line);
@@ -690,6 +713,7 @@ std::string reportJson(const EvalReport& report) {
     json.key("position_m").numbers(position, 5);
     json.key("horizontal_m").numbers(horizontal, 5);
     json.key("aligned_horizontal_m").numbers(aligned, 5);
+    json.key("gauge_free_horizontal_m").numbers(gauge_free, 5);
     json.key("along_track_m").numbers(along, 5);
     json.key("across_track_m").numbers(across, 5);
     json.key("line").numbers(line, 5);
@@ -723,6 +747,8 @@ std::string reportJson(const EvalReport& report) {
   else json.key("closures").null();
   if (report.has_lce) writeLceJson(json, report.lce, report.options.lce);
   else json.key("lce").null();
+  if (report.lce_skipped.empty()) json.key("lce_skipped").null();
+  else json.key("lce_skipped").value(report.lce_skipped);
   if (report.has_matches) writeMatchesJson(json, report.matches);
   else json.key("matches").null();
 

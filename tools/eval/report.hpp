@@ -16,12 +16,17 @@
 //     "ate": {"position_m": stats, "horizontal_m": stats, "vertical_m": stats, "rotation_deg": stats,
 //             "aligned_position_m": stats, "aligned_horizontal_m": stats,
 //             "alignment": {"translation_m": [n, e, d], "quaternion_xyzw": [x, y, z, w],
-//                           "rotation_deg", "heading_deg"}},
+//                           "rotation_deg", "heading_deg"},
+//             "gauge_free_horizontal_m": stats (after the best rotation and scale about the
+//             estimate's first position, no shift; AteResult), "gauge_horizontal_m": stats (the raw
+//             error that rotation and scale explain), "gauge_free_scale", "gauge_free_rotation_deg"
+//             (clockwise from north positive)},
 //     "rpe": [{"window_m", "translation_percent": stats, "translation_m": stats, "rotation_deg": stats}],
 //     "lines": [{"index", "horizontal_m": stats, "position_m": stats, "aligned_horizontal_m": stats}],
 //     "improvement_vs_first_percent": (first horizontal ATE RMSE - this) / first * 100, null for the first,
 //     "series": {"time_s" (since the truth's first pose), "distance_m", "position_m", "horizontal_m",
-//                "aligned_horizontal_m", "along_track_m", "across_track_m", "line" (-1 off lines)}
+//                "aligned_horizontal_m", "gauge_free_horizontal_m", "along_track_m", "across_track_m",
+//                "line" (-1 off lines)}
 //   }],
 //   "heightmaps": [{"label", "path", "estimate_cells", "cells_with_data", "compared_cells",
 //                   "coverage_fraction", "covered_area_m2", "abs_error_m": stats (MAE = mean),
@@ -36,11 +41,13 @@
 //     errors = {"along_m", "lateral_m", "depth_m", "heading_deg": stats of |error| + "bias" (mean
 //               signed error), "horizontal_m": stats of |(along, lateral)|};
 //     component = {"along_m", "lateral_m", "depth_m", "heading_deg"} (signed)
-//   "lce": null | {  (--lce; landmark consistency error on correspondences made from the truth)
+//   "lce": null | {  (landmark consistency error on correspondences made from the truth; sss-eval
+//                     computes it whenever there are --gt and --est, unless --no-lce)
 //     "seabed_depth_m", "seabed_depth_source", "grid_m", "min_ground_range_m", "max_ground_range_m",
 //     "max_correspondences", "sightings", "seabed_points", "candidate_pairs", "correspondences",
 //     "truth": {"horizontal_m": stats, "skipped"} (the self-check, ~0),
 //     "estimates": [{"label", "horizontal_m": stats, "skipped"}]},
+//   "lce_skipped": null | why the LCE asked for by default was not computed (no survey lines),
 //   "matches": null | {  (--matches matches.csv --mission DIR; end-point error against the simulator's truth,
 //                         px of the matching image: rows = pings, columns = decimation bins)
 //     "path", "mission", "decimation", "stride", "probe_step", "matching_pixel_m", "subframes",
@@ -83,6 +90,7 @@ struct EvalRequest {
   std::string closures_path;           // loop_closures.csv of sss-process; needs the truth
   std::string closures_dr_path;        // DR trajectory for the closures' baseline; empty: the first estimate
   bool lce = false;                    // landmark consistency of the truth and every estimate
+  bool lce_optional = false;           // lce by default, not asked for: no survey lines skips it, not an error
   std::string matches_path;            // matches.csv of sss-process --write-matches; needs mission_dir
   std::string mission_dir;             // the sss-sim folder (mission.yaml) the matches are evaluated against
 };
@@ -144,6 +152,7 @@ struct EvalReport {
   ClosureReport closures;
   bool has_lce = false;
   LceReport lce;
+  std::string lce_skipped;  // why an optional LCE was not computed; empty otherwise
   bool has_matches = false;  // filled by evaluateMatchFile (sss-eval), not runEvaluation
   MatchFileEvaluation matches;
   std::vector<std::string> plots;  // figure files written
@@ -160,7 +169,8 @@ bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalR
 bool writeFigures(const EvalRequest& request, EvalReport& report, std::string& error);
 
 // The aligned terminal table: one row per estimate (ATE RMSE raw and aligned, horizontal ATE RMSE
-// and max, RPE, improvement vs the first estimate), per-line horizontal RMSE, heightmaps, closure
+// and max, horizontal aligned and gauge-free RMSE, RPE, improvement vs the first estimate), the
+// gauge fit per estimate (rotation, scale, gauge and gauge-free error), per-line horizontal RMSE, heightmaps, closure
 // errors per status (and per closure with options.closure_table), LCE per trajectory, match accuracy per
 // pair type (and per pair with options.match_table).
 std::string formatTable(const EvalReport& report);
