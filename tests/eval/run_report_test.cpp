@@ -190,6 +190,14 @@ TEST_F(RunReport, WritesEveryFigureAndMetricsMatchTheKnownErrors) {
   EXPECT_NEAR(trajectory["slam"]["ate_horizontal_m"]["rmse"].as<double>(), 0.1, 0.01);
   EXPECT_NEAR(trajectory["slam"]["ate_horizontal_m"]["max"].as<double>(), 0.1, 0.01);
   EXPECT_NEAR(trajectory["slam"]["ate_aligned_horizontal_m"]["rmse"].as<double>(), 0.0, 0.01);
+  // Gauge-free keeps a shift (only rotation and scale about the start are fitted): 0.1 m at the start.
+  EXPECT_GT(trajectory["slam"]["ate_gauge_free_horizontal_m"]["max"].as<double>(), 0.09);
+  EXPECT_LE(trajectory["slam"]["ate_gauge_free_horizontal_m"]["rmse"].as<double>(),
+            trajectory["slam"]["ate_horizontal_m"]["rmse"].as<double>() + 1e-9);
+  for (const char* key : {"gauge_free_scale", "gauge_free_rotation_deg"}) EXPECT_TRUE(trajectory["dr"][key]) << key;
+  EXPECT_TRUE(trajectory["ate_gauge_free_horizontal_rmse_improvement_percent"]);
+  EXPECT_NE(result.out.find("gauge-free"), std::string::npos) << result.out;
+  EXPECT_NE(html.find("ATE horizontal RMSE, gauge-free"), std::string::npos);
   const double dr_rmse = trajectory["dr"]["ate_horizontal_m"]["rmse"].as<double>();
   EXPECT_GT(dr_rmse, 0.3);  // 10x the default drift over ~300 m
   EXPECT_NEAR(trajectory["ate_horizontal_rmse_improvement_percent"].as<double>(),

@@ -536,6 +536,15 @@ std::vector<Table> metricTables(const RunReport& report, const RunReportOptions&
   row("ATE horizontal max", d.horizontal_m.max, s.horizontal_m.max, " m", 3);
   row("ATE horizontal RMSE, SE(3)-aligned", d.aligned_horizontal_m.rmse, s.aligned_horizontal_m.rmse, " m", 3);
   row("ATE horizontal max, SE(3)-aligned", d.aligned_horizontal_m.max, s.aligned_horizontal_m.max, " m", 3);
+  row("ATE horizontal RMSE, gauge-free", d.gauge_free_horizontal_m.rmse, s.gauge_free_horizontal_m.rmse, " m", 3);
+  row("ATE horizontal max, gauge-free", d.gauge_free_horizontal_m.max, s.gauge_free_horizontal_m.max, " m", 3);
+  // The fitted gauge itself: no better or worse, so no improvement cell.
+  trajectory.rows.push_back({{"gauge fit: rotation about the start (clockwise +)"},
+                             {fixed(d.gauge_free_rotation_deg, 4) + " deg"},
+                             {fixed(s.gauge_free_rotation_deg, 4) + " deg"},
+                             {""}});
+  trajectory.rows.push_back(
+      {{"gauge fit: scale about the start"}, {fixed(d.gauge_free_scale, 5)}, {fixed(s.gauge_free_scale, 5)}, {""}});
   row("ATE 3D RMSE", d.position_m.rmse, s.position_m.rmse, " m", 3);
   if (!report.dr.rpe.empty() && !report.slam.rpe.empty()) {
     const std::string window = fixed(report.rpe_window_m, 0) + " m";
@@ -640,6 +649,9 @@ Table keyTable(const RunReport& report, const RunReportOptions& options) {
   table.rows.push_back({{"after SE(3) alignment (shape)"}, {metres(report.dr.ate.aligned_horizontal_m.rmse)},
                         {metres(report.slam.ate.aligned_horizontal_m.rmse)},
                         improvementCell(report.aligned_ate_improvement_percent, same)});
+  table.rows.push_back({{"gauge-free (what side-scan can see)"}, {metres(report.dr.ate.gauge_free_horizontal_m.rmse)},
+                        {metres(report.slam.ate.gauge_free_horizontal_m.rmse)},
+                        improvementCell(report.gauge_free_ate_improvement_percent, same)});
   if (report.heightmap_dr.present || report.heightmap_slam.present) {
     table.rows.push_back({{"heightmap MAE"},
                           {report.heightmap_dr.present ? metres(report.heightmap_dr.error.abs_error_m.mean) : "-"},
@@ -741,7 +753,9 @@ std::string renderHtml(const RunReport& report, const RunReportRequest& request,
   out << "<h2>6. Metrics</h2>\n";
   out << "<p class=\"small\">improvement = (DR - SLAM) / DR; green: SLAM better, red: SLAM worse. ATE: absolute "
          "trajectory error against the truth at the same time stamps; SE(3)-aligned: after the best rigid alignment "
-         "of the whole trajectory. RPE: relative pose error over the given path length.</p>\n";
+         "of the whole trajectory; gauge-free: after the best horizontal rotation and scale about the estimate's first "
+         "position, without a shift (what a constant heading bias and a DVL scale factor do, which no loop closure "
+         "sees). RPE: relative pose error over the given path length.</p>\n";
   for (const Table& table : tables) out << htmlTable(table);
   out << "<h2>Inputs</h2>\n<ul class=\"small\">\n";
   for (const std::string& input : inputs) out << "<li>" << htmlEscape(input) << "</li>\n";
@@ -933,6 +947,8 @@ RunReport writeRunReport(const RunReportRequest& request, const RunReportOptions
     report.ate_improvement_percent = improvementPercent(report.dr.ate.horizontal_m.rmse, report.slam.ate.horizontal_m.rmse);
     report.aligned_ate_improvement_percent =
         improvementPercent(report.dr.ate.aligned_horizontal_m.rmse, report.slam.ate.aligned_horizontal_m.rmse);
+    report.gauge_free_ate_improvement_percent =
+        improvementPercent(report.dr.ate.gauge_free_horizontal_m.rmse, report.slam.ate.gauge_free_horizontal_m.rmse);
 
     // Optional inputs: each missing or unusable one becomes a note.
     readHeightmaps(report, request);
@@ -1052,6 +1068,15 @@ std::string formatRunTable(const RunReport& report) {
   std::vector<std::vector<std::string>> rows = {{"", "DR", "SLAM", "improvement"}};
   rows.push_back({"horizontal ATE RMSE", metres(report.dr.ate.horizontal_m.rmse), metres(report.slam.ate.horizontal_m.rmse),
                   percent(report.ate_improvement_percent, true)});
+  rows.push_back({"  SE(3)-aligned", metres(report.dr.ate.aligned_horizontal_m.rmse),
+                  metres(report.slam.ate.aligned_horizontal_m.rmse), percent(report.aligned_ate_improvement_percent, true)});
+  rows.push_back({"  gauge-free", metres(report.dr.ate.gauge_free_horizontal_m.rmse),
+                  metres(report.slam.ate.gauge_free_horizontal_m.rmse),
+                  percent(report.gauge_free_ate_improvement_percent, true)});
+  if (report.has_lce) {
+    rows.push_back({"LCE mean", metres(report.lce_dr.mean), metres(report.lce_slam.mean),
+                    percent(improvementPercent(report.lce_dr.mean, report.lce_slam.mean), true)});
+  }
   rows.push_back({"heightmap MAE", report.heightmap_dr.present ? metres(report.heightmap_dr.error.abs_error_m.mean) : "-",
                   report.heightmap_slam.present ? metres(report.heightmap_slam.error.abs_error_m.mean) : "-",
                   percent(report.heightmap_improvement_percent, true)});
@@ -1101,6 +1126,9 @@ std::string runReportJson(const RunReport& report, const RunReportRequest& reque
     json.key("matched").value(static_cast<uint64_t>(evaluation->association.pairs.size()));
     writeErrorStatistics(json, "ate_horizontal_m", evaluation->ate.horizontal_m);
     writeErrorStatistics(json, "ate_aligned_horizontal_m", evaluation->ate.aligned_horizontal_m);
+    writeErrorStatistics(json, "ate_gauge_free_horizontal_m", evaluation->ate.gauge_free_horizontal_m);
+    json.key("gauge_free_scale").value(evaluation->ate.gauge_free_scale);
+    json.key("gauge_free_rotation_deg").value(evaluation->ate.gauge_free_rotation_deg);
     writeErrorStatistics(json, "ate_position_m", evaluation->ate.position_m);
     const bool has_rpe = report.rpe_index < evaluation->rpe.size();
     json.key("rpe_translation_percent").value(has_rpe ? evaluation->rpe[report.rpe_index].translation_percent.mean : kNaN);
@@ -1117,6 +1145,7 @@ std::string runReportJson(const RunReport& report, const RunReportRequest& reque
   }
   json.key("ate_horizontal_rmse_improvement_percent").value(report.ate_improvement_percent);
   json.key("ate_aligned_horizontal_rmse_improvement_percent").value(report.aligned_ate_improvement_percent);
+  json.key("ate_gauge_free_horizontal_rmse_improvement_percent").value(report.gauge_free_ate_improvement_percent);
   json.endObject();
 
   if (report.heightmap_dr.present || report.heightmap_slam.present) {

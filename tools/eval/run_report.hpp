@@ -14,10 +14,13 @@
 //   "trajectory": {"truth_path", "truth_poses", "duration_s", "distance_m",
 //                  "lines": [{"index", "length_m", "heading_deg"}], "rpe_window_m",
 //                  "dr" | "slam": {"path", "poses", "matched", "ate_horizontal_m": stats,
-//                      "ate_aligned_horizontal_m": stats, "ate_position_m": stats,
+//                      "ate_aligned_horizontal_m": stats, "ate_gauge_free_horizontal_m": stats (after the best
+//                      rotation and scale about the estimate's start, no shift; AteResult), "gauge_free_scale",
+//                      "gauge_free_rotation_deg", "ate_position_m": stats,
 //                      "rpe_translation_percent", "rpe_rotation_deg" (means over the RPE window),
 //                      "lines": [{"index", "horizontal_rmse_m"}]},
-//                  "ate_horizontal_rmse_improvement_percent", "ate_aligned_horizontal_rmse_improvement_percent"},
+//                  "ate_horizontal_rmse_improvement_percent", "ate_aligned_horizontal_rmse_improvement_percent",
+//                  "ate_gauge_free_horizontal_rmse_improvement_percent"},
 //   "heightmap": null | {"seabed_path", "dr" | "slam": null | {"path", "mae_m", "rmse_m", "median_m", "max_m",
 //                        "bias_m", "coverage_fraction", "compared_cells"}, "mae_improvement_percent"},
 //   "closures": null | {"path", "accepted", "rejected", "pending", "superseded", "total",
@@ -143,6 +146,7 @@ struct RunReport {
   double rpe_window_m = std::numeric_limits<double>::quiet_NaN();
   double ate_improvement_percent = std::numeric_limits<double>::quiet_NaN();
   double aligned_ate_improvement_percent = std::numeric_limits<double>::quiet_NaN();
+  double gauge_free_ate_improvement_percent = std::numeric_limits<double>::quiet_NaN();
 
   std::string seabed_path;  // empty when no seabed was read
   RunHeightmap heightmap_dr;
@@ -176,8 +180,8 @@ struct RunReport {
 // Reads every input, computes the metrics and writes the report. Never throws for bad input.
 RunReport writeRunReport(const RunReportRequest& request, const RunReportOptions& options = {});
 
-// The short terminal table: horizontal ATE RMSE DR / SLAM / improvement, heightmap MAE, closures,
-// real-time factor, the path of index.html.
+// The short terminal table: horizontal ATE RMSE (raw, SE(3)-aligned, gauge-free) and LCE mean DR /
+// SLAM / improvement, heightmap MAE, closures, real-time factor, the path of index.html.
 std::string formatRunTable(const RunReport& report);
 
 // metrics.json as described at the top of this file.
