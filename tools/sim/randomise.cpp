@@ -165,9 +165,10 @@ SimOptions randomiseMission(const RandomiseOptions& request) {
   // Vehicle.
   TrajectoryOptions& t = o.trajectory;
   t.altitude_m = std::clamp(std::round(sonar.range_m * draw.uniform(0.08, 0.2)), 6.0, 40.0);
-  sonar.noise_intensity_at_max_range = farRangeSandEcho(sonar, t.altitude_m) * std::pow(10.0, -snr_db / 10.0);
+  const double far_echo = farRangeSandEcho(sonar, t.altitude_m);
+  sonar.noise_intensity_at_max_range = far_echo * std::pow(10.0, -snr_db / 10.0);
   // Water column from near black to the grey of the real Iver2 file (-7 dB re its seabed mean).
-  sonar.volume_backscatter = farRangeSandEcho(sonar, t.altitude_m) * std::pow(10.0, draw.uniform(-20.0, 2.0) / 10.0);
+  sonar.volume_backscatter = far_echo * std::pow(10.0, draw.uniform(-20.0, 2.0) / 10.0);
   t.speed_m_s = draw.uniform(1.5, 2.5);
   t.roll_amplitude_rad = draw.uniform(0.004, 0.04);
   t.roll_period_s = draw.uniform(6.0, 20.0);
