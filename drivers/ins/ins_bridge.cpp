@@ -9,10 +9,19 @@
 namespace sss::ins {
 
 InsBridge::InsBridge(const InsBridgeOptions& options)
-    : options_(options),
-      plane_(options.origin_latitude_deg, options.origin_longitude_deg),
-      parser_(options.stream),
-      assembler_(options.assembler) {}
+    : options_(options), parser_(options.stream), assembler_(options.assembler) {
+  if (options.origin) setOrigin(*options.origin, sss::core::OriginSource::kConfigured);
+}
+
+void InsBridge::setOrigin(const sss::core::MissionOrigin& origin, sss::core::OriginSource source) {
+  origin_ = origin;
+  origin_source_ = source;
+  plane_.emplace(origin.latitude_deg, origin.longitude_deg);
+}
+
+void InsBridge::resumeOrigin(const sss::core::MissionOrigin& origin) {
+  if (!origin_) setOrigin(origin, sss::core::OriginSource::kResumed);
+}
 
 void InsBridge::onBytes(const uint8_t* data, size_t size, int64_t host_monotonic_us, std::vector<NavSample>& out) {
   sentences_.clear();
@@ -49,11 +58,16 @@ void InsBridge::emit(const InsState& state, int64_t host_monotonic_us, std::vect
 
   NavSample sample;
   sample.ins = state;
-  sample.position_ned_m = plane_.toNed({state.latitude_deg, state.longitude_deg, state.depth_m});
+  if (!plane_ && (state.validity & kValidPosition) &&
+      sss::core::isFirstFixCandidate(state.latitude_deg, state.longitude_deg)) {
+    setOrigin({state.latitude_deg, state.longitude_deg}, sss::core::OriginSource::kFirstFix);
+  }
+  sample.origin = origin_;
+  if (plane_) sample.position_ned_m = plane_->toNed({state.latitude_deg, state.longitude_deg, state.depth_m});
   const Eigen::Quaterniond q_world_body = sss::core::quaternionFromEuler(state.roll_rad, state.pitch_rad, state.heading_rad);
   const Eigen::Vector3d velocity_ned(state.velocity_north_m_s, state.velocity_east_m_s, state.velocity_down_m_s);
   sample.velocity_body_m_s = q_world_body.conjugate() * velocity_ned;
-  if (state.validity & kValidPosition) {
+  if ((state.validity & kValidPosition) && plane_) {
     // After a resume, the saved position counts only if it is recent (a restart, not another dive).
     const double gap_s = static_cast<double>(state.utime_us - last_position_utime_us_) * 1e-6;
     const bool counts = !resumed_ || (gap_s >= 0.0 && gap_s <= options_.odometer_max_bridged_gap_s);

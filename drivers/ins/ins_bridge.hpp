@@ -13,12 +13,14 @@
 #include "drivers/ins/nmea_stream_parser.hpp"
 #include "pipeline/core/config.hpp"
 #include "pipeline/core/geodesy.hpp"
+#include "pipeline/core/mission_origin.hpp"
 
 namespace sss::ins {
 
 struct InsBridgeOptions {
-  double origin_latitude_deg = 59.35;   // mission origin of the local NED frame
-  double origin_longitude_deg = 18.07;
+  // The origin of the local NED frame (mission.origin_*): an override; unset, the first valid
+  // position fixes it (see pipeline/core/mission_origin.hpp).
+  std::optional<sss::core::MissionOrigin> origin;
   InsAssemblerOptions assembler;
   NmeaStreamOptions stream;
   // A restarted bridge resumes its odometer; the path from the last saved position to the first
@@ -37,7 +39,8 @@ struct OdometerState {
 
 struct NavSample {
   InsState ins;                          // as assembled (geodetic, attitude, NED velocity, std)
-  Eigen::Vector3d position_ned_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d position_ned_m = Eigen::Vector3d::Zero();  // zero until the origin is known
+  std::optional<sss::core::MissionOrigin> origin;            // of position_ned_m; none before the first fix
   Eigen::Vector3d velocity_body_m_s = Eigen::Vector3d::Zero();  // FRD
   double distance_travelled_m = 0.0;     // horizontal path length of the DR track so far
 };
@@ -64,6 +67,12 @@ class InsBridge {
   const InsAssemblerCounters& assemblerCounters() const { return assembler_.counters(); }
   uint64_t epochsOutOfOrder() const { return epochs_out_of_order_; }
 
+  // The origin in use and where it came from; nullopt until configured, resumed or fixed.
+  const std::optional<sss::core::MissionOrigin>& origin() const { return origin_; }
+  sss::core::OriginSource originSource() const { return origin_source_; }
+  // Before the first sample, when no origin is configured: keep the frame of an earlier run.
+  void resumeOrigin(const sss::core::MissionOrigin& origin);
+
   OdometerState odometer() const;
   // Before the first sample: continue the odometer of an earlier run.
   void resumeOdometer(const OdometerState& state);
@@ -72,8 +81,12 @@ class InsBridge {
   void assemble(std::vector<std::string>& sentences, int64_t host_monotonic_us, std::vector<NavSample>& out);
   void emit(const InsState& state, int64_t host_monotonic_us, std::vector<NavSample>& out);
 
+  void setOrigin(const sss::core::MissionOrigin& origin, sss::core::OriginSource source);
+
   InsBridgeOptions options_;
-  sss::core::LocalTangentPlane plane_;
+  std::optional<sss::core::MissionOrigin> origin_;
+  sss::core::OriginSource origin_source_ = sss::core::OriginSource::kFirstFix;
+  std::optional<sss::core::LocalTangentPlane> plane_;
   NmeaStreamParser parser_;
   InsStateAssembler assembler_;
   std::vector<std::string> sentences_;  // reused
@@ -87,7 +100,7 @@ class InsBridge {
   std::vector<std::string> reported_;  // fault kinds already handed out
 };
 
-// Reads the ins_bridge section's library keys and the mission origin.
+// Reads the ins_bridge section's library keys (the origin is the mission section's).
 void readInsBridgeOptions(sss::core::ConfigSection& section, InsBridgeOptions& options);
 
 }  // namespace sss::ins

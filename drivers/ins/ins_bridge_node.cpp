@@ -17,6 +17,7 @@
 
 #include "drivers/ins/ins_bridge.hpp"
 #include "drivers/ins/nav_message.hpp"
+#include "pipeline/core/mission_origin.hpp"
 #include "pipeline/core/state_file.hpp"
 #include "pipeline/core/time.hpp"
 #include "pipeline/transport/logging.hpp"
@@ -158,8 +159,7 @@ int main(int argc, char** argv) {
     using namespace sss::core;
     Config config = Config::fromFile(config_path);
     ConfigSection mission = config.section("mission");
-    mission.optional("origin_latitude_deg", options.bridge.origin_latitude_deg, {inRange(-90.0, 90.0)});
-    mission.optional("origin_longitude_deg", options.bridge.origin_longitude_deg, {inRange(-180.0, 180.0)});
+    options.bridge.origin = sss::core::readMissionOrigin(mission);
     ConfigSection section = config.section("ins_bridge");
     sss::transport::readProcessOptions(section, options.process);
     sss::ins::readInsBridgeOptions(section, options.bridge);
@@ -198,6 +198,32 @@ int main(int argc, char** argv) {
       : sss::core::resolveSystemdDirectory(options.state_directory, std::getenv("STATE_DIRECTORY"));
   const std::string odometer_path = state_directory.empty() ? "" : state_directory + "/odometer";
   if (!odometer_path.empty()) loadOdometer(odometer_path, bridge);
+  // The mission origin: configured, else kept from an earlier run (a restart mid-mission must not
+  // move the frame), else the first fix, saved as soon as it is chosen.
+  const std::string origin_path = state_directory.empty() ? "" : state_directory + "/origin";
+  if (bridge.origin()) {
+    spdlog::info("mission origin (configured): {:.7f} {:.7f}", bridge.origin()->latitude_deg, bridge.origin()->longitude_deg);
+  } else if (!origin_path.empty() && access(origin_path.c_str(), F_OK) == 0) {
+    std::string origin_error;
+    if (const auto kept = sss::core::readOriginState(origin_path, origin_error)) {
+      bridge.resumeOrigin(*kept);
+      spdlog::info("mission origin kept from {}: {:.7f} {:.7f} (delete the file to start a new mission frame)",
+                   origin_path, kept->latitude_deg, kept->longitude_deg);
+    } else {
+      spdlog::error("mission origin not resumed, the first fix sets a new one: {}", origin_error);
+    }
+  }
+  bool origin_announced = bridge.origin().has_value();
+  auto announceOrigin = [&] {
+    if (origin_announced || !bridge.origin()) return;
+    origin_announced = true;
+    const sss::core::MissionOrigin origin = *bridge.origin();
+    spdlog::info("mission origin (first INS fix): {:.7f} {:.7f}", origin.latitude_deg, origin.longitude_deg);
+    std::string origin_error;
+    if (!origin_path.empty() && !sss::core::writeOriginState(origin_path, origin, origin_error)) {
+      spdlog::error("mission origin not saved (a restart would choose a new one): {}", origin_error);
+    }
+  };
   int64_t saved_odometer_utime_us = -1;
   uint64_t odometer_write_failures = 0;
   auto saveOdometerIfMoved = [&] {
@@ -213,6 +239,7 @@ int main(int argc, char** argv) {
   loop.addTimer(1.0, saveOdometerIfMoved);
 
   auto publishAll = [&](int64_t since_us) {
+    announceOrigin();
     for (const auto& sample : samples) {
       loop.bus().publish(options.nav_channel, sss::ins::toNavMessage(sample), since_us);
     }

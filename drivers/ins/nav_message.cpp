@@ -1,6 +1,8 @@
 // NavSample -> nav_t, see nav_message.hpp.
 #include "drivers/ins/nav_message.hpp"
 
+#include <limits>
+
 namespace sss::ins {
 
 sss_msgs::nav_t toNavMessage(const NavSample& sample, uint32_t extra_stale) {
@@ -14,6 +16,9 @@ sss_msgs::nav_t toNavMessage(const NavSample& sample, uint32_t extra_stale) {
     nav.position_ned_m[i] = sample.position_ned_m[i];
     nav.velocity_body_m_s[i] = sample.velocity_body_m_s[i];
   }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  nav.origin_latitude_deg = sample.origin ? sample.origin->latitude_deg : nan;
+  nav.origin_longitude_deg = sample.origin ? sample.origin->longitude_deg : nan;
   nav.roll_rad = s.roll_rad;
   nav.pitch_rad = s.pitch_rad;
   nav.heading_rad = s.heading_rad;

@@ -216,7 +216,7 @@ bool writeHeightmapPng(const std::string& path, const HeightmapGrid& grid, std::
 }  // namespace
 
 bool writeHeightmapFiles(const std::string& yaml_path, const HeightmapGrid& grid, const std::string& description,
-                         std::string& error) {
+                         std::string& error, const std::optional<sss::core::MissionOrigin>& origin) {
   if (grid.rows < 1 || grid.cols < 1 || grid.depth_m.size() != static_cast<size_t>(grid.rows) * grid.cols) {
     error = "heightmap " + yaml_path + " has no cells (no seabed points)";
     return false;
@@ -239,6 +239,10 @@ bool writeHeightmapFiles(const std::string& yaml_path, const HeightmapGrid& grid
        << "\nnorth_min_m: " << grid.north_min_m << "\neast_min_m: " << grid.east_min_m
        << "\ndepth_file: " << std::filesystem::path(depth_path).filename().string()
        << "\ndepth_units: \"metres below the origin (NED z, positive down)\"\n";
+  if (origin) {
+    yaml.precision(15);
+    yaml << "origin_latitude_deg: " << origin->latitude_deg << "\norigin_longitude_deg: " << origin->longitude_deg << "\n";
+  }
   std::ofstream out(prefix + ".yaml");
   out << yaml.str();
   if (!out) {

@@ -53,7 +53,7 @@ std::vector<std::string> validateOptimiserEngineOptions(const OptimiserEngineOpt
 }
 
 bool writeTum(const std::string& path, const std::vector<StampedPose>& poses, const std::string& comment,
-              std::string& error) {
+              std::string& error, const std::optional<sss::core::MissionOrigin>& origin) {
   std::FILE* f = std::fopen(path.c_str(), "w");
   if (!f) {
     error = "cannot write " + path;
@@ -61,6 +61,7 @@ bool writeTum(const std::string& path, const std::vector<StampedPose>& poses, co
   }
   std::fprintf(f, "# %s\n# timestamp_s north_m east_m down_m qx qy qz qw (T_world_body, local NED of the mission origin)\n",
                comment.c_str());
+  if (origin) std::fprintf(f, "%s\n", sss::core::originCommentLine(*origin).c_str());
   for (const StampedPose& p : poses) {
     const auto& q = p.T_world_body.rotation;
     const auto& t = p.T_world_body.translation;

@@ -9,11 +9,13 @@
 #include <deque>
 #include <map>
 #include <set>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "pipeline/core/config.hpp"
+#include "pipeline/core/mission_origin.hpp"
 #include "pipeline/core/pose.hpp"
 #include "pipeline/matcher/matcher_engine.hpp"
 #include "pipeline/optimiser/bathymetry.hpp"
@@ -57,9 +59,10 @@ struct StampedPose {
   sss::core::Pose T_world_body;
 };
 
-// Writes poses as TUM (timestamp_s north east down qx qy qz qw, local NED) with a comment line.
+// Writes poses as TUM (timestamp_s north east down qx qy qz qw, local NED) with a comment line
+// and, when known, the line naming the frame's origin (pipeline/core/mission_origin.hpp).
 bool writeTum(const std::string& path, const std::vector<StampedPose>& poses, const std::string& comment,
-              std::string& error);
+              std::string& error, const std::optional<sss::core::MissionOrigin>& origin = std::nullopt);
 
 // One closure for the loop_closures.csv table: the graph's record and the two centres under the
 // current estimate.

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "pipeline/core/geodesy.hpp"
+#include "pipeline/core/mission_origin.hpp"
 #include "pipeline/core/state_file.hpp"
 #include "pipeline/core/time.hpp"
 #include "pipeline/matcher/loop_closure_message.hpp"
@@ -46,8 +47,9 @@ using sss::optimiser::SlidingWindowPoseGraph;
 struct NodeOptions {
   sss::transport::ProcessOptions process;
   sss::optimiser::OptimiserEngineOptions engine;
-  double origin_latitude_deg = 59.35;
-  double origin_longitude_deg = 18.07;
+  // Only to check the configuration: poses are geo-referenced with the origin each SSS_NAV
+  // sample carries (the frame its NED position is in; the INS bridge's choice).
+  std::optional<sss::core::MissionOrigin> configured_origin;
   std::string subframe_channel = "SSS_SUBFRAME";
   std::string loop_channel = "SSS_LOOP";
   std::string nav_channel = "SSS_NAV";
@@ -76,6 +78,7 @@ struct Shared {
   std::deque<sss::matcher::LoopClosure> closures;
   bool products_requested = false;
   bool stop = false;
+  std::optional<sss::core::MissionOrigin> origin;  // of the navigation (SSS_NAV), for the products
   // Results.
   std::shared_ptr<const SlidingWindowPoseGraph> snapshot;  // newest solved graph (for corrections)
   std::optional<std::vector<sss::matcher::TrajectoryNode>> trajectory;  // to publish
@@ -87,13 +90,14 @@ struct Shared {
   std::vector<std::string> messages;  // log lines from the worker (logged by the loop)
 };
 
-bool writeProducts(OptimiserEngine& engine, const std::string& directory, std::vector<std::string>& messages) {
+bool writeProducts(OptimiserEngine& engine, const std::string& directory,
+                   const std::optional<sss::core::MissionOrigin>& origin, std::vector<std::string>& messages) {
   std::error_code ec;
   fs::create_directories(directory, ec);
   std::string error;
   const auto trajectory = engine.pingTrajectory(true);
   if (!sss::optimiser::writeTum(directory + "/slam.tum", trajectory,
-                                "sss-optimiser: optimised pose of every ping of the subframes", error)) {
+                                "sss-optimiser: optimised pose of every ping of the subframes", error, origin)) {
     messages.push_back(error);
     return false;
   }
@@ -102,7 +106,8 @@ bool writeProducts(OptimiserEngine& engine, const std::string& directory, std::v
   if (ok && !points.empty()) {
     ok = sss::optimiser::writeHeightmapFiles(directory + "/heightmap.yaml",
                                              sss::optimiser::gridSeabedPoints(points, engine.options().bathymetry),
-                                             "sss-optimiser: seabed re-triangulated with the optimised poses", error);
+                                             "sss-optimiser: seabed re-triangulated with the optimised poses", error,
+                                             origin);
   }
   messages.push_back(ok ? "products written to " + directory + ": " + std::to_string(trajectory.size()) +
                               " poses, " + std::to_string(points.size()) + " seabed points"
@@ -123,8 +128,7 @@ int main(int argc, char** argv) {
     using namespace sss::core;
     Config config = Config::fromFile(config_path);
     ConfigSection mission = config.section("mission");
-    mission.optional("origin_latitude_deg", options.origin_latitude_deg, {inRange(-90.0, 90.0)});
-    mission.optional("origin_longitude_deg", options.origin_longitude_deg, {inRange(-180.0, 180.0)});
+    options.configured_origin = sss::core::readMissionOrigin(mission);
     ConfigSection section = config.section("optimiser");
     sss::transport::readProcessOptions(section, options.process);
     sss::optimiser::readOptimiserEngineOptions(section, options.engine);
@@ -162,7 +166,8 @@ int main(int argc, char** argv) {
   sss::transport::initLogging(options.process.process_name, options.process.log_level);
   sss::transport::ProcessLoop loop(options.process);
   sss::core::HealthMonitor& health = loop.health();
-  const sss::core::LocalTangentPlane plane(options.origin_latitude_deg, options.origin_longitude_deg);
+  // The tangent plane of the origin in the navigation (rebuilt if the INS bridge's origin changes).
+  std::optional<sss::core::LocalTangentPlane> plane;
   // Determinism and bounded latency come from the iteration bound; the time limit is the config's.
   OptimiserEngine engine(options.engine);
   const std::string checkpoint_path =
@@ -205,6 +210,7 @@ int main(int argc, char** argv) {
       std::deque<sss::subframe::Subframe> subframes;
       std::deque<sss::matcher::LoopClosure> closures;
       bool products = false;
+      std::optional<sss::core::MissionOrigin> origin;
       {
         std::unique_lock<std::mutex> lock(shared.mutex);
         shared.wake.wait_for(lock, std::chrono::duration<double>(std::max(options.update_period_s, 0.05)), [&] {
@@ -215,6 +221,7 @@ int main(int argc, char** argv) {
         closures.swap(shared.closures);
         products = shared.products_requested;
         shared.products_requested = false;
+        origin = shared.origin;
       }
       std::vector<std::string> messages;
       for (const auto& subframe : subframes) {
@@ -233,7 +240,7 @@ int main(int argc, char** argv) {
       bool updated = false;
       if (products) {
         engine.finish();
-        if (!options.products_directory.empty()) writeProducts(engine, options.products_directory, messages);
+        if (!options.products_directory.empty()) writeProducts(engine, options.products_directory, origin, messages);
         updated = true;
       } else if (engine.hasNewInput() && now_s - last_update_monotonic_s >= options.update_period_s) {
         const auto report = engine.update();
@@ -323,10 +330,36 @@ int main(int argc, char** argv) {
         spdlog::warn("nav sample rejected (non-finite pose or no time); further ones are counted in SSS_STATUS");
       return;
     }
+    if (!nav.position_valid || !nav.origin) {
+      // Before the INS's first fix: no position, no frame, nothing to correct yet.
+      if (health.recordError("nav_without_position", "nav sample without a position or origin", sss::core::nowUtime()))
+        spdlog::warn("nav sample without a position (before the INS's first fix?) not corrected; further ones are "
+                     "counted in SSS_STATUS");
+      return;
+    }
+    if (!plane || plane->originLatitudeDeg() != nav.origin->latitude_deg ||
+        plane->originLongitudeDeg() != nav.origin->longitude_deg) {
+      if (plane) {
+        spdlog::error("the navigation's origin moved from {:.7f} {:.7f} to {:.7f} {:.7f} (INS bridge restarted "
+                      "without its state directory?): corrected poses are geo-referenced with the new one",
+                      plane->originLatitudeDeg(), plane->originLongitudeDeg(), nav.origin->latitude_deg,
+                      nav.origin->longitude_deg);
+      } else {
+        spdlog::info("mission origin (from SSS_NAV): {:.7f} {:.7f}", nav.origin->latitude_deg, nav.origin->longitude_deg);
+      }
+      if (options.configured_origin && (options.configured_origin->latitude_deg != nav.origin->latitude_deg ||
+                                        options.configured_origin->longitude_deg != nav.origin->longitude_deg)) {
+        spdlog::warn("the navigation's origin differs from mission.origin_* in the configuration (does the INS "
+                     "bridge read the same file?); the navigation's is used");
+      }
+      plane.emplace(nav.origin->latitude_deg, nav.origin->longitude_deg);
+      std::lock_guard<std::mutex> lock(shared.mutex);
+      shared.origin = nav.origin;
+    }
     const auto graph = snapshot();
     const sss::optimiser::Correction correction = graph->correctionAt(nav.utime_us);
     const auto dr = sss::subframe::poseOf(nav);
-    const sss_msgs::pose_t pose = sss::optimiser::toPoseMessage(nav.utime_us, dr, correction, plane);
+    const sss_msgs::pose_t pose = sss::optimiser::toPoseMessage(nav.utime_us, dr, correction, *plane);
     loop.bus().publish(options.pose_channel, pose, arrival);
     if (writer) {
       const sss_dds_NavigationCorrection sample =
@@ -454,7 +487,7 @@ int main(int argc, char** argv) {
   if (engine.graph().numNodes() > 0) {
     engine.finish();
     std::vector<std::string> messages;
-    if (!options.products_directory.empty()) writeProducts(engine, options.products_directory, messages);
+    if (!options.products_directory.empty()) writeProducts(engine, options.products_directory, shared.origin, messages);
     if (!checkpoint_path.empty()) {
       const auto saved = engine.saveCheckpoint(checkpoint_path);
       if (!saved.ok) messages.push_back("checkpoint: " + saved.message);

@@ -38,6 +38,16 @@ void readPingNavFusionOptions(sss::core::ConfigSection& section, PingNavFusionOp
   section.optional("min_altitude_m", options.min_altitude_m, {inRange(0.0, 1000.0)});
   section.optional("pose_heading_from_fit", options.pose_heading_from_fit);
   section.optional("duplicate_memory_pings", options.duplicate_memory_pings, {inRange(1, 100000)});
+  std::string policy = options.altitude_source == AltitudePolicy::kNav           ? "nav"
+                       : options.altitude_source == AltitudePolicy::kBottomTrack ? "bottom_track"
+                                                                                 : "auto";
+  section.optional("altitude_source", policy, {oneOf({"nav", "bottom_track", "auto"})});
+  options.altitude_source = policy == "nav"            ? AltitudePolicy::kNav
+                            : policy == "bottom_track" ? AltitudePolicy::kBottomTrack
+                                                       : AltitudePolicy::kAuto;
+  ConfigSection bottom_track = section.section("bottom_track");
+  readBottomTrackerOptions(bottom_track, options.bottom_track);
+  bottom_track.rejectUnknownKeys();
   // A ping waits for nav half a heading-rate window past it: a shorter wait drops every ping.
   if (options.max_ping_wait_s <= 0.5 * options.heading_rate_window_s)
     section.addProblem("max_ping_wait_s", std::to_string(options.max_ping_wait_s),
@@ -45,18 +55,35 @@ void readPingNavFusionOptions(sss::core::ConfigSection& section, PingNavFusionOp
 }
 
 PingNavFusion::PingNavFusion(const PingNavFusionOptions& options)
-    : options_(options), T_body_sonar_(options.T_body_sonar()) {}
+    : options_(options), T_body_sonar_(options.T_body_sonar()), bottom_tracker_(options.bottom_track) {}
+
+const char* altitudeSourceName(AltitudeSource source) {
+  switch (source) {
+    case AltitudeSource::kNav: return "nav";
+    case AltitudeSource::kPingHeader: return "ping_header";
+    case AltitudeSource::kBottomTrack: return "bottom_track";
+  }
+  return "unknown";
+}
 
 void PingNavFusion::addNav(const NavInput& nav, std::vector<FusedPing>& out) {
   ++counters_.nav_in;
+  if (!nav.position_valid) {
+    ++counters_.nav_without_position;
+    return;
+  }
   if (!history_.empty() && nav.utime_us <= history_.back().utime_us) {
     ++counters_.nav_out_of_order;
     return;
   }
+  if (first_nav_utime_us_ == INT64_MIN) first_nav_utime_us_ = nav.utime_us;
   history_.push_back(nav);
+  // Release before trimming the history: after a pause in the navigation (a line's end, a 60 s
+  // stop) the first new sample lets the pings before the pause go, and they need the samples
+  // from before it, which trimming to nav_history_s behind the new one would drop.
+  release(out, false);
   const int64_t keep_us = static_cast<int64_t>(options_.nav_history_s * 1e6);
   while (history_.size() > 2 && history_.front().utime_us < nav.utime_us - keep_us) history_.pop_front();
-  release(out, false);
 }
 
 bool PingNavFusion::seenRecently(int64_t ping_number) const {
@@ -116,7 +143,7 @@ bool PingNavFusion::resolve(PingInput&& ping, std::vector<FusedPing>& out) {
                             [](const NavInput& n, int64_t time) { return n.utime_us < time; });
   if (b == history_.end()) return false;  // cannot happen: release() checked the newest nav
   if (b->utime_us != t && b == history_.begin()) {
-    ++counters_.dropped_too_old;
+    ++(t < first_nav_utime_us_ ? counters_.dropped_before_first_fix : counters_.dropped_too_old);
     return false;
   }
   auto a = b->utime_us == t ? b : std::prev(b);
@@ -177,21 +204,52 @@ bool PingNavFusion::resolve(PingInput&& ping, std::vector<FusedPing>& out) {
 
   // Altitude of the sonar: DVL altitude of the body, shifted by the lever arm's vertical
   // component in the world (a sonar mounted below the body origin is closer to the seabed).
+  // An altitude beyond the ping's last sample is impossible (the seabed would be out of range).
+  const double max_range_m =
+      ping.start_range_m + ping.sampleSpacingM() * static_cast<double>(std::max(ping.port.size(), ping.starboard.size()));
+  auto plausible = [&](double altitude_m) {
+    if (!(altitude_m >= options_.min_altitude_m)) return false;
+    if (max_range_m > ping.start_range_m && altitude_m >= max_range_m) {
+      ++counters_.altitude_implausible;
+      return false;
+    }
+    return true;
+  };
   const double sonar_down_offset_m = (fused.T_world_body.rotation * T_body_sonar_.translation).z();
   const bool nav_altitude_ok = a->altitude_valid && b->altitude_valid && a->altitude_m >= options_.min_altitude_m &&
                                b->altitude_m >= options_.min_altitude_m;
-  if (nav_altitude_ok) {
-    fused.altitude_m = a->altitude_m + alpha * (b->altitude_m - a->altitude_m) - sonar_down_offset_m;
-  } else if (ping.altitude_m >= options_.min_altitude_m) {
-    // The sonar's own altitude is measured at the sonar.
-    fused.altitude_m = ping.altitude_m;
-    fused.altitude_from_ping = true;
-    ++counters_.altitude_from_ping;
-  } else {
-    ++counters_.dropped_no_altitude;
-    return false;
+  const double nav_altitude_m = a->altitude_m + alpha * (b->altitude_m - a->altitude_m) - sonar_down_offset_m;
+  // The tracker follows every ping whenever it may be used, so that its track is warm when the
+  // navigation's altitude stops.
+  BottomTrack bottom;
+  if (options_.altitude_source != AltitudePolicy::kNav) {
+    bottom = bottom_tracker_.track(ping.port, ping.starboard, ping.start_range_m, ping.sampleSpacingM());
   }
-  if (fused.altitude_m < options_.min_altitude_m) {
+  bool have_altitude = false;
+  if (options_.altitude_source != AltitudePolicy::kBottomTrack) {
+    if (nav_altitude_ok && plausible(nav_altitude_m)) {
+      fused.altitude_m = nav_altitude_m;
+      fused.altitude_source = AltitudeSource::kNav;
+      ++counters_.altitude_from_nav;
+      have_altitude = true;
+    } else if (ping.altitude_m >= options_.min_altitude_m && plausible(ping.altitude_m)) {
+      // The sonar's own altitude is measured at the sonar.
+      fused.altitude_m = ping.altitude_m;
+      fused.altitude_from_ping = true;
+      fused.altitude_source = AltitudeSource::kPingHeader;
+      ++counters_.altitude_from_ping;
+      have_altitude = true;
+    }
+  }
+  if (!have_altitude && options_.altitude_source != AltitudePolicy::kNav && bottom.valid &&
+      bottom.altitude_m >= options_.min_altitude_m) {
+    fused.altitude_m = bottom.altitude_m;  // a slant range measured at the sonar
+    fused.altitude_source = AltitudeSource::kBottomTrack;
+    fused.bottom_track_quality = bottom.quality;
+    ++counters_.altitude_from_bottom_track;
+    have_altitude = true;
+  }
+  if (!have_altitude || fused.altitude_m < options_.min_altitude_m) {
     ++counters_.dropped_no_altitude;
     return false;
   }

@@ -5,10 +5,13 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <deque>
+#include <optional>
 #include <vector>
 
 #include "pipeline/core/config.hpp"
+#include "pipeline/core/mission_origin.hpp"
 #include "pipeline/core/pose.hpp"
+#include "pipeline/subframe/bottom_tracker.hpp"
 
 namespace sss::subframe {
 
@@ -16,6 +19,10 @@ namespace sss::subframe {
 struct NavInput {
   int64_t utime_us = 0;
   Eigen::Vector3d position_ned_m = Eigen::Vector3d::Zero();  // body origin, local NED
+  // False before the navigation's first fix (no position, so no frame yet): not fused.
+  bool position_valid = true;
+  // The mission origin position_ned_m is relative to, when the source says (SSS_NAV does).
+  std::optional<sss::core::MissionOrigin> origin;
   double roll_rad = 0.0;
   double pitch_rad = 0.0;
   double heading_rad = 0.0;
@@ -42,12 +49,24 @@ struct PingInput {
   double sampleSpacingM() const { return 0.5 * sound_speed_m_s * sample_interval_s; }
 };
 
+// Where a ping's altitude came from.
+enum class AltitudeSource { kNav, kPingHeader, kBottomTrack };
+const char* altitudeSourceName(AltitudeSource source);
+
+// Which altitude the fusion uses (subframe_buffer.fusion.altitude_source):
+//   nav: the navigation's (DVL), else the sonar's own header field, else the ping is dropped;
+//   bottom_track: tracked in the sonar returns only;
+//   auto: nav, else the header, else the bottom track (files without any altitude still work).
+enum class AltitudePolicy { kNav, kBottomTrack, kAuto };
+
 // A ping with its DR pose at the ping time.
 struct FusedPing {
   PingInput ping;
   sss::core::Pose T_world_body;
   double altitude_m = 0.0;           // the sonar's height above the seabed (canonical h)
   bool altitude_from_ping = false;   // nav altitude was invalid or stale
+  AltitudeSource altitude_source = AltitudeSource::kNav;
+  double bottom_track_quality = 0.0; // of the bottom track when it was used (0..1, see BottomTrack)
   double heading_rad = 0.0;
   double roll_rad = 0.0;
   double heading_rate_rad_s = 0.0;   // over heading_rate_window_s centred on the ping (LS slope)
@@ -75,6 +94,8 @@ struct PingNavFusionOptions {
   // INS heading: INS heading noise then neither smears the image nor rotates subframe frames.
   bool pose_heading_from_fit = true;
   double min_altitude_m = 0.5;        // altitudes below this are treated as invalid
+  AltitudePolicy altitude_source = AltitudePolicy::kAuto;
+  BottomTrackerOptions bottom_track;
   int duplicate_memory_pings = 256;   // recent ping numbers remembered to catch duplicates
 
   sss::core::Pose T_body_sonar() const;
@@ -85,6 +106,7 @@ void readPingNavFusionOptions(sss::core::ConfigSection& section, PingNavFusionOp
 struct PingNavFusionCounters {
   uint64_t nav_in = 0;
   uint64_t nav_out_of_order = 0;     // not newer than the newest nav: ignored
+  uint64_t nav_without_position = 0; // before the first fix (no position, no frame): ignored
   uint64_t pings_in = 0;
   uint64_t pings_out = 0;
   uint64_t pings_reordered = 0;      // arrived late but within the waiting window: put in order
@@ -92,11 +114,17 @@ struct PingNavFusionCounters {
   uint64_t pings_duplicate = 0;      // ping number seen recently: dropped
   uint64_t dropped_no_nav = 0;       // waited max_ping_wait_s / overflow without bracketing nav
   uint64_t dropped_too_old = 0;      // older than the nav history
+  uint64_t dropped_before_first_fix = 0;  // older than the first nav sample with a position
   uint64_t dropped_nav_gap = 0;      // bracketing nav samples more than max_nav_gap_s apart
   uint64_t dropped_no_altitude = 0;  // neither nav nor ping altitude usable
+  uint64_t altitude_from_nav = 0;
   uint64_t altitude_from_ping = 0;   // nav altitude invalid/stale, the ping's own altitude used
+  uint64_t altitude_from_bottom_track = 0;
+  uint64_t altitude_implausible = 0; // nav or header altitude beyond the ping's range: not used
 
-  uint64_t droppedWithoutNav() const { return dropped_no_nav + dropped_too_old + dropped_nav_gap; }
+  uint64_t droppedWithoutNav() const {
+    return dropped_no_nav + dropped_too_old + dropped_nav_gap + dropped_before_first_fix;
+  }
 };
 
 // Pings are released in time order, each once its bracketing nav has arrived (nav is assumed to
@@ -113,6 +141,7 @@ class PingNavFusion {
   void finish(std::vector<FusedPing>& out);
 
   const PingNavFusionCounters& counters() const { return counters_; }
+  const BottomTrackerCounters& bottomTrackCounters() const { return bottom_tracker_.counters(); }
   size_t pendingPings() const { return pending_.size(); }
   size_t navHistorySize() const { return history_.size(); }
   size_t memoryBytes() const;
@@ -124,10 +153,12 @@ class PingNavFusion {
 
   PingNavFusionOptions options_;
   sss::core::Pose T_body_sonar_;
+  BottomTracker bottom_tracker_;
   std::deque<NavInput> history_;
   std::deque<PingInput> pending_;   // sorted by utime
   std::deque<int64_t> recent_numbers_;
   int64_t last_released_utime_us_ = INT64_MIN;
+  int64_t first_nav_utime_us_ = INT64_MIN;  // of the first nav with a position; MIN: none yet
   PingNavFusionCounters counters_;
 };
 

@@ -40,6 +40,7 @@ class SubframeBuffer {
   void finish(std::vector<Subframe>& out);
 
   SubframeBufferCounters counters() const;
+  const BottomTrackerCounters& bottomTrackCounters() const { return fusion_.bottomTrackCounters(); }
   SubframeNumbering numbering() const { return builder_.numbering(); }
   void resumeNumbering(const SubframeNumbering& numbering) { builder_.resumeNumbering(numbering); }
   const SubframeBufferOptions& options() const { return options_; }

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/core/mission_origin.hpp"
 #include "pipeline/core/state_file.hpp"
 #include "pipeline/core/time.hpp"
 #include "pipeline/subframe/subframe_buffer.hpp"
@@ -75,9 +76,7 @@ int main(int argc, char** argv) {
     // The mission origin is the NED origin of SSS_NAV already (the INS bridge converts); it is
     // read here only so the shared mission section is validated the same way everywhere.
     ConfigSection mission = config.section("mission");
-    double origin_latitude_deg = 0.0, origin_longitude_deg = 0.0;
-    mission.optional("origin_latitude_deg", origin_latitude_deg, {inRange(-90.0, 90.0)});
-    mission.optional("origin_longitude_deg", origin_longitude_deg, {inRange(-180.0, 180.0)});
+    (void)sss::core::readMissionOrigin(mission);
     ConfigSection section = config.section("subframe_buffer");
     sss::transport::readProcessOptions(section, options.process);
     sss::subframe::readSubframeBufferOptions(section, options.buffer);
@@ -171,8 +170,13 @@ int main(int argc, char** argv) {
     set("pings_reordered", c.fusion.pings_reordered);
     set("pings_duplicate", c.fusion.pings_duplicate);
     set("pings_dropped_no_altitude", c.fusion.dropped_no_altitude);
+    set("pings_dropped_before_first_fix", c.fusion.dropped_before_first_fix);
+    set("altitude_from_nav", c.fusion.altitude_from_nav);
     set("altitude_from_ping", c.fusion.altitude_from_ping);
+    set("altitude_from_bottom_track", c.fusion.altitude_from_bottom_track);
+    set("altitude_implausible", c.fusion.altitude_implausible);
     set("nav_in", c.fusion.nav_in);
+    set("nav_without_position", c.fusion.nav_without_position);
     set("nav_out_of_order", c.fusion.nav_out_of_order);
     set("turn_rows", c.turn_rows);
     set("lines", c.builder.lines);
@@ -195,7 +199,9 @@ int main(int argc, char** argv) {
     }
     if (c.fusion.dropped_no_altitude > reported_no_altitude) {
       if (health.recordError("ping_without_altitude", "pings dropped: no valid nav or sonar altitude", now))
-        spdlog::warn("pings dropped without a valid altitude; further ones are counted in SSS_STATUS");
+        spdlog::warn("pings dropped without a valid altitude (no DVL altitude in SSS_NAV, none in the ping and no "
+                     "seabed return found; subframe_buffer.fusion.altitude_source: auto or bottom_track tracks the "
+                     "bottom in the returns); further ones are counted in SSS_STATUS");
       reported_no_altitude = c.fusion.dropped_no_altitude;
     }
   });

@@ -24,6 +24,10 @@ NavInput fromNavMessage(const sss_msgs::nav_t& message) {
   NavInput nav;
   nav.utime_us = message.utime;
   nav.position_ned_m = Eigen::Vector3d(message.position_ned_m[0], message.position_ned_m[1], message.position_ned_m[2]);
+  // Before the INS's first fix the bridge has no frame (origin NaN) and no position to give.
+  nav.position_valid = (message.validity & sss_msgs::nav_t::VALID_POSITION) != 0 &&
+                       sss::core::isValidOrigin(message.origin_latitude_deg, message.origin_longitude_deg);
+  if (nav.position_valid) nav.origin = sss::core::MissionOrigin{message.origin_latitude_deg, message.origin_longitude_deg};
   nav.roll_rad = message.roll_rad;
   nav.pitch_rad = message.pitch_rad;
   nav.heading_rad = message.heading_rad;

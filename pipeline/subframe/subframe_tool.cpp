@@ -16,6 +16,7 @@
 #include "drivers/ins/ins_bridge.hpp"
 #include "drivers/ins/nav_message.hpp"
 #include "pipeline/core/health.hpp"
+#include "pipeline/core/mission_origin.hpp"
 #include "pipeline/core/time.hpp"
 #include "pipeline/subframe/pictures.hpp"
 #include "pipeline/subframe/subframe_buffer.hpp"
@@ -54,8 +55,7 @@ int main(int argc, char** argv) {
     using namespace sss::core;
     Config config = Config::fromFile(config_path);
     ConfigSection mission = config.section("mission");
-    mission.optional("origin_latitude_deg", bridge_options.origin_latitude_deg, {inRange(-90.0, 90.0)});
-    mission.optional("origin_longitude_deg", bridge_options.origin_longitude_deg, {inRange(-180.0, 180.0)});
+    bridge_options.origin = sss::core::readMissionOrigin(mission);
     ConfigSection section = config.section("subframe_buffer");
     sss::subframe::readSubframeBufferOptions(section, options);
     if (!config.ok()) {

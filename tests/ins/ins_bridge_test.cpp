@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "drivers/ins/nav_message.hpp"
 #include "ins_test_states.hpp"
 
@@ -12,8 +14,7 @@ namespace {
 
 InsBridgeOptions testOptions() {
   InsBridgeOptions options;
-  options.origin_latitude_deg = test::kOriginLatitudeDeg;
-  options.origin_longitude_deg = test::kOriginLongitudeDeg;
+  options.origin = sss::core::MissionOrigin{test::kOriginLatitudeDeg, test::kOriginLongitudeDeg};
   return options;
 }
 
@@ -109,6 +110,62 @@ TEST(InsBridge, CorruptSentencesAreCountedAndReportedOnce) {
   const auto faults = bridge.takeNewFaultMessages();
   EXPECT_GE(faults.size(), 2u);
   EXPECT_TRUE(bridge.takeNewFaultMessages().empty());
+}
+
+// No origin configured: the first valid fix is the origin, so the mission starts at (0, 0) in
+// its own frame wherever on Earth it is; epochs before it have no position and no frame.
+TEST(InsBridge, WithoutConfiguredOriginTheFirstFixIsTheOrigin) {
+  std::string stream;
+  ins::InsState null_island = test::eastboundState(1);  // what some INSs send before their first fix
+  null_island.latitude_deg = 0.0;
+  null_island.longitude_deg = 0.0;
+  ins::InsState no_fix = test::eastboundState(0);
+  no_fix.validity &= ~(kValidPosition | kValidDepth);  // heading, attitude, speed; no position yet
+  no_fix.latitude_deg = 0.0;
+  no_fix.longitude_deg = 0.0;
+  stream += encodeInsState(no_fix);
+  null_island.utime_us = no_fix.utime_us + 50'000;
+  stream += encodeInsState(null_island);
+  for (int e = 1; e <= 20; ++e) stream += encodeInsState(test::eastboundState(e));
+  InsBridge bridge(InsBridgeOptions{});
+  EXPECT_FALSE(bridge.origin());
+  const std::vector<NavSample> samples = feedAll(bridge, stream);
+  ASSERT_EQ(samples.size(), 22u);
+  EXPECT_FALSE(samples[0].origin);
+  EXPECT_FALSE(samples[1].origin);  // 0 N 0 E is not a fix
+  const sss_msgs::nav_t before_fix = toNavMessage(samples[0], 0);
+  EXPECT_TRUE(std::isnan(before_fix.origin_latitude_deg));
+  EXPECT_EQ(before_fix.validity & sss_msgs::nav_t::VALID_POSITION, 0);
+  ASSERT_TRUE(bridge.origin());
+  EXPECT_EQ(bridge.originSource(), sss::core::OriginSource::kFirstFix);
+  const ins::InsState first = test::eastboundState(1);
+  // As the NMEA carried it (8 decimals).
+  EXPECT_NEAR(bridge.origin()->latitude_deg, first.latitude_deg, 1e-8);
+  EXPECT_NEAR(bridge.origin()->longitude_deg, first.longitude_deg, 1e-8);
+  EXPECT_NEAR(samples[2].position_ned_m.head<2>().norm(), 0.0, 1e-6);
+  EXPECT_NEAR(samples[2].position_ned_m.z(), 40.0, 0.002);  // depth stays absolute
+  // 1.9 s later at 2 m/s east: 3.8 m east of the first fix (the configured frame says 10 m north too).
+  EXPECT_NEAR(samples[21].position_ned_m.x(), 0.0, 0.005);
+  EXPECT_NEAR(samples[21].position_ned_m.y(), 3.8, 0.005);
+  EXPECT_NEAR(samples[21].distance_travelled_m, 3.8, 0.01);
+  const sss_msgs::nav_t nav = toNavMessage(samples[21], 0);
+  EXPECT_DOUBLE_EQ(nav.origin_latitude_deg, bridge.origin()->latitude_deg);
+  EXPECT_DOUBLE_EQ(nav.origin_longitude_deg, bridge.origin()->longitude_deg);
+}
+
+// A configured origin is an override; a resumed one (state directory) is kept over the first fix.
+TEST(InsBridge, ConfiguredOrResumedOriginIsKept) {
+  InsBridge configured(testOptions());
+  EXPECT_EQ(configured.originSource(), sss::core::OriginSource::kConfigured);
+  configured.resumeOrigin({1.0, 2.0});  // ignored: the configuration wins
+  EXPECT_DOUBLE_EQ(configured.origin()->latitude_deg, test::kOriginLatitudeDeg);
+
+  InsBridge resumed(InsBridgeOptions{});
+  resumed.resumeOrigin({test::kOriginLatitudeDeg, test::kOriginLongitudeDeg});
+  const std::vector<NavSample> samples = feedAll(resumed, test::eastboundStream(5));
+  EXPECT_EQ(resumed.originSource(), sss::core::OriginSource::kResumed);
+  EXPECT_NEAR(samples.back().position_ned_m.x(), 10.0, 0.005);  // the earlier run's frame
+  EXPECT_NEAR(samples.back().position_ned_m.y(), 0.8, 0.005);
 }
 
 TEST(NavMessage, CopiesFieldsAndMapsValidityBits) {

@@ -48,6 +48,8 @@ inline sss_msgs::nav_t makeNav() {
   nav.position_ned_m[0] = 100.0;
   nav.position_ned_m[1] = -50.0;
   nav.position_ned_m[2] = 40.0;
+  nav.origin_latitude_deg = 59.349101;
+  nav.origin_longitude_deg = 18.0717;
   nav.heading_rad = -2.0;
   nav.velocity_body_m_s[0] = 2.0;
   nav.altitude_m = 18.0;

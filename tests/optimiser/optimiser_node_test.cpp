@@ -146,6 +146,8 @@ sss_msgs::nav_t makeNav(int64_t utime_us, const sss::core::LocalTangentPlane& pl
   const sss::core::GeodeticPosition geodetic = plane.toGeodetic(s.dr.translation);
   m.latitude_deg = geodetic.latitude_deg;
   m.longitude_deg = geodetic.longitude_deg;
+  m.origin_latitude_deg = plane.originLatitudeDeg();
+  m.origin_longitude_deg = plane.originLongitudeDeg();
   m.depth_m = s.dr.translation.z();
   for (int i = 0; i < 3; ++i) m.position_ned_m[i] = s.dr.translation[i];
   const sss::core::EulerAngles euler = sss::core::eulerFromQuaternion(s.dr.rotation);

@@ -1,6 +1,7 @@
 // Whole short missions on disk: same seed -> same bytes (any thread count), different seed ->
 // different bytes, JSF type 80 fields at their exact byte offsets, TUM and seabed outputs.
 #include "tools/sim/mission.hpp"
+#include "pipeline/core/mission_origin.hpp"
 
 #include "drivers/edgetech/jsf_format.hpp"
 
@@ -133,6 +134,13 @@ TEST(Mission, OutputsHaveOneTumLinePerPingAndAConsistentSeabedRaster) {
   std::string error;
   ASSERT_TRUE(writeMission(mission, dir, report, error)) << error;
   std::istringstream tum(readFile(dir + "/ground_truth.tum"));
+  // The first line names the frame's origin (sss-eval re-expresses runs with another origin).
+  std::string header;
+  ASSERT_TRUE(static_cast<bool>(std::getline(tum, header)));
+  const auto origin = core::parseOriginCommentLine(header);
+  ASSERT_TRUE(origin) << header;
+  EXPECT_DOUBLE_EQ(origin->latitude_deg, mission.options().origin_latitude_deg);
+  EXPECT_DOUBLE_EQ(origin->longitude_deg, mission.options().origin_longitude_deg);
   size_t lines = 0;
   for (std::string line; std::getline(tum, line); ++lines) {
     std::istringstream fields(line);

@@ -29,7 +29,7 @@ PingInput ping(double t_s, int64_t number, double altitude_m = -1.0) {
   PingInput p;
   p.utime_us = kT0 + static_cast<int64_t>(std::llround(t_s * 1e6));
   p.ping_number = number;
-  p.sample_interval_s = 2e-5;
+  p.sample_interval_s = 0.01;  // 10 samples 7.5 m apart: a 75 m range, beyond the altitudes used
   p.altitude_m = altitude_m;
   p.port.assign(10, 1.0f);
   p.starboard.assign(10, 1.0f);
@@ -141,16 +141,48 @@ TEST(PingNavFusion, DropsPingsInsideANavGapAndBeforeTheHistory) {
   PingNavFusion fusion(options);
   std::vector<FusedPing> out;
   fusion.addNav(nav(1.0, 0.0, 0.0), out);
-  fusion.addPing(ping(0.5, 1), out);  // before any nav: too old once nav is there
+  fusion.addPing(ping(0.5, 1), out);  // before any nav: before the navigation's first fix
   fusion.addNav(nav(3.0, 4.0, 0.0), out);
   fusion.addPing(ping(2.0, 2), out);  // bracketed by nav 2 s apart
   fusion.addNav(nav(3.2, 4.4, 0.0), out);
   fusion.addPing(ping(3.1, 3), out);
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(out[0].ping.ping_number, 3);
-  EXPECT_EQ(fusion.counters().dropped_too_old, 1u);
+  EXPECT_EQ(fusion.counters().dropped_before_first_fix, 1u);
+  EXPECT_EQ(fusion.counters().dropped_too_old, 0u);
   EXPECT_EQ(fusion.counters().dropped_nav_gap, 1u);
   EXPECT_EQ(fusion.counters().droppedWithoutNav(), 2u);
+}
+
+// Nav without a position (before the INS's first fix) founds no frame: ignored and counted.
+TEST(PingNavFusion, NavWithoutPositionIsIgnored) {
+  PingNavFusion fusion(immediate());
+  std::vector<FusedPing> out;
+  NavInput no_fix = nav(0.0, 0.0, 0.0);
+  no_fix.position_valid = false;
+  fusion.addNav(no_fix, out);
+  fusion.addPing(ping(0.5, 1), out);
+  fusion.addNav(nav(1.0, 2.0, 0.0), out);
+  fusion.addNav(nav(1.2, 2.4, 0.0), out);
+  fusion.finish(out);
+  EXPECT_TRUE(out.empty());
+  EXPECT_EQ(fusion.counters().nav_without_position, 1u);
+  EXPECT_EQ(fusion.counters().dropped_before_first_fix, 1u);
+}
+
+// After a pause in the navigation longer than the history (a 90 s stop between lines), the pings
+// just before the pause still get their pose: the new sample releases them before the history is
+// trimmed to nav_history_s behind it.
+TEST(PingNavFusion, PingsBeforeALongNavPauseKeepTheirPose) {
+  PingNavFusionOptions options;  // 8 s heading window: pings wait 4 s past them
+  PingNavFusion fusion(options);
+  std::vector<FusedPing> out;
+  for (int i = 0; i <= 100; ++i) fusion.addNav(nav(0.1 * i, 0.2 * i, 0.0), out);  // 0 .. 10 s
+  for (int k = 0; k < 40; ++k) fusion.addPing(ping(0.05 + 0.25 * k, k), out);        // up to 9.8 s
+  EXPECT_LT(out.size(), 40u);  // the last ones wait for nav 4 s past them
+  for (int i = 0; i <= 10; ++i) fusion.addNav(nav(100.0 + 0.1 * i, 50.0 + 0.2 * i, 0.0), out);  // 90 s later
+  EXPECT_EQ(out.size(), 40u);
+  EXPECT_EQ(fusion.counters().droppedWithoutNav(), 0u);
 }
 
 TEST(PingNavFusion, ReordersWaitingPingsAndDropsLateOnesAndDuplicates) {

@@ -1,6 +1,8 @@
 // Heightmap reading, writing and comparison. See heightmap_metrics.hpp.
 #include "tools/eval/heightmap_metrics.hpp"
 
+#include "tools/eval/frame_alignment.hpp"
+
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -104,6 +106,19 @@ bool readHeightmap(const std::string& yaml_path, HeightmapRaster& raster, std::s
       !readKey(yaml_path, root, "depth_file", "a file name", depth_file, error)) {
     return false;
   }
+  if (root["origin_latitude_deg"] || root["origin_longitude_deg"]) {
+    sss::core::MissionOrigin origin;
+    if (!readKey(yaml_path, root, "origin_latitude_deg", "a number", origin.latitude_deg, error) ||
+        !readKey(yaml_path, root, "origin_longitude_deg", "a number", origin.longitude_deg, error)) {
+      return false;
+    }
+    if (!sss::core::isValidOrigin(origin.latitude_deg, origin.longitude_deg)) {
+      error = located(yaml_path, root["origin_latitude_deg"]) + ": the origin must be a latitude in (-90, 90) and a "
+              "longitude in [-180, 180] (degrees)";
+      return false;
+    }
+    result.origin = origin;
+  }
   if (result.rows < 1 || result.cols < 1) {
     error = located(yaml_path, root[result.rows < 1 ? "rows" : "cols"]) + ": rows and cols must be >= 1";
     return false;
@@ -144,6 +159,10 @@ bool readHeightmap(const std::string& yaml_path, HeightmapRaster& raster, std::s
     return false;
   }
   if (const YAML::Node units = root["depth_units"]; units && units.IsScalar()) result.units = units.Scalar();
+  if (options.target_origin && result.origin && !sameOrigin(*result.origin, *options.target_origin)) {
+    reexpressHeightmap(result, *result.origin, *options.target_origin);
+    result.origin = options.target_origin;
+  }
   raster = std::move(result);
   return true;
 }
@@ -186,6 +205,11 @@ bool writeHeightmap(const std::string& path, const HeightmapRaster& raster, std:
        << "rows: " << raster.rows << "\ncols: " << raster.cols << "\nresolution_m: " << raster.resolution_m
        << "\nnorth_min_m: " << raster.north_min_m << "\neast_min_m: " << raster.east_min_m
        << "\ndepth_file: " << fs::path(depth_path).filename().string() << "\ndepth_units: \"" << raster.units << "\"\n";
+  if (raster.origin) {
+    yaml.precision(15);
+    yaml << "origin_latitude_deg: " << raster.origin->latitude_deg << "\norigin_longitude_deg: "
+         << raster.origin->longitude_deg << "\n";
+  }
   std::ofstream out(yaml_path, std::ios::binary);
   out << yaml.str();
   out.close();

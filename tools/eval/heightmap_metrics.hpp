@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/core/mission_origin.hpp"
 #include "tools/eval/trajectory_metrics.hpp"
 
 namespace sss::eval {
@@ -26,6 +27,8 @@ struct HeightmapRaster {
   std::vector<float> depth_m;     // rows * cols
   std::string description;        // written as the YAML's header comment (optional)
   std::string units = "metres below the origin (NED z, positive down)";
+  // The frame's origin (YAML keys origin_latitude_deg / origin_longitude_deg); nullopt: not said.
+  std::optional<sss::core::MissionOrigin> origin;
 
   float at(int row, int col) const { return depth_m[static_cast<size_t>(row) * cols + col]; }
   float& at(int row, int col) { return depth_m[static_cast<size_t>(row) * cols + col]; }
@@ -38,10 +41,13 @@ struct HeightmapRaster {
 
 struct HeightmapReadOptions {
   int64_t max_cells = 400'000'000;  // 1.6 GB of float32: a header asking for more is corrupt
+  // Set: a raster whose header names another origin is re-expressed in this one's frame
+  // (frame_alignment.hpp); raster.origin then says the target.
+  std::optional<sss::core::MissionOrigin> target_origin;
 };
 
 // Reads YAML keys rows, cols, resolution_m, north_min_m, east_min_m, depth_file (relative to the
-// YAML's folder unless absolute). False with "FILE:LINE: ..." in error on any problem.
+// YAML's folder unless absolute), and origin_latitude_deg + origin_longitude_deg when present. False with "FILE:LINE: ..." in error on any problem.
 bool readHeightmap(const std::string& yaml_path, HeightmapRaster& raster, std::string& error,
                    const HeightmapReadOptions& options = {});
 

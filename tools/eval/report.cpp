@@ -246,6 +246,9 @@ bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalR
   report = EvalReport();
   report.options = options;
   report.truth_path = request.truth_path;
+  // Everything is compared in the truth's frame: a file whose header names another origin (a run
+  // with its own origin, the first fix) is re-expressed in it.
+  std::optional<sss::core::MissionOrigin> truth_origin;
   if (!request.estimates.empty() || !request.closures_path.empty() || request.lce) {
     if (request.truth_path.empty()) {
       error = "estimates, closures and LCE need the truth trajectory (--gt TRUTH.tum)";
@@ -257,13 +260,16 @@ bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalR
       return false;
     }
     report.truth = std::move(truth.poses);
+    truth_origin = truth.origin;
     const std::vector<double> distance = cumulativeDistanceM(report.truth);
     report.truth_distance_m = distance.back();
     report.lines = segmentSurveyLines(report.truth, options.trajectory.lines);
   }
   std::vector<Trajectory> estimates;  // kept for the closures' DR and the LCE
   for (const EvalInput& input : request.estimates) {
-    TumReadResult estimate = readTum(input.path);
+    TumReadOptions in_truth_frame;
+    in_truth_frame.target_origin = truth_origin;
+    TumReadResult estimate = readTum(input.path, in_truth_frame);
     if (!estimate.ok) {
       error = estimate.error;
       return false;
@@ -295,10 +301,12 @@ bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalR
     }
     if (!readHeightmap(request.seabed_path, seabed, error)) return false;
   }
+  HeightmapReadOptions in_seabed_frame;
+  in_seabed_frame.target_origin = seabed.origin ? seabed.origin : truth_origin;
   if (!request.heightmaps.empty()) {
     for (const EvalInput& input : request.heightmaps) {
       HeightmapRaster estimate;
-      if (!readHeightmap(input.path, estimate, error)) return false;
+      if (!readHeightmap(input.path, estimate, error, in_seabed_frame)) return false;
       HeightmapReport entry;
       entry.input = {defaultLabel(input), input.path};
       entry.result = compareHeightmaps(seabed, estimate);
@@ -317,7 +325,9 @@ bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalR
     report.closures.path = request.closures_path;
     Trajectory dr;
     if (!request.closures_dr_path.empty()) {
-      TumReadResult read = readTum(request.closures_dr_path);
+      TumReadOptions in_truth_frame;
+      in_truth_frame.target_origin = truth_origin;
+      TumReadResult read = readTum(request.closures_dr_path, in_truth_frame);
       if (!read.ok) {
         error = read.error;
         return false;

@@ -271,18 +271,32 @@ void makeVerdict(RunReport& report, const RunReportOptions& options) {
 
 // ---- inputs --------------------------------------------------------------------------------
 
-bool readTrajectoryInput(const std::string& path, const std::string& what, Trajectory& poses, std::string& error) {
+// A file whose header names another origin than target_origin is re-expressed in its frame; the
+// file's own origin goes to *origin when given.
+bool readTrajectoryInput(const std::string& path, const std::string& what, Trajectory& poses, std::string& error,
+                         const std::optional<sss::core::MissionOrigin>& target_origin = std::nullopt,
+                         std::optional<sss::core::MissionOrigin>* origin = nullptr) {
   if (!fileExists(path)) {
     error = path + ": missing (" + what + ")";
     return false;
   }
-  TumReadResult result = readTum(path);
+  TumReadOptions options;
+  options.target_origin = target_origin;
+  TumReadResult result = readTum(path, options);
   if (!result.ok) {
     error = result.error;
     return false;
   }
   poses = std::move(result.poses);
+  if (origin) *origin = result.origin;
   return true;
+}
+
+// Heightmaps are compared in the truth's frame (a run with its own origin is re-expressed).
+HeightmapReadOptions truthFrame(const RunReport& report) {
+  HeightmapReadOptions options;
+  options.target_origin = report.truth_origin;
+  return options;
 }
 
 void readHeightmaps(RunReport& report, const RunReportRequest& request) {
@@ -297,7 +311,7 @@ void readHeightmaps(RunReport& report, const RunReportRequest& request) {
   std::string error;
   if (!fileExists(seabed_path)) {
     report.notes.push_back("no true seabed (" + seabed_path + "): heightmap errors not computed");
-  } else if (!readHeightmap(seabed_path, seabed, error)) {
+  } else if (!readHeightmap(seabed_path, seabed, error, truthFrame(report))) {
     report.notes.push_back("true seabed unusable, heightmap errors not computed: " + error);
     seabed = HeightmapRaster();
   } else {
@@ -307,7 +321,7 @@ void readHeightmaps(RunReport& report, const RunReportRequest& request) {
                                       std::tuple{dr_path, &report.heightmap_dr, have_dr}}) {
     if (!present || report.seabed_path.empty()) continue;
     HeightmapRaster estimate;
-    if (!readHeightmap(path, estimate, error)) {
+    if (!readHeightmap(path, estimate, error, truthFrame(report))) {
       report.notes.push_back("heightmap unusable: " + error);
       continue;
     }
@@ -916,9 +930,9 @@ RunReport writeRunReport(const RunReportRequest& request, const RunReportOptions
     report.dr_path = joinPath(request.run_dir, "dead_reckoning.tum");
     Trajectory truth, dr, slam;
     if (!readTrajectoryInput(report.truth_path, "the simulator's ground truth; is --mission the sss-sim --out folder?",
-                             truth, error) ||
+                             truth, error, std::nullopt, &report.truth_origin) ||
         !readTrajectoryInput(report.slam_path, "the SLAM trajectory; is --run the sss-process output folder?", slam,
-                             error)) {
+                             error, report.truth_origin)) {
       return fail(RunReportStatus::bad_input, error);
     }
     if (!fileExists(report.dr_path)) {
@@ -930,7 +944,9 @@ RunReport writeRunReport(const RunReportRequest& request, const RunReportOptions
       report.notes.push_back("no dead_reckoning.tum in the run folder; the mission's " + fallback + " stands in for DR");
       report.dr_path = fallback;
     }
-    if (!readTrajectoryInput(report.dr_path, "dead reckoning", dr, error)) return fail(RunReportStatus::bad_input, error);
+    if (!readTrajectoryInput(report.dr_path, "dead reckoning", dr, error, report.truth_origin)) {
+      return fail(RunReportStatus::bad_input, error);
+    }
 
     report.truth_poses = truth.size();
     report.duration_s = static_cast<double>(truth.back().utime_us - truth.front().utime_us) * 1e-6;
@@ -980,7 +996,7 @@ RunReport writeRunReport(const RunReportRequest& request, const RunReportOptions
       // Landmark consistency on correspondences made from the truth (sss-eval --lce).
       HeightmapRaster seabed;
       const std::string seabed_path = joinPath(request.mission_dir, "seabed.yaml");
-      const bool have_seabed = fileExists(seabed_path) && readHeightmap(seabed_path, seabed, error);
+      const bool have_seabed = fileExists(seabed_path) && readHeightmap(seabed_path, seabed, error, truthFrame(report));
       LandmarkConsistencyOptions model;
       model.seabed_depth_m = flatSeabedDepthM(truth, have_seabed ? &seabed : nullptr, options.lce_altitude_m,
                                               report.lce_seabed_depth_source);

@@ -48,6 +48,7 @@
 #include <cstdint>
 #include <limits>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -136,6 +137,8 @@ struct RunReport {
   std::vector<std::string> notes;  // missing or unusable optional inputs, figures not drawn
 
   std::string truth_path, dr_path, slam_path;
+  // The truth's frame (its TUM header); the run's files are re-expressed in it when theirs differs.
+  std::optional<sss::core::MissionOrigin> truth_origin;
   size_t truth_poses = 0;
   double duration_s = 0.0;
   double distance_m = 0.0;

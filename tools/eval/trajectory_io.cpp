@@ -1,6 +1,8 @@
 // TUM trajectory reading and writing. See trajectory_io.hpp.
 #include "tools/eval/trajectory_io.hpp"
 
+#include "tools/eval/frame_alignment.hpp"
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -116,6 +118,7 @@ TumReadResult parseTum(const std::string& text, const std::string& name, const T
     }
     if (line[first] == '#') {
       ++result.comment_lines;
+      if (!result.origin) result.origin = sss::core::parseOriginCommentLine(line);
       continue;
     }
     const std::vector<std::string> fields = splitFields(line);
@@ -153,6 +156,10 @@ TumReadResult parseTum(const std::string& text, const std::string& name, const T
     line_number = std::max<size_t>(line_number, 1);
     return fail("no poses (only comments or blank lines)");
   }
+  if (options.target_origin && result.origin && !sameOrigin(*result.origin, *options.target_origin)) {
+    reexpressTrajectory(result.poses, *result.origin, *options.target_origin);
+    result.reexpressed = true;
+  }
   result.ok = true;
   return result;
 }
@@ -183,7 +190,8 @@ std::string tumLine(const StampedPose& pose) {
   return line;
 }
 
-bool writeTum(const std::string& path, const Trajectory& poses, std::string& error, const std::string& comment) {
+bool writeTum(const std::string& path, const Trajectory& poses, std::string& error, const std::string& comment,
+              const std::optional<sss::core::MissionOrigin>& origin) {
   std::ofstream out(path, std::ios::binary);
   if (!out) {
     error = "cannot write " + path + "; check the directory exists and is writable";
@@ -193,6 +201,7 @@ bool writeTum(const std::string& path, const Trajectory& poses, std::string& err
     std::istringstream lines(comment);
     for (std::string line; std::getline(lines, line);) out << "# " << line << "\n";
   }
+  if (origin) out << sss::core::originCommentLine(*origin) << "\n";
   for (const StampedPose& pose : poses) out << tumLine(pose);
   out.close();
   if (!out) {

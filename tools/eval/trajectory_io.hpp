@@ -2,9 +2,11 @@
 // a strict reader that names file:line for every problem, and the matching writer.
 #pragma once
 
+#include "pipeline/core/mission_origin.hpp"
 #include "pipeline/core/pose.hpp"
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,6 +24,10 @@ struct TumReadOptions {
   // A quaternion whose norm is further than this from 1 is a malformed line (a unit quaternion
   // written with 9 decimals is within 1e-8). The others are normalised.
   double max_quaternion_norm_error = 0.01;
+  // Set: poses of a file whose header names another origin are re-expressed in this origin's
+  // frame (see frame_alignment.hpp), so that a run processed with its own origin (the first fix)
+  // compares with a truth in the simulator's frame.
+  std::optional<sss::core::MissionOrigin> target_origin;
 };
 
 struct TumReadResult {
@@ -30,9 +36,13 @@ struct TumReadResult {
   std::string error;  // "FILE:LINE: what is wrong; what to do" when !ok
   size_t comment_lines = 0;
   size_t blank_lines = 0;
+  // The origin a '# origin_latitude_deg .. origin_longitude_deg ..' header line names (the frame
+  // the file was written in), before any re-expression; nullopt when the file names none.
+  std::optional<sss::core::MissionOrigin> origin;
+  bool reexpressed = false;  // the poses were moved into options.target_origin's frame
 };
 
-// Reads a TUM file. Lines starting with '#' and blank lines are skipped; fields are separated by
+// Reads a TUM file. Lines starting with '#' (one may name the origin) and blank lines are skipped; fields are separated by
 // spaces, tabs or commas. Any other line must hold 8 finite numbers. Timestamps must increase
 // strictly. The first problem ends the read with ok = false and a message naming file and line.
 TumReadResult readTum(const std::string& path, const TumReadOptions& options = {});
@@ -49,6 +59,7 @@ bool parseTumTimestamp(const std::string& text, int64_t& utime_us);
 std::string tumLine(const StampedPose& pose);
 // Writes the poses (with an optional '#' comment first). False with a message in error when the
 // file cannot be written.
-bool writeTum(const std::string& path, const Trajectory& poses, std::string& error, const std::string& comment = "");
+bool writeTum(const std::string& path, const Trajectory& poses, std::string& error, const std::string& comment = "",
+              const std::optional<sss::core::MissionOrigin>& origin = std::nullopt);
 
 }  // namespace sss::eval

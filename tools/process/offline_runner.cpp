@@ -27,6 +27,7 @@
 #include "drivers/xtf/xtf_reader.hpp"
 #include "pipeline/core/config.hpp"
 #include "pipeline/core/geodesy.hpp"
+#include "pipeline/core/mission_origin.hpp"
 #include "pipeline/matcher/matcher_engine.hpp"
 #include "pipeline/optimiser/optimiser_engine.hpp"
 #include "pipeline/subframe/pictures.hpp"
@@ -60,8 +61,8 @@ bool hasExtension(const std::string& path, const char* extension) {
 }
 
 struct Options {
-  double origin_latitude_deg = 59.35;
-  double origin_longitude_deg = 18.07;
+  // mission.origin_*: an override; unset, the first valid position of the navigation.
+  std::optional<sss::core::MissionOrigin> origin;
   sss::edgetech::SonarDriverOptions sonar;
   sss::xtf::XtfReaderOptions xtf;
   sss::ins::InsBridgeOptions ins;
@@ -78,8 +79,7 @@ bool readOptions(const std::string& path, Options& options, std::string& error) 
     using namespace sss::core;
     Config config = Config::fromFile(path);
     ConfigSection mission = config.section("mission");
-    mission.optional("origin_latitude_deg", options.origin_latitude_deg, {inRange(-90.0, 90.0)});
-    mission.optional("origin_longitude_deg", options.origin_longitude_deg, {inRange(-180.0, 180.0)});
+    options.origin = readMissionOrigin(mission);
     ConfigSection sonar = config.section("sonar_driver");
     sss::edgetech::readSonarDriverOptions(sonar, options.sonar);
     sonar.optional("xtf_pair_index", options.xtf.pair_index, {inRange(0, 7)});
@@ -96,8 +96,7 @@ bool readOptions(const std::string& path, Options& options, std::string& error) 
       return false;
     }
   }
-  options.ins.origin_latitude_deg = options.origin_latitude_deg;
-  options.ins.origin_longitude_deg = options.origin_longitude_deg;
+  options.ins.origin = options.origin;
   // Files carry the ping time of the sonar's clock; a recording has no live clock to compare with.
   options.sonar.time_source = sss::edgetech::TimeSource::kSonarClock;
   options.sonar.recorder.directory.clear();
@@ -209,6 +208,7 @@ class InsFileSource {
     for (const auto& sample : samples) out.push_back(sss::ins::toNavMessage(sample));
     return !finished_ || !samples.empty();
   }
+  const std::optional<sss::core::MissionOrigin>& origin() const { return bridge_.origin(); }
   uint64_t faults() const {
     const auto& c = bridge_.streamCounters();
     return static_cast<uint64_t>(c.bad_checksum + c.missing_checksum + c.overlong + c.bad_character + c.truncated);
@@ -221,17 +221,26 @@ class InsFileSource {
 };
 
 // Navigation from a sonar ping's header (JSF type 80 and XTF carry position, attitude, altitude).
+// With no origin configured, the first ping with a position is the origin.
 class EmbeddedNavigation {
  public:
-  EmbeddedNavigation(double latitude_deg, double longitude_deg) : plane_(latitude_deg, longitude_deg) {}
+  explicit EmbeddedNavigation(const std::optional<sss::core::MissionOrigin>& origin) {
+    if (origin) setOrigin(*origin);
+  }
+  const std::optional<sss::core::MissionOrigin>& origin() const { return origin_; }
   std::optional<NavInput> fromPing(const sss::edgetech::DriverPing& driver_ping) {
     const auto& side = driver_ping.ping.port ? *driver_ping.ping.port : *driver_ping.ping.starboard;
     if (!(side.validity & sss::edgetech::kValidLatLon) && side.latitude_deg == 0.0 && side.longitude_deg == 0.0) {
-      return std::nullopt;  // no position in this file
+      return std::nullopt;  // no position in this ping
+    }
+    if (!plane_) {
+      if (!sss::core::isFirstFixCandidate(side.latitude_deg, side.longitude_deg)) return std::nullopt;
+      setOrigin({side.latitude_deg, side.longitude_deg});
     }
     NavInput nav;
     nav.utime_us = driver_ping.utime_us;
-    nav.position_ned_m = plane_.toNed({side.latitude_deg, side.longitude_deg, side.depth_m});
+    nav.origin = origin_;
+    nav.position_ned_m = plane_->toNed({side.latitude_deg, side.longitude_deg, side.depth_m});
     nav.roll_rad = side.roll_rad;
     nav.pitch_rad = side.pitch_rad;
     nav.heading_rad = side.heading_rad;
@@ -244,10 +253,107 @@ class EmbeddedNavigation {
   }
 
  private:
-  sss::core::LocalTangentPlane plane_;
+  void setOrigin(const sss::core::MissionOrigin& origin) {
+    origin_ = origin;
+    plane_.emplace(origin.latitude_deg, origin.longitude_deg);
+  }
+  std::optional<sss::core::MissionOrigin> origin_;
+  std::optional<sss::core::LocalTangentPlane> plane_;
   std::optional<Eigen::Vector3d> last_;
   double distance_m_ = 0.0;
 };
+
+// ---- what a run yields, and why not -------------------------------------------------------------
+
+std::string count(uint64_t n) { return std::to_string(static_cast<unsigned long long>(n)); }
+
+// One line per stage that yielded nothing, naming the cause and the fix, in chain order; the
+// first explains the rest. Empty when every stage produced something.
+std::vector<std::string> explainRun(const OfflineSummary& s, const Options& options) {
+  std::vector<std::string> findings;
+  const auto& fusion = s.buffer.fusion;
+  const uint64_t pings = s.pings;
+  if (s.pings_with_pose == 0) {
+    // The largest cause of loss first.
+    const std::pair<uint64_t, std::string> causes[] = {
+        {s.pings_without_position,
+         count(s.pings_without_position) + " of " + count(pings) + " ping headers carry no position: the file has no "
+         "navigation of its own; give the INS file with --ins"},
+        {fusion.dropped_no_altitude,
+         count(fusion.dropped_no_altitude) + " of " + count(pings) + " pings have no altitude: the navigation and "
+         "the ping headers carry none" +
+             (options.buffer.fusion.altitude_source == sss::subframe::AltitudePolicy::kNav
+                  ? "; set subframe_buffer.fusion.altitude_source: auto (tracks the bottom in the returns)"
+                  : " and no seabed return was found in the sonar returns (bottom tracking found one in " +
+                        count(s.bottom_track.detected) + " pings); check that the file holds the sonar's raw "
+                        "returns from the water column down, or give an INS file with altitude (--ins)")},
+        {fusion.dropped_nav_gap,
+         count(fusion.dropped_nav_gap) + " of " + count(pings) + " pings fall between navigation samples more than " +
+             std::to_string(options.buffer.fusion.max_nav_gap_s) + " s apart; raise subframe_buffer.fusion."
+             "max_nav_gap_s to the navigation's sample interval"},
+        {fusion.dropped_no_nav + fusion.dropped_too_old + fusion.dropped_before_first_fix,
+         count(fusion.dropped_no_nav + fusion.dropped_too_old + fusion.dropped_before_first_fix) + " of " +
+             count(pings) + " pings have no navigation at their time (" + count(fusion.dropped_before_first_fix) +
+             " before the first fix): the INS file does not cover the sonar file's times (another day? a clock "
+             "offset?); give the INS file recorded with it"},
+        {fusion.pings_duplicate + fusion.pings_out_of_order,
+         count(fusion.pings_duplicate + fusion.pings_out_of_order) + " of " + count(pings) +
+             " pings repeat a ping number or go back in time; check the file's ping times"},
+    };
+    const auto* worst = &causes[0];
+    for (const auto& cause : causes) {
+      if (cause.first > worst->first) worst = &cause;
+    }
+    findings.push_back(worst->first > 0 ? "no ping got a pose: " + worst->second
+                                        : "no ping got a pose (" + count(pings) + " pings, " + count(s.nav_samples) +
+                                              " navigation samples)");
+    return findings;
+  }
+  if (s.subframes == 0) {
+    const auto& builder = s.buffer.builder;
+    std::string why;
+    if (builder.lines == 0) {
+      why = "no straight survey line was found: the " + count(s.pings_with_pose) + " pings with a pose are all in "
+            "turns (" + count(builder.turn_pings) + ") or the heading wanders more than subframe_buffer.lines."
+            "max_heading_deviation_rad; a curved line needs that raised";
+    } else {
+      why = "the " + count(builder.lines) + " survey line(s) are shorter than subframe_buffer.subframes.min_pings (" +
+            std::to_string(options.buffer.subframes.min_pings) + " pings; " + count(builder.dropped_tail_pings) +
+            " pings dropped as short tails); lower min_pings for short lines";
+    }
+    findings.push_back("no subframe: " + why);
+    return findings;
+  }
+  const double swath_m = options.buffer.canonical.bins_per_side * options.buffer.canonical.bin_size_m;
+  if (s.pairs_attempted == 0) {
+    if (s.survey_lines < 2) {
+      findings.push_back("no pair to match: every subframe is on one survey line; loop closures need a second line "
+                         "over the same seabed (the result is dead reckoning)");
+    } else {
+      char text[512];
+      std::snprintf(text, sizeof text,
+                    "no pair to match: no two subframes of different lines overlap within the canonical swath of "
+                    "%.0f m per side (nearest centres of different lines: %.0f m apart); widen it with "
+                    "subframe_buffer.canonical.bins_per_side x bin_size_m up to the sonar's range",
+                    swath_m, s.nearest_other_line_m);
+      findings.push_back(text);
+    }
+    return findings;
+  }
+  if (s.matcher_closures == 0) {
+    findings.push_back("no loop closure: " + count(s.pairs_attempted) + " pair attempts, " +
+                       count(s.pairs_few_matches) + " with too few dense matches (little overlap or texture), " +
+                       count(s.pairs_pose_rejected) + " with a rejected relative pose; first: " + s.first_pair_rejection +
+                       " (the result is dead reckoning)");
+    return findings;
+  }
+  if (s.closures_accepted == 0) {
+    findings.push_back("no closure accepted: the optimiser rejected all " + count(s.matcher_closures) +
+                       " (inconsistent with dead reckoning and with each other; see loop_closures.csv); the result is "
+                       "dead reckoning");
+  }
+  return findings;
+}
 
 // ---- outputs -----------------------------------------------------------------------------------
 
@@ -323,6 +429,15 @@ bool writeSummaryJson(const std::string& path, const OfflineRequest& request, co
   json.key("lcm_log").value(request.lcm_log_path);
   json.key("config").value(request.config_path);
   json.endObject();
+  // The frame of every trajectory, heightmap and point cloud of the run (local NED of this point).
+  json.key("origin").beginObject();
+  if (s.origin) {
+    json.key("latitude_deg").value(s.origin->latitude_deg, 13);
+    json.key("longitude_deg").value(s.origin->longitude_deg, 13);
+  }
+  json.key("source").value(s.origin_source);
+  json.key("detail").value(s.origin_detail);
+  json.endObject();
   const std::pair<const char*, uint64_t> counts[] = {
       {"nav_samples", s.nav_samples},         {"pings", s.pings},
       {"pings_with_pose", s.pings_with_pose}, {"subframes", s.subframes},
@@ -332,6 +447,45 @@ bool writeSummaryJson(const std::string& path, const OfflineRequest& request, co
       {"closures_superseded", s.closures_superseded}, {"seabed_points", s.seabed_points},
       {"input_faults", s.input_faults}};
   for (const auto& [name, value] : counts) json.key(name).value(value);
+  const auto& fusion = s.buffer.fusion;
+  json.key("pings_dropped").beginObject();
+  const std::pair<const char*, uint64_t> drops[] = {
+      {"no_position_in_header", s.pings_without_position},
+      {"before_first_fix", fusion.dropped_before_first_fix},
+      {"no_nav", fusion.dropped_no_nav},
+      {"older_than_nav_history", fusion.dropped_too_old},
+      {"nav_gap", fusion.dropped_nav_gap},
+      {"no_altitude", fusion.dropped_no_altitude},
+      {"duplicate", fusion.pings_duplicate},
+      {"out_of_order", fusion.pings_out_of_order}};
+  for (const auto& [name, value] : drops) json.key(name).value(value);
+  json.endObject();
+  json.key("altitude_sources").beginObject();
+  json.key("nav").value(fusion.altitude_from_nav);
+  json.key("ping_header").value(fusion.altitude_from_ping);
+  json.key("bottom_track").value(fusion.altitude_from_bottom_track);
+  json.key("implausible_rejected").value(fusion.altitude_implausible);
+  json.endObject();
+  json.key("bottom_track").beginObject();
+  json.key("pings").value(s.bottom_track.pings);
+  json.key("detected").value(s.bottom_track.detected);
+  json.key("one_side_only").value(s.bottom_track.one_side_only);
+  json.key("outliers").value(s.bottom_track.outliers);
+  json.endObject();
+  json.key("lines").beginObject();
+  json.key("survey_lines").value(s.survey_lines);
+  json.key("turn_pings").value(s.buffer.builder.turn_pings);
+  json.key("short_tail_pings").value(s.buffer.builder.dropped_tail_pings);
+  json.key("nearest_other_line_m").value(s.nearest_other_line_m, 6);
+  json.endObject();
+  json.key("pairs_rejected").beginObject();
+  json.key("few_dense_matches").value(s.pairs_few_matches);
+  json.key("relative_pose").value(s.pairs_pose_rejected);
+  json.key("first_reason").value(s.first_pair_rejection);
+  json.endObject();
+  json.key("findings").beginArray();
+  for (const std::string& finding : s.findings) json.value(finding);
+  json.endArray();
   const std::pair<const char*, double> figures[] = {
       {"mission_s", s.mission_s},     {"wall_s", s.wall_s},
       {"matcher_s", s.matcher_s},     {"optimiser_s", s.optimiser_s},
@@ -404,6 +558,7 @@ class Runner {
 
   void addNav(const NavInput& nav) {
     ++summary_.nav_samples;
+    if (nav.origin && !origin_) origin_ = nav.origin;  // the frame every output is written in
     buffer_.addNav(nav, subframes_);
     handleSubframes();
   }
@@ -450,6 +605,27 @@ class Runner {
 
   bool writeOutputs(std::string& error);
   OfflineSummary& summary() { return summary_; }
+  const std::optional<sss::core::MissionOrigin>& origin() const { return origin_; }
+  const sss::subframe::SubframeBuffer& buffer() const { return buffer_; }
+  // The stage counters and the survey's layout into the summary (after finish()).
+  void countStages() {
+    summary_.buffer = buffer_.counters();
+    summary_.bottom_track = buffer_.bottomTrackCounters();
+    std::vector<int> lines;
+    for (const auto& [line, centre] : centres_) {
+      if (std::find(lines.begin(), lines.end(), line) == lines.end()) lines.push_back(line);
+    }
+    summary_.survey_lines = lines.size();
+    double nearest = -1.0;
+    for (size_t i = 0; i < centres_.size(); ++i) {
+      for (size_t j = i + 1; j < centres_.size(); ++j) {
+        if (centres_[i].first == centres_[j].first) continue;
+        const double d = (centres_[i].second - centres_[j].second).head<2>().norm();
+        if (nearest < 0.0 || d < nearest) nearest = d;
+      }
+    }
+    summary_.nearest_other_line_m = nearest;
+  }
 
   // matches.csv: the matcher engine shows every matched pair to the writer.
   bool openMatchWriter(std::string& error) {
@@ -479,7 +655,12 @@ class Runner {
     bool added = false;
     for (const auto& outcome : outcomes) {
       ++summary_.pairs_attempted;
-      if (!outcome.accepted) continue;
+      if (!outcome.accepted) {
+        const bool few_matches = outcome.reason.find("dense matches, below") != std::string::npos;
+        ++(few_matches ? summary_.pairs_few_matches : summary_.pairs_pose_rejected);
+        if (summary_.first_pair_rejection.empty()) summary_.first_pair_rejection = outcome.reason;
+        continue;
+      }
       ++summary_.matcher_closures;
       sss::matcher::LoopClosure closure = outcome.closure;
       if (injectFalseClosure(closure)) ++summary_.false_closures_injected;
@@ -517,6 +698,7 @@ class Runner {
   void handleSubframes() {
     for (sss::subframe::Subframe& subframe : subframes_) {
       ++summary_.subframes;
+      centres_.push_back({subframe.line_id, subframe.centre().T_world_body.translation});
       optimiser_.addSubframe(subframe);
       if (request_.write_mosaics) mosaic_subframes_.push_back(decimateForMosaic(subframe, mosaic_factor_));
       addOutcomes(timedMatch([&] { return matcher_.addSubframe(std::move(subframe)); }));
@@ -533,12 +715,14 @@ class Runner {
   sss::optimiser::OptimiserEngine optimiser_;
   std::vector<sss::subframe::Subframe> subframes_;  // reused
   std::vector<sss::subframe::Subframe> mosaic_subframes_;
+  std::vector<std::pair<int, Eigen::Vector3d>> centres_;  // line id and DR centre of every subframe
   std::vector<sss::optimiser::StampedPose> dr_per_ping_;
   int mosaic_factor_ = 1;
   OfflineSummary summary_;
   MatchCsvWriter match_writer_;  // open only with request_.write_matches
   int64_t first_ping_us_ = -1;
   int64_t last_ping_us_ = 0;
+  std::optional<sss::core::MissionOrigin> origin_;
   double start_s_ = wallSeconds();
   double last_progress_s_ = 0.0;
 };
@@ -552,8 +736,13 @@ bool Runner::writeOutputs(std::string& error) {
     slam.push_back({p.utime_us, optimiser_.correctionAt(p.utime_us).T_corrected_dr * p.T_world_body});
   }
   summary_.pings_with_pose = dr_per_ping_.size();
-  if (!sss::optimiser::writeTum(dir + "/dead_reckoning.tum", dr_per_ping_, "sss-process: dead reckoning at every ping", error)) return false;
-  if (!sss::optimiser::writeTum(dir + "/slam.tum", slam, "sss-process: SLAM-corrected pose at every ping", error)) return false;
+  if (!sss::optimiser::writeTum(dir + "/dead_reckoning.tum", dr_per_ping_, "sss-process: dead reckoning at every ping",
+                                error, origin_)) {
+    return false;
+  }
+  if (!sss::optimiser::writeTum(dir + "/slam.tum", slam, "sss-process: SLAM-corrected pose at every ping", error, origin_)) {
+    return false;
+  }
   if (!writeClosuresCsv(dir + "/loop_closures.csv", optimiser_, error)) return false;
   if (!match_writer_.close(error)) return false;
 
@@ -572,13 +761,13 @@ bool Runner::writeOutputs(std::string& error) {
   if (!sss::optimiser::writeSeabedPly(dir + "/bathymetry_dr.ply", points_dr, error)) return false;
   if (!points.empty() &&
       !sss::optimiser::writeHeightmapFiles(dir + "/heightmap.yaml", sss::optimiser::gridSeabedPoints(points, bathymetry),
-                                           "sss-process: seabed re-triangulated with the SLAM poses", error)) {
+                                           "sss-process: seabed re-triangulated with the SLAM poses", error, origin_)) {
     return false;
   }
   if (!points_dr.empty() &&
       !sss::optimiser::writeHeightmapFiles(dir + "/heightmap_dr.yaml",
                                            sss::optimiser::gridSeabedPoints(points_dr, bathymetry),
-                                           "sss-process: seabed triangulated with the DR poses", error)) {
+                                           "sss-process: seabed triangulated with the DR poses", error, origin_)) {
     return false;
   }
 
@@ -697,7 +886,7 @@ OfflineResult runOffline(const OfflineRequest& request) {
         return result;
       }
     } else {
-      embedded.emplace(options.origin_latitude_deg, options.origin_longitude_deg);
+      embedded.emplace(options.origin);
     }
     // Merge by time: nav before a ping of the same time, so the ping finds its bracketing nav.
     // Everything goes through the SSS_PING and SSS_NAV messages, exactly as in the live chain.
@@ -746,6 +935,7 @@ OfflineResult runOffline(const OfflineRequest& request) {
           runner.addNav(*nav);
         } else {
           ++without_nav;
+          ++runner.summary().pings_without_position;
         }
       }
       const sss_msgs::ping_t message = sss::edgetech::toPingMessage(ping);
@@ -765,7 +955,24 @@ OfflineResult runOffline(const OfflineRequest& request) {
   }
   runner.progress(1.0, true);
   runner.finish();
+  runner.countStages();
   OfflineSummary& summary = runner.summary();
+  summary.origin = runner.origin();
+  if (options.origin) {
+    summary.origin_source = sss::core::originSourceName(sss::core::OriginSource::kConfigured);
+    summary.origin_detail = "mission.origin_latitude_deg / origin_longitude_deg in " + request.config_path;
+  } else if (from_log) {
+    summary.origin_source = sss::core::originSourceName(sss::core::OriginSource::kFromNavigation);
+    summary.origin_detail = "carried by the log's " + request.nav_channel + " messages (the INS bridge's origin)";
+  } else {
+    summary.origin_source = sss::core::originSourceName(sss::core::OriginSource::kFirstFix);
+    summary.origin_detail = request.ins_path.empty() ? "the first position in the sonar file's ping headers"
+                                                     : "the first position fix in " + request.ins_path;
+  }
+  if (request.progress && summary.origin) {
+    std::fprintf(request.progress, "sss-process: mission origin %.7f %.7f (%s: %s)\n", summary.origin->latitude_deg,
+                 summary.origin->longitude_deg, summary.origin_source.c_str(), summary.origin_detail.c_str());
+  }
   summary.input_faults = faults;
   result.exit_code = 1;
   if (!runner.writeOutputs(result.error)) return result;
@@ -773,8 +980,15 @@ OfflineResult runOffline(const OfflineRequest& request) {
   summary.mission_s = runner.missionSeconds();
   summary.real_time_factor = summary.wall_s > 0.0 ? summary.mission_s / summary.wall_s : 0.0;
   summary.peak_rss_mib = peakRssMib();
+  summary.findings = explainRun(summary, options);
   result.summary = summary;
   if (!writeSummaryJson(request.out_dir + "/summary.json", request, summary, result.error)) return result;
+  if (summary.pings_with_pose == 0 || summary.subframes == 0) {
+    // Nothing could be processed: the outputs say so (summary.json), and so does the exit code.
+    result.exit_code = 3;
+    result.error = summary.findings.empty() ? "nothing could be processed" : summary.findings.front();
+    return result;
+  }
   result.ok = true;
   result.exit_code = 0;
   return result;

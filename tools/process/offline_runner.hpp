@@ -8,7 +8,12 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <optional>
 #include <string>
+
+#include "pipeline/core/mission_origin.hpp"
+#include "pipeline/subframe/subframe_buffer.hpp"
+#include <vector>
 
 namespace sss::offline {
 
@@ -40,6 +45,11 @@ struct OfflineRequest {
 };
 
 struct OfflineSummary {
+  // The local NED frame of every output: configured (mission.origin_*), else the first valid
+  // position of the navigation (INS file, sonar file headers) or the one SSS_NAV carries (a log).
+  std::optional<sss::core::MissionOrigin> origin;
+  std::string origin_source;  // "configured", "first_fix" (which source: origin_detail), "from_navigation"
+  std::string origin_detail;  // e.g. "the first position in the sonar file's ping headers"
   uint64_t nav_samples = 0;
   uint64_t pings = 0;            // pings read
   uint64_t pings_with_pose = 0;  // pings that got a DR pose (in the trajectories)
@@ -52,6 +62,17 @@ struct OfflineSummary {
   uint64_t closures_superseded = 0;
   uint64_t seabed_points = 0;
   uint64_t input_faults = 0;       // corrupt records, bad messages, dropped pings
+  // Where the pings went: the fusion's drops by cause and altitude sources, the line builder's.
+  sss::subframe::SubframeBufferCounters buffer;
+  sss::subframe::BottomTrackerCounters bottom_track;
+  uint64_t pings_without_position = 0;  // embedded navigation: a ping header without a position
+  uint64_t survey_lines = 0;
+  double nearest_other_line_m = -1.0;   // closest centres of subframes of different lines; < 0: none
+  uint64_t pairs_few_matches = 0;       // pairs rejected for too few dense matches
+  uint64_t pairs_pose_rejected = 0;     // pairs whose relative pose failed
+  std::string first_pair_rejection;
+  // One line each, cause and fix, when a stage yielded nothing (no pose, subframe, pair, closure).
+  std::vector<std::string> findings;
   double mission_s = 0.0;          // first to last ping time
   double wall_s = 0.0;
   double matcher_s = 0.0;
@@ -62,7 +83,10 @@ struct OfflineSummary {
 
 struct OfflineResult {
   bool ok = false;
-  int exit_code = 1;      // 0 ok, 2 unusable input or configuration, 1 failure while writing
+  // 0 ok (also with findings: a DR-only result is a result), 1 failure while writing, 2 unusable
+  // input or configuration, 3 nothing could be processed: no ping got a pose or no subframe could
+  // be built (the outputs and summary.json are written; error holds the first finding).
+  int exit_code = 1;
   std::string error;      // one line, names the file
   OfflineSummary summary;
 };

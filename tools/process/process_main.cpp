@@ -1,7 +1,9 @@
 // sss-process: post-processes a survey offline with the live chain's libraries, deterministically.
 //   sss-process --sonar FILE.jsf|FILE.xtf [--ins FILE.nmea] [--config FILE] --out DIR
 //   sss-process --lcm-log FILE [--config FILE] --out DIR
-// Without --ins the navigation in the sonar file's ping headers is used. Exit 0 ok, 2 bad input.
+// Without --ins the navigation in the sonar file's ping headers is used. Exit 0 ok (with a warning
+// per stage that yielded nothing), 1 an output could not be written, 2 bad input, 3 nothing could
+// be processed (no ping got a pose, or no subframe: the reason is printed and in summary.json).
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -24,7 +26,10 @@ void usage(std::FILE* out) {
                "                         before the optimiser (summary.json: false_closures_injected)\n"
                "Writes to DIR: dead_reckoning.tum, slam.tum (every ping, TUM, local NED of the mission origin),\n"
                "loop_closures.csv, bathymetry.ply (+ bathymetry_dr.ply), heightmap.yaml/.png (+ heightmap_dr),\n"
-               "mosaic_dr.png, mosaic_slam.png (+ .yaml geo-references) and summary.json.\n");
+               "mosaic_dr.png, mosaic_slam.png (+ .yaml geo-references) and summary.json (counts, where the pings\n"
+               "went, the mission origin and, when a stage yielded nothing, why).\n"
+               "Exit: 0 ok, 1 an output could not be written, 2 bad arguments or input, 3 nothing could be\n"
+               "processed (no ping got a pose, or no subframe).\n");
 }
 }  // namespace
 
@@ -81,6 +86,7 @@ int main(int argc, char** argv) {
     return result.exit_code;
   }
   const auto& s = result.summary;
+  for (const std::string& finding : s.findings) std::fprintf(stderr, "sss-process: warning: %s\n", finding.c_str());
   if (s.false_closures_injected > 0)
     std::printf("sss-process: %llu of the matcher's closures made false on purpose (--inject-false-closures)\n",
                 static_cast<unsigned long long>(s.false_closures_injected));

@@ -2,6 +2,8 @@
 // rendering in chunks (JSF streamed to disk), TUM trajectories, seabed rasters, PNG previews.
 #include "tools/sim/mission.hpp"
 
+#include "pipeline/core/mission_origin.hpp"
+
 #include "drivers/edgetech/jsf_format.hpp"
 #include "drivers/ins/ixblue_nmea.hpp"
 
@@ -47,6 +49,7 @@ void readSimOptions(sss::core::ConfigSection section, SimOptions& o) {
   section.optional("auto_seabed_extent", o.auto_seabed_extent);
   section.optional("waterfall_bins_per_side", o.waterfall_bins_per_side, {inRange(16, 20000)});
   section.optional("mosaic_resolution_m", o.mosaic_resolution_m, {inRange(0.05, 10.0)});
+  section.optional("record_altitude", o.record_altitude);
 
   sss::core::ConfigSection seabed = subsection(section, "seabed");
   SeabedOptions& s = o.seabed;
@@ -157,6 +160,8 @@ std::vector<std::string> validateSimOptions(const SimOptions& o) {
     text << "sim." << key << ": " << value << " " << reason;
     problems.push_back(text.str());
   };
+  if (!(std::abs(o.origin_latitude_deg) <= 89.0)) add("origin_latitude_deg", o.origin_latitude_deg, "must be within [-89, 89]");
+  if (!(std::abs(o.origin_longitude_deg) <= 180.0)) add("origin_longitude_deg", o.origin_longitude_deg, "must be within [-180, 180]");
   const double max_ping_rate = o.sonar.sound_speed_m_s / (2.0 * o.sonar.range_m);
   if (o.sonar.ping_rate_hz > max_ping_rate + 1e-9) {
     add("sonar.ping_rate_hz", o.sonar.ping_rate_hz,
@@ -201,6 +206,7 @@ std::string simOptionsYaml(const SimOptions& o) {
   out << YAML::Key << "auto_seabed_extent" << YAML::Value << o.auto_seabed_extent;
   out << YAML::Key << "waterfall_bins_per_side" << YAML::Value << o.waterfall_bins_per_side;
   out << YAML::Key << "mosaic_resolution_m" << YAML::Value << o.mosaic_resolution_m;
+  out << YAML::Key << "record_altitude" << YAML::Value << o.record_altitude;
   const SeabedOptions& s = o.seabed;
   out << YAML::Key << "seabed" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "north_min_m" << YAML::Value << s.north_min_m << YAML::Key << "east_min_m" << YAML::Value << s.east_min_m
@@ -340,6 +346,10 @@ std::vector<uint8_t> Mission::encodePingJsf(size_t ping, const PingSamples& samp
   record.longitude_deg = geo.longitude_deg;
   record.depth_m = geo.depth_m;
   record.altitude_m = nav.altitude_m;
+  if (!options_.record_altitude) {
+    record.validity &= ~jsf::kValidAltitude;
+    record.altitude_m = 0.0;
+  }
   record.heading_rad = nav.heading_rad < 0.0 ? nav.heading_rad + 2.0 * kPi : nav.heading_rad;
   record.pitch_rad = nav.pitch_rad;
   record.roll_rad = nav.roll_rad;
@@ -383,6 +393,7 @@ std::string insNmeaStream(const Mission& mission) {
     state.velocity_east_std_m_s = 0.01;
     state.velocity_down_std_m_s = 0.01;
     state.validity = sss::ins::kValidAll;
+    if (!mission.options().record_altitude) state.validity &= ~sss::ins::kValidAltitude;
     stream += sss::ins::encodeInsState(state);
   }
   return stream;
@@ -522,7 +533,10 @@ bool writeMission(const Mission& mission, const std::string& out_dir, MissionRep
   if (!writeSeabed(mission, dir, report, error)) return false;
 
   // Trajectories, one line per ping.
-  std::string truth_text, dr_text;
+  // The frame's origin heads both files, so that a run with another origin is compared right.
+  const std::string origin_line =
+      sss::core::originCommentLine({mission.options().origin_latitude_deg, mission.options().origin_longitude_deg}) + "\n";
+  std::string truth_text = origin_line, dr_text = origin_line;
   for (size_t i = 0; i < pings; ++i) {
     const int64_t utime = mission.pingUtimeUs(i);
     const sss::core::Pose truth = mission.truthAtPing(i).T_world_body;

@@ -27,6 +27,9 @@ struct SimOptions {
   bool auto_seabed_extent = true;           // size the seabed from the path and the range
   int waterfall_bins_per_side = 1000;       // PNG previews: slant-range samples are averaged
   double mosaic_resolution_m = 0.5;
+  // False: no altitude in the files (INS stream and JSF headers), as a towed fish or a vehicle
+  // without DVL records: the chain has to track the bottom in the sonar returns.
+  bool record_altitude = true;
   SeabedOptions seabed;
   TrajectoryOptions trajectory;
   DeadReckoningOptions dead_reckoning;

@@ -204,6 +204,11 @@ SimOptions randomiseMission(const RandomiseOptions& request) {
   o.dead_reckoning.heading_noise_rad = draw.chance(0.5) ? draw.uniform(0.0, 0.03) : 0.0;
   drawSeabedFamily(o.family, area_km2, s.resolution_m, draw, s, sonar);
   o.mosaic_resolution_m = sonar.range_m <= 100.0 ? 0.5 : 1.0;
+  // Anywhere on Earth up to 70 degrees of latitude (an own stream: the draws above keep their
+  // values): the chain takes its frame from the data, and must hold wherever it was recorded.
+  Draw where(mixSeed(static_cast<uint64_t>(request.seed), 0x0E1C1Dull));
+  o.origin_latitude_deg = std::round(where.uniform(-70.0, 70.0) * 1e4) / 1e4;
+  o.origin_longitude_deg = std::round(where.uniform(-179.99, 179.99) * 1e4) / 1e4;
   return o;
 }
 

@@ -41,7 +41,7 @@ struct RandomiseOptions {
 //   survey: lawnmower (75 %) or lawnmower + 2 cross lines, 3-6 lines of 250-500 m at any heading,
 //     spacing 0.5-1.7 x the ground swath per side (overlap of a line pair 75 % down to 15 %);
 //   dead reckoning: drift scale 0.5-2, white heading noise 0-0.03 rad on half the missions.
-// The mission origin stays at the default (the processing chain's configured origin).
+//   origin: anywhere within 70 degrees of the equator (the chain takes its frame from the data).
 SimOptions randomiseMission(const RandomiseOptions& options);
 
 }  // namespace sss::sim

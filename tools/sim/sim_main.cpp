@@ -16,11 +16,15 @@ const char* kUsage =
     "usage: sss-sim --out DIR [--config FILE] [--seed N] [--pattern lawnmower|loop|cross] [--lines N]\n"
     "               [--cross-lines K] [--line-length-m M] [--line-spacing-m M] [--range-m M] [--altitude-m M]\n"
     "               [--ping-rate-hz HZ] [--drift-scale K] [--heading-noise-rad S] [--duration-s S]\n"
+    "               [--origin-latitude-deg LAT --origin-longitude-deg LON] [--no-altitude]\n"
     "               [--randomise [--family NAME]]\n"
+    "--no-altitude: no altitude in ins.nmea nor in the JSF headers (a towed fish, no DVL).\n"
+    "The mission is flown around the origin (59.35 N 18.07 E unless set; --randomise draws one).\n"
     "Defaults make a ~20 minute, 5-line lawnmower at 2 m/s, 18 m altitude, 75 m range per side.\n"
     "--randomise draws the whole mission from --seed: a seabed family (sand_ripples, mud, rock_outcrops,\n"
     "  boulder_field, trawled, mixed; --family forces one), relief, sonar range 50-200 m with its\n"
-    "  frequency, absorption, TVG, gain steps and speckle, vehicle motion, survey geometry and DR errors.\n"
+    "  frequency, absorption, TVG, gain steps and speckle, vehicle motion, survey geometry, DR errors and\n"
+    "  the place on Earth (within 70 degrees of the equator).\n"
     "  mission.yaml records every drawn value; --config and the flags above then override them.\n"
     "--pattern cross: the lawnmower's --lines, then --cross-lines K (2) lines perpendicular to them\n"
     "  across the block at 1/(K+1) ... K/(K+1) of the line length, one spacing beyond the outer lines.\n"
@@ -41,11 +45,16 @@ bool parseNumber(const std::string& flag, const std::string& text, double& value
 int main(int argc, char** argv) {
   std::map<std::string, std::string> flags;
   bool randomise = false;
+  bool no_altitude = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--help" || arg == "-h") {
       std::cout << kUsage;
       return 0;
+    }
+    if (arg == "--no-altitude") {
+      no_altitude = true;
+      continue;
     }
     if (arg == "--randomise") {
       randomise = true;
@@ -108,7 +117,10 @@ int main(int argc, char** argv) {
       {"--drift-scale", &options.dead_reckoning.drift_scale},
       {"--heading-noise-rad", &options.dead_reckoning.heading_noise_rad},
       {"--duration-s", &options.duration_s},
+      {"--origin-latitude-deg", &options.origin_latitude_deg},
+      {"--origin-longitude-deg", &options.origin_longitude_deg},
   };
+  if (no_altitude) options.record_altitude = false;
   for (const auto& [flag, value] : flags) {
     if (flag == "--out" || flag == "--config" || flag == "--family") continue;
     double number = 0.0;
