@@ -32,16 +32,24 @@ SideDetection detectFirstReturn(const std::vector<float>& envelope, double start
   const int first_bin = std::max(0, static_cast<int>(std::ceil((options.min_altitude_m - start_range_m) / bin_length_m)));
   if (bins - after_bins - first_bin < 4) return detection;
 
-  // Prefix sums of the per-bin level in dB (speckle is multiplicative: compare logarithms).
-  std::vector<double> prefix(static_cast<size_t>(bins) + 1, 0.0);
+  // Prefix sums of the per-bin level in dB (speckle is multiplicative: compare logarithms), each
+  // bin at least 60 dB below the side's bright level (p90 of the bins): a water column of exact
+  // zeros (quantised, or a simulator's) must not make one stray sample a 250 dB "rise".
+  std::vector<double> level(static_cast<size_t>(bins), 0.0);
   for (int b = 0; b < bins; ++b) {
     double sum = 0.0;
     for (int k = 0; k < per_bin; ++k) {
       const float value = envelope[static_cast<size_t>(b) * per_bin + k];
       sum += std::isfinite(value) && value > 0.0f ? value : 0.0;
     }
-    prefix[b + 1] = prefix[b] + 10.0 * std::log10(std::max(sum / per_bin, 1e-30));
+    level[b] = sum / per_bin;
   }
+  std::vector<double> sorted = level;
+  const size_t p90 = sorted.size() * 9 / 10;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(p90), sorted.end());
+  const double floor_level = std::max(sorted[p90] * 1e-6, 1e-30);
+  std::vector<double> prefix(static_cast<size_t>(bins) + 1, 0.0);
+  for (int b = 0; b < bins; ++b) prefix[b + 1] = prefix[b] + 10.0 * std::log10(std::max(level[b], floor_level));
   const int last_bin = bins - after_bins;
   std::vector<double> score(static_cast<size_t>(bins), -1e300);
   double best = -1e300;

@@ -63,7 +63,8 @@ std::vector<std::string> writeWaterfalls(const std::vector<Subframe>& subframes,
 
 bool writeMosaic(const std::vector<Subframe>& subframes,
                  const std::map<int64_t, std::vector<sss::core::Pose>>& poses_by_subframe, const std::string& path,
-                 const PictureOptions& options, std::string& error) {
+                 const PictureOptions& options, std::string& error,
+                 const std::optional<sss::core::MissionOrigin>& origin) {
   if (subframes.empty()) {
     error = "no subframes for the mosaic " + path;
     return false;
@@ -137,6 +138,10 @@ bool writeMosaic(const std::vector<Subframe>& subframes,
           "resolution_m.\n"
        << "resolution_m: " << res << "\nnorth_max_m: " << n_min + rows * res << "\neast_min_m: " << e_min
        << "\nrows: " << rows << "\ncols: " << cols << "\n";
+  if (origin) {
+    yaml.precision(15);
+    yaml << "origin_latitude_deg: " << origin->latitude_deg << "\norigin_longitude_deg: " << origin->longitude_deg << "\n";
+  }
   if (!yaml) {
     error = "cannot write " + yaml_path;
     return false;

@@ -3,9 +3,11 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "pipeline/core/mission_origin.hpp"
 #include "pipeline/core/pose.hpp"
 #include "pipeline/subframe/subframe_builder.hpp"
 
@@ -25,9 +27,11 @@ std::vector<std::string> writeWaterfalls(const std::vector<Subframe>& subframes,
 
 // Writes a north-up mosaic: mean normalised intensity per cell of every valid pixel geo-referenced
 // with the given poses per subframe id (DR when a subframe has none there); black = no data. Its geo-reference goes
-// beside it as the same name with .yaml (keys resolution_m, north_max_m, east_min_m, rows, cols).
+// beside it as the same name with .yaml (keys resolution_m, north_max_m, east_min_m, rows, cols,
+// and origin_latitude_deg / origin_longitude_deg when the frame's origin is given).
 bool writeMosaic(const std::vector<Subframe>& subframes,
                  const std::map<int64_t, std::vector<sss::core::Pose>>& poses_by_subframe, const std::string& path,
-                 const PictureOptions& options, std::string& error);
+                 const PictureOptions& options, std::string& error,
+                 const std::optional<sss::core::MissionOrigin>& origin = std::nullopt);
 
 }  // namespace sss::subframe

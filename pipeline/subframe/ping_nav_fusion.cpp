@@ -38,6 +38,9 @@ void readPingNavFusionOptions(sss::core::ConfigSection& section, PingNavFusionOp
   section.optional("min_altitude_m", options.min_altitude_m, {inRange(0.0, 1000.0)});
   section.optional("pose_heading_from_fit", options.pose_heading_from_fit);
   section.optional("duplicate_memory_pings", options.duplicate_memory_pings, {inRange(1, 100000)});
+  section.optional("bottom_track_calibration_pings", options.bottom_track_calibration_pings, {inRange(1, 100000)});
+  section.optional("min_bottom_track_calibration_pings", options.min_bottom_track_calibration_pings,
+                   {inRange(1, 100000)});
   std::string policy = options.altitude_source == AltitudePolicy::kNav           ? "nav"
                        : options.altitude_source == AltitudePolicy::kBottomTrack ? "bottom_track"
                                                                                  : "auto";
@@ -241,9 +244,23 @@ bool PingNavFusion::resolve(PingInput&& ping, std::vector<FusedPing>& out) {
       have_altitude = true;
     }
   }
+  if (have_altitude && bottom.valid && bottom.altitude_m > 0.0) {
+    const double ratio = fused.altitude_m / bottom.altitude_m;
+    if (ratio > 0.5 && ratio < 1.5) {  // else one of them is lost (a fish, a DVL dropout)
+      altitude_ratios_.push_back(ratio);
+      while (static_cast<int>(altitude_ratios_.size()) > options_.bottom_track_calibration_pings) altitude_ratios_.pop_front();
+    }
+  }
   if (!have_altitude && options_.altitude_source != AltitudePolicy::kNav && bottom.valid &&
       bottom.altitude_m >= options_.min_altitude_m) {
-    fused.altitude_m = bottom.altitude_m;  // a slant range measured at the sonar
+    double scale = 1.0;
+    if (static_cast<int>(altitude_ratios_.size()) >= options_.min_bottom_track_calibration_pings) {
+      std::vector<double> ratios(altitude_ratios_.begin(), altitude_ratios_.end());
+      std::nth_element(ratios.begin(), ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2), ratios.end());
+      scale = ratios[ratios.size() / 2];
+    }
+    counters_.bottom_track_scale = scale;
+    fused.altitude_m = scale * bottom.altitude_m;  // a slant range measured at the sonar
     fused.altitude_source = AltitudeSource::kBottomTrack;
     fused.bottom_track_quality = bottom.quality;
     ++counters_.altitude_from_bottom_track;

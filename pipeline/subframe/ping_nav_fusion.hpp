@@ -96,6 +96,14 @@ struct PingNavFusionOptions {
   double min_altitude_m = 0.5;        // altitudes below this are treated as invalid
   AltitudePolicy altitude_source = AltitudePolicy::kAuto;
   BottomTrackerOptions bottom_track;
+  // A side-scan's first strong return often comes from the inner edge of its beam, not from
+  // nadir: on a real Marine Sonic record it reads 10-20 % above the DVL's altitude. While the
+  // navigation's altitude and the bottom track both exist, their ratio is learned (median of the
+  // last bottom_track_calibration_pings); when the navigation's altitude stops, the bottom track
+  // is scaled by it. Before min_bottom_track_calibration_pings of them, and with no altitude in
+  // the whole file, the first-return range is used as it is.
+  int bottom_track_calibration_pings = 200;
+  int min_bottom_track_calibration_pings = 20;
   int duplicate_memory_pings = 256;   // recent ping numbers remembered to catch duplicates
 
   sss::core::Pose T_body_sonar() const;
@@ -121,6 +129,7 @@ struct PingNavFusionCounters {
   uint64_t altitude_from_ping = 0;   // nav altitude invalid/stale, the ping's own altitude used
   uint64_t altitude_from_bottom_track = 0;
   uint64_t altitude_implausible = 0; // nav or header altitude beyond the ping's range: not used
+  double bottom_track_scale = 1.0;   // the last scale applied to the bottom track (see options)
 
   uint64_t droppedWithoutNav() const {
     return dropped_no_nav + dropped_too_old + dropped_nav_gap + dropped_before_first_fix;
@@ -154,6 +163,7 @@ class PingNavFusion {
   PingNavFusionOptions options_;
   sss::core::Pose T_body_sonar_;
   BottomTracker bottom_tracker_;
+  std::deque<double> altitude_ratios_;  // recorded altitude / bottom track, recent pings
   std::deque<NavInput> history_;
   std::deque<PingInput> pending_;   // sorted by utime
   std::deque<int64_t> recent_numbers_;

@@ -58,6 +58,17 @@ TEST(BottomTracker, FindsTheFirstSeabedReturnPastFishAndABrightPatch) {
   EXPECT_GE(within_10cm, 45);  // the bin is 0.1 m
 }
 
+// A water column of exact zeros (quantised, or simulated without noise) with one stray sample:
+// the stray sample is no seabed.
+TEST(BottomTracker, ASilentWaterColumnWithAStraySampleStillGivesTheSeabed) {
+  std::mt19937 random(4);
+  std::vector<float> side = envelope(random, 18.0, 0.0);
+  side[50] = 1e-4f;  // 1 m out
+  const SideDetection d = detectFirstReturn(side, 0.0, kSpacingM, {});
+  ASSERT_TRUE(d.valid);
+  EXPECT_NEAR(d.slant_range_m, 18.0, 0.15);
+}
+
 TEST(BottomTracker, ADeadSideOrAllWaterIsNoDetection) {
   std::mt19937 random(3);
   const auto dead = envelope(random, 15.0, 0.03, {}, true);

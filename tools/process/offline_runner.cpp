@@ -471,6 +471,7 @@ bool writeSummaryJson(const std::string& path, const OfflineRequest& request, co
   json.key("detected").value(s.bottom_track.detected);
   json.key("one_side_only").value(s.bottom_track.one_side_only);
   json.key("outliers").value(s.bottom_track.outliers);
+  json.key("scale_applied").value(fusion.bottom_track_scale, 6);
   json.endObject();
   json.key("lines").beginObject();
   json.key("survey_lines").value(s.survey_lines);
@@ -551,6 +552,7 @@ class Runner {
         optimiser_(options.optimiser) {
     buffer_.setFusedPingObserver([this](const sss::subframe::FusedPing& fused) {
       dr_per_ping_.push_back({fused.ping.utime_us, fused.T_world_body});
+      altitude_per_ping_.push_back({fused.ping.utime_us, fused.altitude_m, fused.altitude_source, fused.bottom_track_quality});
     });
     mosaic_factor_ = std::max(1, static_cast<int>(std::floor(options.pictures.mosaic_resolution_m /
                                                               (2.0 * options.buffer.canonical.bin_size_m))));
@@ -604,6 +606,7 @@ class Runner {
   }
 
   bool writeOutputs(std::string& error);
+  bool writeAltitudeCsv(const std::string& path, std::string& error) const;
   OfflineSummary& summary() { return summary_; }
   const std::optional<sss::core::MissionOrigin>& origin() const { return origin_; }
   const sss::subframe::SubframeBuffer& buffer() const { return buffer_; }
@@ -717,6 +720,13 @@ class Runner {
   std::vector<sss::subframe::Subframe> mosaic_subframes_;
   std::vector<std::pair<int, Eigen::Vector3d>> centres_;  // line id and DR centre of every subframe
   std::vector<sss::optimiser::StampedPose> dr_per_ping_;
+  struct PingAltitude {
+    int64_t utime_us;
+    double altitude_m;
+    sss::subframe::AltitudeSource source;
+    double quality;
+  };
+  std::vector<PingAltitude> altitude_per_ping_;
   int mosaic_factor_ = 1;
   OfflineSummary summary_;
   MatchCsvWriter match_writer_;  // open only with request_.write_matches
@@ -726,6 +736,25 @@ class Runner {
   double start_s_ = wallSeconds();
   double last_progress_s_ = 0.0;
 };
+
+// altitude.csv: the altitude every ping was processed with and where it came from.
+bool Runner::writeAltitudeCsv(const std::string& path, std::string& error) const {
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) {
+    error = "cannot write " + path;
+    return false;
+  }
+  std::fprintf(f, "# the sonar's altitude above the seabed each ping was processed with; source: nav (DVL), "
+                  "ping_header (the sonar's own field) or bottom_track (its returns; quality 0..1)\n"
+                  "utime_us,altitude_m,source,bottom_track_quality\n");
+  for (const PingAltitude& p : altitude_per_ping_) {
+    std::fprintf(f, "%lld,%.3f,%s,%.2f\n", static_cast<long long>(p.utime_us), p.altitude_m,
+                 sss::subframe::altitudeSourceName(p.source), p.quality);
+  }
+  const bool ok = std::fclose(f) == 0;
+  if (!ok) error = "cannot write " + path;
+  return ok;
+}
 
 bool Runner::writeOutputs(std::string& error) {
   const std::string dir = request_.out_dir;
@@ -744,6 +773,7 @@ bool Runner::writeOutputs(std::string& error) {
     return false;
   }
   if (!writeClosuresCsv(dir + "/loop_closures.csv", optimiser_, error)) return false;
+  if (!writeAltitudeCsv(dir + "/altitude.csv", error)) return false;
   if (!match_writer_.close(error)) return false;
 
   const auto& counters = optimiser_.graph().counters();
@@ -779,8 +809,11 @@ bool Runner::writeOutputs(std::string& error) {
         poses.push_back(optimiser_.correctionAt(ping.utime_us).T_corrected_dr * ping.T_world_body);
       }
     }
-    if (!sss::subframe::writeMosaic(mosaic_subframes_, {}, dir + "/mosaic_dr.png", options_.pictures, error)) return false;
-    if (!sss::subframe::writeMosaic(mosaic_subframes_, slam_poses, dir + "/mosaic_slam.png", options_.pictures, error)) {
+    if (!sss::subframe::writeMosaic(mosaic_subframes_, {}, dir + "/mosaic_dr.png", options_.pictures, error, origin_)) {
+      return false;
+    }
+    if (!sss::subframe::writeMosaic(mosaic_subframes_, slam_poses, dir + "/mosaic_slam.png", options_.pictures, error,
+                                    origin_)) {
       return false;
     }
   }

@@ -1,0 +1,197 @@
+// The real XTF in ../shared/data/real (an Iver2 AUV's Marine Sonic record past the Scotsman wreck,
+// see its README) through what a user runs: sss-process with no configuration, and the bottom
+// tracker against the altitude the vehicle recorded. Checks what a person would: every ping, a
+// frame at the file's first fix, positions inside the file's own lat/lon box, plausible
+// altitudes, subframes and a mosaic in which the wreck stands out. Skipped when the file is absent.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "drivers/xtf/xtf_reader.hpp"
+#include "pipeline/core/geodesy.hpp"
+#include "pipeline/subframe/bottom_tracker.hpp"
+#include "tools/eval/trajectory_io.hpp"
+#include "tools/process/offline_runner.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::string kRealFile = std::string(SSS_REAL_DATA_DIR) + "/scotsman-iver2.xtf";
+
+#define SKIP_WITHOUT_REAL_FILE()                                                                       \
+  if (!fs::is_regular_file(kRealFile)) {                                                               \
+    GTEST_SKIP() << kRealFile << " is absent: the real-data tests need ../shared/data/real beside the " \
+                    "repository";                                                                      \
+  }
+
+std::string readFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+struct FileFacts {
+  size_t pings = 0;
+  double latitude_min = 90, latitude_max = -90, longitude_min = 180, longitude_max = -180;
+  std::vector<double> header_altitude_m, tracked_altitude_m;
+};
+
+// The file as the reader gives it, with the bottom tracker run over every ping.
+FileFacts readFacts() {
+  FileFacts facts;
+  sss::xtf::XtfReader reader(kRealFile);
+  EXPECT_TRUE(reader.isOpen()) << reader.error();
+  sss::subframe::BottomTracker tracker;
+  sss::edgetech::DriverPing ping;
+  while (reader.next(ping)) {
+    ++facts.pings;
+    const auto& side = ping.ping.port ? *ping.ping.port : *ping.ping.starboard;
+    if (side.latitude_deg != 0.0 || side.longitude_deg != 0.0) {
+      facts.latitude_min = std::min(facts.latitude_min, side.latitude_deg);
+      facts.latitude_max = std::max(facts.latitude_max, side.latitude_deg);
+      facts.longitude_min = std::min(facts.longitude_min, side.longitude_deg);
+      facts.longitude_max = std::max(facts.longitude_max, side.longitude_deg);
+    }
+    if (!ping.ping.port || !ping.ping.starboard) continue;
+    const auto& port = *ping.ping.port;
+    const double spacing_m = 0.5 * port.sound_speed_m_s * port.sample_interval_s;
+    const auto track = tracker.track(port.samples, ping.ping.starboard->samples, 0.0, spacing_m);
+    if (track.valid && port.altitude_m > 0.0) {
+      facts.header_altitude_m.push_back(port.altitude_m);
+      facts.tracked_altitude_m.push_back(track.altitude_m);
+    }
+  }
+  return facts;
+}
+
+double percentile(std::vector<double> values, double fraction) {
+  std::sort(values.begin(), values.end());
+  return values[std::min(values.size() - 1, static_cast<size_t>(fraction * static_cast<double>(values.size())))];
+}
+
+// The Marine Sonic's first strong return lies 10-20 % beyond the DVL's altitude (its beam does not
+// reach nadir: the first return comes from the beam's inner edge). The fusion learns that ratio
+// while both exist and scales the bottom track by it when the DVL's altitude stops; here the
+// ratio of the first 200 pings is applied to the remaining 260, as after a DVL dropout.
+TEST(RealFile, BottomTrackFollowsTheAltitudeTheVehicleRecorded) {
+  SKIP_WITHOUT_REAL_FILE();
+  const FileFacts facts = readFacts();
+  ASSERT_EQ(facts.pings, 461u);
+  ASSERT_GT(facts.header_altitude_m.size(), 430u) << "the tracker must find the seabed in nearly every ping";
+  const size_t n = facts.header_altitude_m.size();
+  std::vector<double> raw_errors, ratios, calibrated_errors;
+  for (size_t i = 0; i < n; ++i) {
+    raw_errors.push_back(std::abs(facts.tracked_altitude_m[i] - facts.header_altitude_m[i]));
+    if (i < 200) ratios.push_back(facts.header_altitude_m[i] / facts.tracked_altitude_m[i]);
+  }
+  const double scale = percentile(ratios, 0.5);
+  for (size_t i = 200; i < n; ++i) {
+    calibrated_errors.push_back(std::abs(scale * facts.tracked_altitude_m[i] - facts.header_altitude_m[i]));
+  }
+  std::printf("real file: header altitude %.2f-%.2f m; bottom track - header: p50 %.2f m, p95 %.2f m over %zu pings; "
+              "scale %.3f learned over 200 pings, then p50 %.2f m, p95 %.2f m over %zu\n",
+              *std::min_element(facts.header_altitude_m.begin(), facts.header_altitude_m.end()),
+              *std::max_element(facts.header_altitude_m.begin(), facts.header_altitude_m.end()),
+              percentile(raw_errors, 0.5), percentile(raw_errors, 0.95), n, scale, percentile(calibrated_errors, 0.5),
+              percentile(calibrated_errors, 0.95), calibrated_errors.size());
+  EXPECT_GT(scale, 0.75);  // the first return beyond nadir, within a 40 deg inner beam edge
+  EXPECT_LT(scale, 1.0);
+  EXPECT_LT(percentile(raw_errors, 0.95), 2.5);
+  EXPECT_LT(percentile(calibrated_errors, 0.5), 0.25);
+  EXPECT_LT(percentile(calibrated_errors, 0.95), 0.5);
+}
+
+TEST(RealFile, SssProcessWithoutConfigGivesATrajectoryInTheFilesBoxAndAMosaicOfTheWreck) {
+  SKIP_WITHOUT_REAL_FILE();
+  const FileFacts facts = readFacts();
+  sss::offline::OfflineRequest request;
+  request.sonar_path = kRealFile;
+  request.out_dir = (fs::temp_directory_path() / ("sss_real_file_test_" + std::to_string(getpid()))).string();
+  const auto result = sss::offline::runOffline(request);
+  ASSERT_TRUE(result.ok) << result.error;
+  const auto& s = result.summary;
+  EXPECT_EQ(s.pings, 461u);
+  EXPECT_GE(s.pings_with_pose, 438u) << "95 % of the pings";
+  EXPECT_GE(s.subframes, 1u);
+  EXPECT_EQ(s.buffer.fusion.altitude_from_nav, s.pings_with_pose) << "the file's own altitudes are used";
+  // One line past the wreck: DR only, and the run says why.
+  ASSERT_EQ(s.findings.size(), 1u);
+  EXPECT_NE(s.findings[0].find("one survey line"), std::string::npos) << s.findings[0];
+
+  // The frame is the file's first fix, and every pose lies inside the file's own lat/lon box.
+  ASSERT_TRUE(s.origin);
+  EXPECT_EQ(s.origin_source, "first_fix");
+  EXPECT_GE(s.origin->latitude_deg, facts.latitude_min);
+  EXPECT_LE(s.origin->latitude_deg, facts.latitude_max);
+  const auto slam = sss::eval::readTum(request.out_dir + "/slam.tum");
+  ASSERT_TRUE(slam.ok && slam.origin) << slam.error;
+  const sss::core::LocalTangentPlane plane(slam.origin->latitude_deg, slam.origin->longitude_deg);
+  const double margin_deg = 1e-6;  // 0.1 m
+  for (const auto& pose : slam.poses) {
+    const auto geodetic = plane.toGeodetic(pose.T_world_body.translation);
+    ASSERT_GE(geodetic.latitude_deg, facts.latitude_min - margin_deg);
+    ASSERT_LE(geodetic.latitude_deg, facts.latitude_max + margin_deg);
+    ASSERT_GE(geodetic.longitude_deg, facts.longitude_min - margin_deg);
+    ASSERT_LE(geodetic.longitude_deg, facts.longitude_max + margin_deg);
+  }
+  const std::string mosaic_yaml = readFile(request.out_dir + "/mosaic_dr.yaml");
+  EXPECT_NE(mosaic_yaml.find("origin_latitude_deg"), std::string::npos) << mosaic_yaml;
+
+  // The wreck stands out of the seabed: the brightest 4 m blocks of the mosaic (its hull and the
+  // edge of its shadow) far above the typical block, and the darkest (the shadow) far below.
+  const cv::Mat mosaic = cv::imread(request.out_dir + "/mosaic_dr.png", cv::IMREAD_GRAYSCALE);
+  ASSERT_FALSE(mosaic.empty());
+  std::vector<double> blocks;
+  constexpr int kBlock = 8;  // 8 x 0.5 m
+  for (int r = 0; r + kBlock <= mosaic.rows; r += kBlock / 2) {
+    for (int c = 0; c + kBlock <= mosaic.cols; c += kBlock / 2) {
+      const cv::Mat block = mosaic(cv::Rect(c, r, kBlock, kBlock));
+      if (cv::countNonZero(block) < kBlock * kBlock) continue;  // no data at the edges
+      blocks.push_back(cv::mean(block)[0]);
+    }
+  }
+  ASSERT_GT(blocks.size(), 50u);
+  const double median = percentile(blocks, 0.5), bright = percentile(blocks, 0.99), dark = percentile(blocks, 0.01);
+  std::printf("real file mosaic: %zu full 4 m blocks, grey p1 %.0f, median %.0f, p99 %.0f\n", blocks.size(), dark,
+              median, bright);
+  EXPECT_GT(bright, 1.6 * median);
+  EXPECT_LT(dark, 0.5 * median);
+  fs::remove_all(request.out_dir);
+}
+
+TEST(RealFile, BottomTrackedAltitudeAloneGivesTheSameSubframes) {
+  SKIP_WITHOUT_REAL_FILE();
+  // As a towed fish without altitude would be processed: the returns only.
+  const std::string dir = (fs::temp_directory_path() / ("sss_real_file_bt_" + std::to_string(getpid()))).string();
+  fs::create_directories(dir);
+  {
+    std::ofstream config(dir + "/config.yaml");
+    config << "subframe_buffer:\n  fusion:\n    altitude_source: bottom_track\n";
+  }
+  sss::offline::OfflineRequest request;
+  request.sonar_path = kRealFile;
+  request.config_path = dir + "/config.yaml";
+  request.out_dir = dir + "/run";
+  request.write_mosaics = false;
+  const auto result = sss::offline::runOffline(request);
+  ASSERT_TRUE(result.ok) << result.error;
+  const auto& s = result.summary;
+  EXPECT_GE(s.pings_with_pose, 438u);
+  EXPECT_GE(s.buffer.fusion.altitude_from_bottom_track, 438u);
+  EXPECT_EQ(s.buffer.fusion.altitude_from_nav, 0u);
+  EXPECT_GE(s.subframes, 1u);
+  fs::remove_all(dir);
+}
+
+}  // namespace
