@@ -73,6 +73,11 @@ struct SonarChannelRecord {
   uint16_t validity = 0;           // kValid* bits
   double latitude_deg = 0.0;       // stored as minutes of arc x 10000 (coordinate units 2)
   double longitude_deg = 0.0;
+  // A position in projected metres instead (XTF NavUnits 0: the file's grid, its CRS not
+  // recorded); JSF never sets it.
+  bool projected_position = false;
+  double easting_m = 0.0;
+  double northing_m = 0.0;
   double depth_m = 0.0;            // stored in mm
   double altitude_m = 0.0;         // stored in mm
   double heading_rad = 0.0;        // stored in 0.01 degree, [0, 360)

@@ -285,13 +285,18 @@ SonarDecodeResult decodeSonarPacket(const XtfFileInfo& info, const SonarDecodeOp
   }
   const double sensor_y = readF64(p, offset::kSensorY);
   const double sensor_x = readF64(p, offset::kSensorX);
-  // Only geographic coordinates fit our record; projected metres (NavUnits 0) stay without
-  // kValidLatLon. XTF has no validity flags: 0/0 is how writers leave position unset.
+  // Geographic coordinates (NavUnits 3) or projected metres (NavUnits 0, kept as easting and
+  // northing without kValidLatLon). XTF has no validity flags: 0/0 is how writers leave it unset.
   if (info.nav_units == kNavUnitsLatLon && std::isfinite(sensor_y) && std::isfinite(sensor_x) &&
       std::fabs(sensor_y) <= 90.0 && std::fabs(sensor_x) <= 180.0 && !(sensor_y == 0.0 && sensor_x == 0.0)) {
     common.latitude_deg = sensor_y;
     common.longitude_deg = sensor_x;
     common.validity |= sss::edgetech::kValidLatLon;
+  } else if (info.nav_units == kNavUnitsMetres && std::isfinite(sensor_y) && std::isfinite(sensor_x) &&
+             !(sensor_y == 0.0 && sensor_x == 0.0) && std::fabs(sensor_y) < 1e8 && std::fabs(sensor_x) < 1e8) {
+    common.projected_position = true;
+    common.northing_m = sensor_y;
+    common.easting_m = sensor_x;
   }
   const float depth_m = readF32(p, offset::kSensorDepth);
   if (std::isfinite(depth_m)) {

@@ -78,6 +78,12 @@ void XtfReader::openWith() {
     return;
   }
   const std::vector<ChannelPair> pairs = sideScanPairs(info_);
+  if (pairs.empty()) {
+    error_ = "XTF '" + source_name_ + "': no side-scan channel among its " + std::to_string(info_.channels.size()) +
+             " channel(s) (" + std::to_string(info_.bathymetry_channels) +
+             " bathymetry): a multibeam or sub-bottom record; sss-slam needs a side-scan port/starboard pair";
+    return;
+  }
   if (options_.pair_index < 0 || static_cast<size_t>(options_.pair_index) >= pairs.size()) {
     error_ = "XTF '" + source_name_ + "': " + std::to_string(pairs.size()) + " side-scan pair(s) among " +
              std::to_string(info_.channels.size()) + " channels, pair " + std::to_string(options_.pair_index) +

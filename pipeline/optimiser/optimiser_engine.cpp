@@ -59,8 +59,13 @@ bool writeTum(const std::string& path, const std::vector<StampedPose>& poses, co
     error = "cannot write " + path;
     return false;
   }
-  std::fprintf(f, "# %s\n# timestamp_s north_m east_m down_m qx qy qz qw (T_world_body, local NED of the mission origin)\n",
-               comment.c_str());
+  // Every line of the comment behind a '#'.
+  for (size_t start = 0; start <= comment.size();) {
+    const size_t end = std::min(comment.find('\n', start), comment.size());
+    std::fprintf(f, "# %s\n", comment.substr(start, end - start).c_str());
+    start = end + 1;
+  }
+  std::fprintf(f, "# timestamp_s north_m east_m down_m qx qy qz qw (T_world_body, local NED of the mission origin)\n");
   if (origin) std::fprintf(f, "%s\n", sss::core::originCommentLine(*origin).c_str());
   for (const StampedPose& p : poses) {
     const auto& q = p.T_world_body.rotation;

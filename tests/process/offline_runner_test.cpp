@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <random>
 #include <sstream>
 #include <string>
 #include <tuple>
@@ -23,6 +24,7 @@
 #include "tools/eval/trajectory_io.hpp"
 #include "tools/eval/trajectory_metrics.hpp"
 #include "tools/process/offline_runner.hpp"
+#include "drivers/xtf/xtf_writer.hpp"
 
 namespace fs = std::filesystem;
 
@@ -377,6 +379,103 @@ TEST_F(OfflineRunnerTest, WithoutAnyAltitudeTheBottomTrackKeepsTheAccuracy) {
   // Measured: p50 0.058 m, p95 0.109 m; SLAM 0.221 m without, 0.215 m with the DVL's altitude.
   EXPECT_LT(p95, 0.25);
   EXPECT_LT(ate_without, 1.1 * ate_with);
+}
+
+// An XTF with its navigation in projected metres (NavUnits 0, as Isis writes it) and no altitude
+// (a towed fish), with attitude packets between the pings, built from the public layout: it is
+// processed in the file's own grid (north = northing - N0 of the first fix), says so, and tracks
+// the bottom; and a multibeam-only file is refused in one line.
+TEST_F(OfflineRunnerTest, XtfInProjectedMetresWithoutAltitudeIsProcessedInItsGrid) {
+  sss::xtf::XtfWriterOptions options;
+  options.nav_units = sss::xtf::kNavUnitsMetres;
+  sss::xtf::XtfWriterChannel port, starboard;
+  starboard.type_of_channel = sss::xtf::kChannelStarboard;
+  starboard.name = "Starboard";
+  options.channels = {port, starboard};
+  const std::string path = root_ + "/projected.xtf";
+  {
+    sss::xtf::XtfWriter writer(path, options);
+    ASSERT_TRUE(writer.isOpen());
+    std::mt19937 random(3);
+    std::exponential_distribution<double> speckle(1.0);
+    const double heading_rad = 30.0 * M_PI / 180.0, speed_m_s = 2.0, altitude_m = 15.0, spacing_m = 0.03;
+    for (int i = 0; i < 600; ++i) {  // 150 s at 4 Hz: 300 m
+      sss::xtf::XtfPingInput ping;
+      ping.ping_number = static_cast<uint32_t>(i);
+      ping.ping_time_us = 1780300800000000LL + i * 250000LL;
+      ping.sound_velocity = 750.0f;
+      ping.sensor_x = 650123.0 + speed_m_s * 0.25 * i * std::sin(heading_rad);   // easting
+      ping.sensor_y = 6580456.0 + speed_m_s * 0.25 * i * std::cos(heading_rad);  // northing
+      ping.depth_m = 30.0f;
+      ping.heading_deg = 30.0f;
+      for (uint16_t channel = 0; channel < 2; ++channel) {
+        sss::xtf::XtfChannelData data;
+        data.channel_number = channel;
+        data.slant_range_m = 75.0f;
+        for (int k = 0; k < 2500; ++k) {
+          const double r = k * spacing_m;
+          const double mean = r < altitude_m ? 20.0 : 4000.0 * altitude_m / r;
+          data.samples.push_back(static_cast<float>(mean * speckle(random)));
+        }
+        ping.channels.push_back(std::move(data));
+      }
+      ASSERT_TRUE(writer.write(ping));
+      ASSERT_TRUE(writer.writeBytes(sss::xtf::encodeOtherPacket(3, 64)));  // an attitude packet
+    }
+  }
+  sss::offline::OfflineRequest r;
+  r.sonar_path = path;
+  r.out_dir = root_ + "/run_projected";
+  r.write_mosaics = false;
+  const auto result = sss::offline::runOffline(r);
+  ASSERT_TRUE(result.ok) << result.error;
+  const auto& s = result.summary;
+  EXPECT_EQ(s.pings, 600u);
+  EXPECT_GE(s.pings_with_pose, 570u) << "95 % of the pings";
+  EXPECT_GE(s.subframes, 2u);
+  EXPECT_EQ(s.buffer.fusion.altitude_from_bottom_track, s.pings_with_pose);
+  EXPECT_EQ(s.origin_source, "projected_first_fix");
+  EXPECT_FALSE(s.origin);
+  EXPECT_DOUBLE_EQ(s.projected_origin_easting_m, 650123.0);
+  EXPECT_DOUBLE_EQ(s.projected_origin_northing_m, 6580456.0);
+  const std::string summary = readFile(r.out_dir + "/summary.json");
+  EXPECT_NE(summary.find("projected_northing_m"), std::string::npos) << summary;
+  const auto slam = sss::eval::readTum(r.out_dir + "/slam.tum");
+  ASSERT_TRUE(slam.ok) << slam.error;
+  EXPECT_FALSE(slam.origin);
+  EXPECT_NE(readFile(r.out_dir + "/slam.tum").find("north = northing - 6580456.000"), std::string::npos);
+  // The last pose: 299.5 m along 30 deg from the first fix, in the grid.
+  const Eigen::Vector3d last = slam.poses.back().T_world_body.translation;
+  const double along_m = 2.0 * 0.25 * 599;
+  EXPECT_NEAR(last.x(), along_m * std::cos(30.0 * M_PI / 180.0), 3.0);
+  EXPECT_NEAR(last.y(), along_m * std::sin(30.0 * M_PI / 180.0), 3.0);
+  std::istringstream altitudes(readFile(r.out_dir + "/altitude.csv"));
+  size_t near_truth = 0, rows = 0;
+  for (std::string line; std::getline(altitudes, line);) {
+    if (line.empty() || line[0] == '#' || line[0] == 'u') continue;
+    ++rows;
+    near_truth += std::abs(std::stod(line.substr(line.find(',') + 1)) - 15.0) < 0.2 ? 1 : 0;
+  }
+  EXPECT_GE(near_truth, rows * 95 / 100) << "bottom-tracked altitude within 0.2 m of the 15 m";
+
+  // A multibeam-only XTF: refused with the reason, exit 2.
+  sss::xtf::XtfWriterOptions multibeam;
+  sss::xtf::XtfWriterChannel bathymetry;
+  bathymetry.type_of_channel = 3;  // bathymetry
+  bathymetry.name = "Bathy";
+  multibeam.channels = {bathymetry};
+  const std::string multibeam_path = root_ + "/multibeam.xtf";
+  {
+    sss::xtf::XtfWriter writer(multibeam_path, multibeam);
+    ASSERT_TRUE(writer.writeBytes(sss::xtf::encodeOtherPacket(2, 256)));
+  }
+  sss::offline::OfflineRequest mb;
+  mb.sonar_path = multibeam_path;
+  mb.out_dir = root_ + "/run_multibeam";
+  const auto refused = sss::offline::runOffline(mb);
+  EXPECT_FALSE(refused.ok);
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_NE(refused.error.find("no side-scan channel"), std::string::npos) << refused.error;
 }
 
 TEST_F(OfflineRunnerTest, BadInputIsRefusedWithTheFileNamed) {

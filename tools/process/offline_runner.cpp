@@ -228,8 +228,11 @@ class EmbeddedNavigation {
     if (origin) setOrigin(*origin);
   }
   const std::optional<sss::core::MissionOrigin>& origin() const { return origin_; }
+  // Set once a ping with projected metres (XTF NavUnits 0) founded the frame: its easting, northing.
+  const std::optional<Eigen::Vector2d>& projectedOrigin() const { return projected_origin_; }
   std::optional<NavInput> fromPing(const sss::edgetech::DriverPing& driver_ping) {
     const auto& side = driver_ping.ping.port ? *driver_ping.ping.port : *driver_ping.ping.starboard;
+    if (side.projected_position) return fromProjected(driver_ping.utime_us, side);
     if (!(side.validity & sss::edgetech::kValidLatLon) && side.latitude_deg == 0.0 && side.longitude_deg == 0.0) {
       return std::nullopt;  // no position in this ping
     }
@@ -241,6 +244,25 @@ class EmbeddedNavigation {
     nav.utime_us = driver_ping.utime_us;
     nav.origin = origin_;
     nav.position_ned_m = plane_->toNed({side.latitude_deg, side.longitude_deg, side.depth_m});
+    fillAttitude(nav, side);
+    return nav;
+  }
+
+ private:
+  // Projected metres: processed in the file's own grid, north = northing - N0, east = easting -
+  // E0 of the first fix (the CRS is not in the file, so no latitude/longitude). The heading is
+  // used as recorded: true north, which differs from the grid's north by the projection's
+  // meridian convergence (within a degree or two in UTM).
+  std::optional<NavInput> fromProjected(int64_t utime_us, const sss::edgetech::SonarChannelRecord& side) {
+    if (!projected_origin_) projected_origin_ = Eigen::Vector2d(side.easting_m, side.northing_m);
+    NavInput nav;
+    nav.utime_us = utime_us;
+    nav.position_ned_m = Eigen::Vector3d(side.northing_m - projected_origin_->y(), side.easting_m - projected_origin_->x(),
+                                         side.depth_m);
+    fillAttitude(nav, side);
+    return nav;
+  }
+  void fillAttitude(NavInput& nav, const sss::edgetech::SonarChannelRecord& side) {
     nav.roll_rad = side.roll_rad;
     nav.pitch_rad = side.pitch_rad;
     nav.heading_rad = side.heading_rad;
@@ -249,10 +271,8 @@ class EmbeddedNavigation {
     if (last_) distance_m_ += (nav.position_ned_m - *last_).head<2>().norm();
     last_ = nav.position_ned_m;
     nav.distance_travelled_m = distance_m_;
-    return nav;
   }
-
- private:
+  std::optional<Eigen::Vector2d> projected_origin_;
   void setOrigin(const sss::core::MissionOrigin& origin) {
     origin_ = origin;
     plane_.emplace(origin.latitude_deg, origin.longitude_deg);
@@ -435,6 +455,10 @@ bool writeSummaryJson(const std::string& path, const OfflineRequest& request, co
     json.key("latitude_deg").value(s.origin->latitude_deg, 13);
     json.key("longitude_deg").value(s.origin->longitude_deg, 13);
   }
+  if (s.origin_source == "projected_first_fix") {
+    json.key("projected_easting_m").value(s.projected_origin_easting_m, 12);
+    json.key("projected_northing_m").value(s.projected_origin_northing_m, 12);
+  }
   json.key("source").value(s.origin_source);
   json.key("detail").value(s.origin_detail);
   json.endObject();
@@ -609,6 +633,15 @@ class Runner {
   bool writeAltitudeCsv(const std::string& path, std::string& error) const;
   OfflineSummary& summary() { return summary_; }
   const std::optional<sss::core::MissionOrigin>& origin() const { return origin_; }
+  // The frame is a projected grid's (XTF NavUnits 0): said in every trajectory file.
+  void setProjectedOrigin(const Eigen::Vector2d& easting_northing_m) {
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "\nframe: the file's projected grid (XTF NavUnits 0, CRS not recorded): north = northing - %.3f, "
+                  "east = easting - %.3f",
+                  easting_northing_m.y(), easting_northing_m.x());
+    frame_comment_ = text;
+  }
   const sss::subframe::SubframeBuffer& buffer() const { return buffer_; }
   // The stage counters and the survey's layout into the summary (after finish()).
   void countStages() {
@@ -733,6 +766,7 @@ class Runner {
   int64_t first_ping_us_ = -1;
   int64_t last_ping_us_ = 0;
   std::optional<sss::core::MissionOrigin> origin_;
+  std::string frame_comment_;  // appended to the trajectories' comment (a projected frame)
   double start_s_ = wallSeconds();
   double last_progress_s_ = 0.0;
 };
@@ -765,11 +799,12 @@ bool Runner::writeOutputs(std::string& error) {
     slam.push_back({p.utime_us, optimiser_.correctionAt(p.utime_us).T_corrected_dr * p.T_world_body});
   }
   summary_.pings_with_pose = dr_per_ping_.size();
-  if (!sss::optimiser::writeTum(dir + "/dead_reckoning.tum", dr_per_ping_, "sss-process: dead reckoning at every ping",
-                                error, origin_)) {
+  if (!sss::optimiser::writeTum(dir + "/dead_reckoning.tum", dr_per_ping_,
+                                "sss-process: dead reckoning at every ping" + frame_comment_, error, origin_)) {
     return false;
   }
-  if (!sss::optimiser::writeTum(dir + "/slam.tum", slam, "sss-process: SLAM-corrected pose at every ping", error, origin_)) {
+  if (!sss::optimiser::writeTum(dir + "/slam.tum", slam, "sss-process: SLAM-corrected pose at every ping" + frame_comment_,
+                                error, origin_)) {
     return false;
   }
   if (!writeClosuresCsv(dir + "/loop_closures.csv", optimiser_, error)) return false;
@@ -858,6 +893,7 @@ OfflineResult runOffline(const OfflineRequest& request) {
     return result;
   }
   uint64_t faults = 0;
+  std::optional<Eigen::Vector2d> projected_origin;  // a projected frame (XTF NavUnits 0): E0, N0
   if (from_log) {
     lcm::LogFile log(request.lcm_log_path, "r");
     if (!log.good()) {
@@ -981,17 +1017,30 @@ OfflineResult runOffline(const OfflineRequest& request) {
       result.error = "no usable pings in " + request.sonar_path;
       return result;
     }
+    if (embedded) projected_origin = embedded->projectedOrigin();
     if (embedded && without_nav == runner.summary().pings) {
       result.error = request.sonar_path + " carries no navigation in its ping headers; give an INS file with --ins";
       return result;
     }
   }
+  if (projected_origin) runner.setProjectedOrigin(*projected_origin);
   runner.progress(1.0, true);
   runner.finish();
   runner.countStages();
   OfflineSummary& summary = runner.summary();
   summary.origin = runner.origin();
-  if (options.origin) {
+  if (projected_origin) {
+    summary.origin_source = "projected_first_fix";
+    summary.projected_origin_easting_m = projected_origin->x();
+    summary.projected_origin_northing_m = projected_origin->y();
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "projected metres (XTF NavUnits 0): north = northing - %.3f, east = easting - %.3f of the first "
+                  "fix, in the file's grid; the file records no CRS, so no latitude/longitude; headings are used as "
+                  "recorded (true north, not grid north)",
+                  summary.projected_origin_northing_m, summary.projected_origin_easting_m);
+    summary.origin_detail = text;
+  } else if (options.origin) {
     summary.origin_source = sss::core::originSourceName(sss::core::OriginSource::kConfigured);
     summary.origin_detail = "mission.origin_latitude_deg / origin_longitude_deg in " + request.config_path;
   } else if (from_log) {
@@ -1005,6 +1054,8 @@ OfflineResult runOffline(const OfflineRequest& request) {
   if (request.progress && summary.origin) {
     std::fprintf(request.progress, "sss-process: mission origin %.7f %.7f (%s: %s)\n", summary.origin->latitude_deg,
                  summary.origin->longitude_deg, summary.origin_source.c_str(), summary.origin_detail.c_str());
+  } else if (request.progress && !summary.origin_detail.empty()) {
+    std::fprintf(request.progress, "sss-process: frame: %s\n", summary.origin_detail.c_str());
   }
   summary.input_faults = faults;
   result.exit_code = 1;

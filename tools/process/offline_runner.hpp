@@ -50,6 +50,9 @@ struct OfflineSummary {
   std::optional<sss::core::MissionOrigin> origin;
   std::string origin_source;  // "configured", "first_fix" (which source: origin_detail), "from_navigation"
   std::string origin_detail;  // e.g. "the first position in the sonar file's ping headers"
+  // origin_source "projected_first_fix" (XTF NavUnits 0): the frame is the file's grid less these.
+  double projected_origin_easting_m = 0.0;
+  double projected_origin_northing_m = 0.0;
   uint64_t nav_samples = 0;
   uint64_t pings = 0;            // pings read
   uint64_t pings_with_pose = 0;  // pings that got a DR pose (in the trajectories)
