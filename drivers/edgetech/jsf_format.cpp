@@ -184,8 +184,16 @@ SonarDecodeResult decodeSonarData(const JsfMessageHeader& header, const uint8_t*
     r.longitude_deg = x / kMinutesX10000PerDegree;
     r.latitude_deg = y / kMinutesX10000PerDegree;
   } else {
-    // Projected units (mm, cm, dm) carry no geodetic position.
+    // Projected units (1 mm, 3 dm, 4 cm) carry no geodetic position: kept as easting/northing
+    // in metres (X east, Y north), the frame the offline runner then works in.
+    const bool had_position = (r.validity & kValidLatLon) != 0 && !(x == 0 && y == 0);
     r.validity = static_cast<uint16_t>(r.validity & ~kValidLatLon);
+    const double metres_per_unit = coordinate_units == 1 ? 1e-3 : coordinate_units == 3 ? 0.1 : coordinate_units == 4 ? 0.01 : 0.0;
+    if (had_position && metres_per_unit > 0.0) {
+      r.projected_position = true;
+      r.easting_m = x * metres_per_unit;
+      r.northing_m = y * metres_per_unit;
+    }
   }
   const size_t num_samples = static_cast<size_t>(readLe<uint16_t>(body, 114)) | (static_cast<size_t>((msbs >> 8) & 0xF) << 16);
   r.sample_interval_s = readLe<uint32_t>(body, 116) * 1e-9;

@@ -86,6 +86,29 @@ TEST(JsfFormat, DecodeGivesBackTheRecordWithinTheWireResolution) {
   EXPECT_NEAR(r.slantRangeM(100), 100 * 20e-6 * 750.0, 1e-9);
 }
 
+// Coordinate units 1 (mm), 3 (dm) and 4 (cm) at byte 88: projected X (east) / Y (north), kept in
+// metres with no latitude/longitude; unknown units give no position.
+TEST(JsfFormat, ProjectedCoordinateUnitsGiveEastingAndNorthing) {
+  for (const auto& [units, metres_per_unit] : {std::pair{int16_t(1), 1e-3}, std::pair{int16_t(3), 0.1},
+                                               std::pair{int16_t(4), 0.01}, std::pair{int16_t(7), 0.0}}) {
+    std::vector<uint8_t> bytes = test::encodeRecord(test::makeRecord(5, kChannelPort), 10);
+    const int32_t x = 65012345, y = 658045678;
+    std::memcpy(bytes.data() + 16 + 80, &x, 4);
+    std::memcpy(bytes.data() + 16 + 84, &y, 4);
+    std::memcpy(bytes.data() + 16 + 88, &units, 2);
+    const auto header = decodeHeader(bytes.data());
+    ASSERT_TRUE(header);
+    const SonarDecodeResult result = decodeSonarData(*header, bytes.data() + 16, bytes.size() - 16);
+    ASSERT_TRUE(result.record) << result.error;
+    EXPECT_EQ(result.record->validity & kValidLatLon, 0) << units;
+    EXPECT_EQ(result.record->projected_position, metres_per_unit > 0.0) << units;
+    if (metres_per_unit > 0.0) {
+      EXPECT_DOUBLE_EQ(result.record->easting_m, x * metres_per_unit);
+      EXPECT_DOUBLE_EQ(result.record->northing_m, y * metres_per_unit);
+    }
+  }
+}
+
 TEST(JsfFormat, QuantiseChoosesTheWeightingThatFillsSixteenBits) {
   int16_t n = 0;
   const std::vector<uint16_t> codes = quantiseEnvelope({0.0f, 1.0f, 2.0f}, n);

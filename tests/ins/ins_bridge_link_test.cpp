@@ -7,8 +7,15 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+
+#include <filesystem>
 #include <fstream>
 #include <thread>
+
+#include "pipeline/core/mission_origin.hpp"
 
 #include "ins_test_states.hpp"
 #include "pipeline/core/time.hpp"
@@ -113,6 +120,72 @@ TEST(InsBridgeLink, PublishesEveryEpochGoesStaleInAPauseAndRecovers) {
   EXPECT_GE(faulted, 20.0);
   EXPECT_GE(accepted_sentences, 12.0 * kEpochs - faulted);
   EXPECT_LE(accepted_sentences, 12.0 * kEpochs - faulted / 2);  // most flips hit a sentence body
+}
+
+// No origin in the configuration: the bridge takes the first fix, saves it in its state directory
+// and, restarted mid-mission, keeps it (the frame must not jump to wherever the vehicle is then).
+TEST(InsBridgeLink, WithoutConfiguredOriginTheFirstFixIsKeptAcrossARestart) {
+  const std::string dir = ::testing::TempDir() + "/ins_origin_" + std::to_string(getpid());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const int udp_port = 25000 + static_cast<int>(getpid() % 2000);
+  const int lcm_port = 27000 + static_cast<int>(getpid() % 2000);
+  const std::string lcm_url = "udpm://239.255.76.67:" + std::to_string(lcm_port) + "?ttl=0";
+  const std::string config_path = dir + "/config.yaml";
+  {
+    std::ofstream config(config_path);
+    config << "ins_bridge:\n  source: udp\n  bind_address: 127.0.0.1\n  udp_port: " << udp_port
+           << "\n  lcm_url: \"" << lcm_url << "\"\n  state_directory: " << dir << "\n  log_level: warn\n";
+  }
+  sss::core::HealthMonitor health(sss::core::monotonicUtime());
+  sss::transport::LcmBus bus(lcm_url, health);
+  ASSERT_TRUE(bus.good());
+  std::vector<sss_msgs::nav_t> navs;
+  bus.subscribe<sss_msgs::nav_t>("SSS_NAV", [&](const sss_msgs::nav_t& nav) { navs.push_back(nav); });
+  const int socket_fd = ::socket(AF_INET, SOCK_DGRAM, 0);
+  ASSERT_GE(socket_fd, 0);
+  sockaddr_in to{};
+  to.sin_family = AF_INET;
+  to.sin_port = htons(static_cast<uint16_t>(udp_port));
+  to.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  // One bridge run: epochs [first, first + 20) as one datagram each, then SIGTERM.
+  auto run = [&](int first) {
+    navs.clear();
+    pid_t bridge = 0;
+    char* argv[] = {const_cast<char*>(INS_BRIDGE_PATH), const_cast<char*>("--config"),
+                    const_cast<char*>(config_path.c_str()), nullptr};
+    ASSERT_EQ(posix_spawn(&bridge, INS_BRIDGE_PATH, nullptr, nullptr, argv, environ), 0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));  // the bridge binds its port
+    for (int e = first; e < first + 20; ++e) {
+      const std::string burst = encodeInsState(test::eastboundState(e));
+      ::sendto(socket_fd, burst.data(), burst.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to);
+      bus.handleTimeout(10);
+    }
+    const int64_t end = sss::core::monotonicUtime() + 500'000;
+    while (sss::core::monotonicUtime() < end && navs.size() < 20) bus.handleTimeout(20);
+    ::kill(bridge, SIGTERM);
+    int status = 0;
+    ::waitpid(bridge, &status, 0);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  };
+  run(0);
+  ASSERT_GE(navs.size(), 18u) << "UDP on the loopback should lose nothing";
+  const ins::InsState first_fix = test::eastboundState(0);
+  EXPECT_NEAR(navs.front().origin_latitude_deg, first_fix.latitude_deg, 1e-8);
+  EXPECT_NEAR(navs.front().origin_longitude_deg, first_fix.longitude_deg, 1e-8);
+  EXPECT_NEAR(navs.front().position_ned_m[1], 0.0, 0.01);
+  std::string error;
+  const auto saved = sss::core::readOriginState(dir + "/origin", error);
+  ASSERT_TRUE(saved) << error;
+  EXPECT_DOUBLE_EQ(saved->latitude_deg, navs.front().origin_latitude_deg);
+
+  run(50);  // restarted 5 s later, 10 m further east
+  ASSERT_GE(navs.size(), 18u);
+  EXPECT_DOUBLE_EQ(navs.front().origin_latitude_deg, saved->latitude_deg);
+  EXPECT_DOUBLE_EQ(navs.front().origin_longitude_deg, saved->longitude_deg);
+  EXPECT_NEAR(navs.front().position_ned_m[1], 10.0, 0.01) << "in the first run's frame";
+  ::close(socket_fd);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace
