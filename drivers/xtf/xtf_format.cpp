@@ -225,6 +225,67 @@ std::optional<PacketHeader> decodePacketHeader(const uint8_t* bytes) {
   return header;
 }
 
+std::optional<XtfNavigationRecord> decodeNavigationPacket(const uint8_t* p, size_t size) {
+  constexpr size_t kNavigationPacketBytes = 64;
+  if (size < kNavigationPacketBytes || readU16(p, 0) != kXtfMagic) return std::nullopt;
+  XtfNavigationRecord r;
+  r.header_type = p[2];
+  auto angle = [](float degrees, float limit) -> std::optional<double> {
+    if (!std::isfinite(degrees) || std::fabs(degrees) > limit) return std::nullopt;
+    return static_cast<double>(degrees) * kDegToRad;
+  };
+  auto heading = [](float degrees) -> std::optional<double> {
+    if (!std::isfinite(degrees) || std::fabs(degrees) > 720.0f) return std::nullopt;
+    double wrapped = std::fmod(static_cast<double>(degrees), 360.0);
+    if (wrapped < 0.0) wrapped += 360.0;
+    return wrapped * kDegToRad;
+  };
+  auto position = [&](size_t y_at, size_t x_at, size_t altitude_at) {
+    const double y = readF64(p, y_at), x = readF64(p, x_at), altitude = readF64(p, altitude_at);
+    if (std::isfinite(y) && std::isfinite(x) && !(y == 0.0 && x == 0.0) && std::fabs(y) < 1e8 && std::fabs(x) < 1e8) {
+      r.y = y;
+      r.x = x;
+    }
+    if (std::isfinite(altitude) && altitude > 0.0 && altitude < 1e4) r.altitude_m = altitude;
+  };
+  std::optional<int64_t> seconds_us;
+  int64_t sub_second_us = 0;
+  switch (r.header_type) {
+    case kHeaderAttitude: {
+      const uint32_t epoch_s = readU32(p, 26);
+      if (epoch_s > 0) {
+        seconds_us = static_cast<int64_t>(epoch_s) * 1000000;
+        sub_second_us = std::min<uint32_t>(readU32(p, 22), 999999);
+      } else {
+        seconds_us = utcFromCalendar(readU16(p, 54), p[56], p[57], p[58], p[59], p[60], 0);
+        sub_second_us = 1000 * std::min<uint16_t>(readU16(p, 61), 999);
+      }
+      r.pitch_rad = angle(readF32(p, 30), 90.0f);
+      r.roll_rad = angle(readF32(p, 34), 180.0f);
+      r.heading_rad = heading(readF32(p, 50));
+      break;
+    }
+    case kHeaderNavigation:
+      seconds_us = utcFromCalendar(readU16(p, 14), p[16], p[17], p[18], p[19], p[20], 0);
+      sub_second_us = std::min<uint32_t>(readU32(p, 21), 999999);
+      position(33, 41, 49);
+      break;
+    case kHeaderPosRawNavigation:
+      seconds_us = utcFromCalendar(readU16(p, 14), p[16], p[17], p[18], p[19], p[20], 0);
+      sub_second_us = 100 * std::min<uint16_t>(readU16(p, 21), 9999);
+      position(23, 31, 39);
+      r.pitch_rad = angle(readF32(p, 47), 90.0f);
+      r.roll_rad = angle(readF32(p, 51), 180.0f);
+      r.heading_rad = heading(readF32(p, 59));
+      break;
+    default:
+      return std::nullopt;
+  }
+  if (!seconds_us) return std::nullopt;
+  r.utime_us = *seconds_us + sub_second_us;
+  return r;
+}
+
 std::optional<int64_t> utcFromCalendar(int year, int month, int day, int hour, int minute, int second,
                                        int hundredths) {
   if (year < 1970 || year > 2200 || month < 1 || month > 12 || day < 1 || hour > 23 || minute > 59 || second > 60 ||
@@ -283,8 +344,16 @@ SonarDecodeResult decodeSonarPacket(const XtfFileInfo& info, const SonarDecodeOp
     common.sound_speed_m_s = options.fallback_sound_speed_m_s;
     result.sound_speed_fallback = true;
   }
-  const double sensor_y = readF64(p, offset::kSensorY);
-  const double sensor_x = readF64(p, offset::kSensorX);
+  double sensor_y = readF64(p, offset::kSensorY);
+  double sensor_x = readF64(p, offset::kSensorX);
+  if (sensor_y == 0.0 && sensor_x == 0.0) {
+    // No sensor position: the vessel's (a hull-mounted sonar, or a tow without layback).
+    sensor_y = readF64(p, offset::kShipY);
+    sensor_x = readF64(p, offset::kShipX);
+    if (std::isfinite(sensor_y) && std::isfinite(sensor_x) && !(sensor_y == 0.0 && sensor_x == 0.0)) {
+      result.ship_coordinates = true;
+    }
+  }
   // Geographic coordinates (NavUnits 3) or projected metres (NavUnits 0, kept as easting and
   // northing without kValidLatLon). XTF has no validity flags: 0/0 is how writers leave it unset.
   if (info.nav_units == kNavUnitsLatLon && std::isfinite(sensor_y) && std::isfinite(sensor_x) &&

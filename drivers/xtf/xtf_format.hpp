@@ -63,7 +63,12 @@ constexpr size_t kMaxChannels = 64;
 
 enum XtfNavUnits : uint16_t { kNavUnitsMetres = 0, kNavUnitsLatLon = 3 };
 enum XtfChannelType : uint8_t { kChannelSubbottom = 0, kChannelPort = 1, kChannelStarboard = 2, kChannelBathymetry = 3 };
-enum XtfHeaderType : uint8_t { kHeaderSonar = 0 };
+enum XtfHeaderType : uint8_t {
+  kHeaderSonar = 0,
+  kHeaderAttitude = 3,           // XTFATTITUDEDATA: pitch, roll, heave, yaw, heading
+  kHeaderNavigation = 42,        // XTFHEADERNAVIGATION: source-time-stamped position and altitude
+  kHeaderPosRawNavigation = 107  // XTFPOSRAWNAVIGATION: position, altitude and attitude
+};
 
 // Byte offsets of the fields we use, from the packet start (ping header) or the block start.
 namespace offset {
@@ -101,6 +106,8 @@ constexpr size_t kHSeconds = 21;
 constexpr size_t kJulianDay = 22;
 constexpr size_t kPingNumber = 28;
 constexpr size_t kSoundVelocity = 32;
+constexpr size_t kShipY = 128;
+constexpr size_t kShipX = 136;
 constexpr size_t kSensorY = 160;
 constexpr size_t kSensorX = 168;
 constexpr size_t kSensorDepth = 192;
@@ -187,10 +194,36 @@ struct SonarDecodeResult {
   std::string error;
   bool no_selected_channel = false;  // valid packet without the chosen port or starboard
   bool sound_speed_fallback = false; // SoundVelocity unusable: the fallback was used
+  bool ship_coordinates = false;     // SensorY/X unset: the ping has ShipY/X instead
 };
 // Decodes one whole sonar packet (header type 0) of `size` bytes (NumBytesThisRecord).
 SonarDecodeResult decodeSonarPacket(const XtfFileInfo& info, const SonarDecodeOptions& options, const uint8_t* packet,
                                     size_t size);
+
+// Navigation carried in its own packets (when the pings carry none), offsets from the packet start
+// as pyxtf's xtf_ctypes.py lays them out (packed), every packet 64 bytes:
+//   3 attitude:  22 EpochMicroseconds u32  26 SourceEpoch u32 (s since 1970)  30 Pitch f32 deg
+//     (nose up +)  34 Roll f32 deg (starboard down +)  38 Heave f32  42 Yaw f32  46 TimeTag u32
+//     50 Heading f32 deg  54 Year u16  56 Month  57 Day  58 Hour  59 Minute  60 Second
+//     61 Millisecond u16
+//   42 navigation:  14 Year u16  16 Month  17 Day  18 Hour  19 Minute  20 Second  21 Microsecond
+//     u32  25 SourceEpoch u32  29 TimeTag u32  33 RawYcoordinate f64  41 RawXcoordinate f64
+//     49 RawAltitude f64  57 TimeFlag u8
+//   107 raw position:  14 Year u16  16 Month  17 Day  18 Hour  19 Minute  20 Second
+//     21 MicroSecond u16 (0-9999: units of 100 us)  23 RawYcoordinate f64  31 RawXcoordinate f64
+//     39 RawAltitude f64  47 Pitch f32  51 Roll f32  55 Heave f32  59 Heading f32
+// Coordinates are in the file's NavUnits (degrees, or projected metres). The sonar ping header
+// also has ShipY/ShipXcoordinate (f64 at 128/136): the vessel's, used when SensorY/X are unset.
+struct XtfNavigationRecord {
+  uint8_t header_type = 0;
+  int64_t utime_us = 0;
+  std::optional<double> y, x;  // latitude/longitude degrees or northing/easting metres
+  std::optional<double> altitude_m;
+  std::optional<double> pitch_rad, roll_rad, heading_rad;
+};
+// Decodes a packet of type 3, 42 or 107; nullopt when it is shorter than 64 bytes, of another
+// type, or its time is impossible. Zero coordinates and angles out of range are left unset.
+std::optional<XtfNavigationRecord> decodeNavigationPacket(const uint8_t* packet, size_t size);
 
 // UTC microseconds from calendar fields; nullopt when a field is out of range.
 std::optional<int64_t> utcFromCalendar(int year, int month, int day, int hour, int minute, int second,

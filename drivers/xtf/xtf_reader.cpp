@@ -148,6 +148,12 @@ void XtfReader::skipBytes(size_t count, const std::string& kind) {
   consume(count);
 }
 
+std::vector<XtfNavigationRecord> XtfReader::takeNavigation() {
+  std::vector<XtfNavigationRecord> records;
+  records.swap(navigation_);
+  return records;
+}
+
 bool XtfReader::next(sss::edgetech::DriverPing& ping) {
   if (!open_) return false;
   while (true) {
@@ -213,6 +219,16 @@ bool XtfReader::next(sss::edgetech::DriverPing& ping) {
     skipping_ = false;
     ++counters_.packets;
     const uint64_t packet_offset = consumed_offset_;
+    if (header.header_type == kHeaderAttitude || header.header_type == kHeaderNavigation ||
+        header.header_type == kHeaderPosRawNavigation) {
+      if (auto record = decodeNavigationPacket(buffer_.data() + start_, size)) {
+        ++counters_.navigation_packets;
+        // Bounded: a file of navigation without pings must not grow this without end.
+        if (navigation_.size() < 100000) navigation_.push_back(*record);
+        consume(size);
+        continue;
+      }
+    }
     if (header.header_type != kHeaderSonar) {
       ++counters_.packets_skipped;
       ++counters_.skipped_by_type[header.header_type];
@@ -240,6 +256,7 @@ bool XtfReader::next(sss::edgetech::DriverPing& ping) {
       continue;
     }
     ++counters_.pings;
+    if (result.ship_coordinates) ++counters_.pings_ship_coordinates;
     ping = std::move(*result.ping);
     return true;
   }

@@ -42,6 +42,8 @@ struct XtfReaderCounters {
   uint64_t bytes_skipped = 0;           // bytes between packets that belong to none
   uint64_t resyncs = 0;                 // runs of skipped bytes
   uint64_t sound_speed_fallbacks = 0;   // pings that used fallback_sound_speed_m_s
+  uint64_t navigation_packets = 0;      // attitude (3), navigation (42), raw position (107) decoded
+  uint64_t pings_ship_coordinates = 0;  // pings positioned by ShipY/X (SensorY/X unset)
   uint64_t bytes_before_first_packet = 0;  // header padding or an unexpected header size
   // Corrupt records in the file: impossible headers, truncated packets, undecodable pings.
   uint64_t corruptRecords() const { return bad_headers + truncated_packets + sonar_decode_errors; }
@@ -62,6 +64,9 @@ class XtfReader {
 
   // The next sonar ping; false at the end of the data.
   bool next(sss::edgetech::DriverPing& ping);
+  // The navigation packets (types 3, 42, 107) read since the last call, in file order: those
+  // before the ping next() just gave.
+  std::vector<XtfNavigationRecord> takeNavigation();
 
   const XtfReaderCounters& counters() const { return counters_; }
   // Faults since the last call, one text per kind the first time it happens (log these).
@@ -102,6 +107,7 @@ class XtfReader {
   bool first_packet_found_ = false;
   bool skipping_ = false;
   XtfReaderCounters counters_;
+  std::vector<XtfNavigationRecord> navigation_;
   std::vector<std::string> reported_kinds_;
   std::vector<std::string> new_faults_;
   std::string source_name_;

@@ -24,6 +24,7 @@
 #include "tools/eval/trajectory_io.hpp"
 #include "tools/eval/trajectory_metrics.hpp"
 #include "tools/process/offline_runner.hpp"
+#include "pipeline/core/geodesy.hpp"
 #include "drivers/xtf/xtf_writer.hpp"
 
 namespace fs = std::filesystem;
@@ -476,6 +477,104 @@ TEST_F(OfflineRunnerTest, XtfInProjectedMetresWithoutAltitudeIsProcessedInItsGri
   EXPECT_FALSE(refused.ok);
   EXPECT_EQ(refused.exit_code, 2);
   EXPECT_NE(refused.error.find("no side-scan channel"), std::string::npos) << refused.error;
+}
+
+// XTF pings without a sensor position: navigation from raw-position packets (type 107, 4 Hz,
+// latitude/longitude with attitude) between the pings, or the vessel's ShipY/X in the ping header.
+TEST_F(OfflineRunnerTest, XtfNavigationPacketsOrShipCoordinatesPositionPingsWithoutSensorPosition) {
+  for (const bool ship : {false, true}) {
+    sss::xtf::XtfWriterOptions options;
+    options.nav_units = sss::xtf::kNavUnitsLatLon;
+    sss::xtf::XtfWriterChannel port, starboard;
+    starboard.type_of_channel = sss::xtf::kChannelStarboard;
+    options.channels = {port, starboard};
+    const std::string path = root_ + (ship ? "/ship.xtf" : "/packets.xtf");
+    const sss::core::LocalTangentPlane plane(43.0, 5.0);
+    const double heading_rad = 100.0 * M_PI / 180.0;
+    auto positionAt = [&](double t_s) {
+      return plane.toGeodetic(Eigen::Vector3d(2.0 * t_s * std::cos(heading_rad), 2.0 * t_s * std::sin(heading_rad), 0.0));
+    };
+    {
+      sss::xtf::XtfWriter writer(path, options);
+      ASSERT_TRUE(writer.isOpen());
+      std::mt19937 random(5);
+      std::exponential_distribution<double> speckle(1.0);
+      for (int i = 0; i < 600; ++i) {  // 150 s at 4 Hz
+        const double t_s = 0.25 * i;
+        const int64_t utime_us = 1780300800000000LL + i * 250000LL;
+        if (!ship) {
+          for (int k = 0; k < (i == 0 ? 2 : 1); ++k) {  // a 107 packet 50 ms before every ping (4 Hz)
+            const double packet_s = t_s - 0.05 + 0.2 * k;
+            if (packet_s < 0.0) continue;
+            std::vector<uint8_t> packet = sss::xtf::encodeOtherPacket(sss::xtf::kHeaderPosRawNavigation, 64);
+            const int64_t packet_us = 1780300800000000LL + static_cast<int64_t>(std::llround(packet_s * 1e6));
+            const int64_t seconds = packet_us / 1000000;
+            // 2026-06-01T08:00:00Z + seconds
+            const int64_t of_day = seconds % 86400;
+            sss::xtf::writeU16(packet.data(), 14, 2026);
+            packet[16] = 6;
+            packet[17] = 1;
+            packet[18] = static_cast<uint8_t>(of_day / 3600);
+            packet[19] = static_cast<uint8_t>(of_day / 60 % 60);
+            packet[20] = static_cast<uint8_t>(of_day % 60);
+            sss::xtf::writeU16(packet.data(), 21, static_cast<uint16_t>((packet_us % 1000000) / 100));
+            const auto geo = positionAt(packet_s);
+            sss::xtf::writeF64(packet.data(), 23, geo.latitude_deg);
+            sss::xtf::writeF64(packet.data(), 31, geo.longitude_deg);
+            sss::xtf::writeF32(packet.data(), 59, 100.0f);  // heading
+            ASSERT_TRUE(writer.writeBytes(packet));
+          }
+        }
+        sss::xtf::XtfPingInput ping;
+        ping.ping_number = static_cast<uint32_t>(i);
+        ping.ping_time_us = utime_us;
+        ping.depth_m = 30.0f;
+        ping.altitude_m = 15.0f;
+        ping.heading_deg = 100.0f;
+        for (uint16_t channel = 0; channel < 2; ++channel) {
+          sss::xtf::XtfChannelData data;
+          data.channel_number = channel;
+          data.slant_range_m = 75.0f;
+          for (int k = 0; k < 2500; ++k) {
+            const double r = k * 0.03;
+            data.samples.push_back(static_cast<float>((r < 15.0 ? 20.0 : 4000.0 * 15.0 / r) * speckle(random)));
+          }
+          ping.channels.push_back(std::move(data));
+        }
+        std::vector<uint8_t> packet = sss::xtf::encodeSonarPacket(options, ping);
+        if (ship) {  // SensorY/X stay 0: the vessel's position only
+          const auto geo = positionAt(t_s);
+          sss::xtf::writeF64(packet.data(), 128, geo.latitude_deg);
+          sss::xtf::writeF64(packet.data(), 136, geo.longitude_deg);
+        }
+        ASSERT_TRUE(writer.writeBytes(packet));
+      }
+    }
+    sss::offline::OfflineRequest r;
+    r.sonar_path = path;
+    r.out_dir = root_ + (ship ? "/run_ship" : "/run_packets");
+    r.write_mosaics = false;
+    const auto result = sss::offline::runOffline(r);
+    ASSERT_TRUE(result.ok) << result.error;
+    const auto& s = result.summary;
+    EXPECT_GE(s.pings_with_pose, 570u) << (ship ? "ship" : "packets") << ": 95 % of the pings";
+    EXPECT_GE(s.subframes, 2u);
+    if (!ship) {
+      EXPECT_GE(s.nav_from_packets, 600u);
+      EXPECT_EQ(s.pings_without_position, 600u);
+    } else {
+      EXPECT_EQ(s.nav_from_packets, 0u);
+      EXPECT_EQ(s.pings_without_position, 0u);
+    }
+    ASSERT_TRUE(s.origin);
+    EXPECT_NEAR(s.origin->latitude_deg, 43.0, 1e-4);
+    const auto slam = sss::eval::readTum(r.out_dir + "/slam.tum");
+    ASSERT_TRUE(slam.ok) << slam.error;
+    const double t_last_s = 1e-6 * static_cast<double>(slam.poses.back().utime_us - 1780300800000000LL);
+    const Eigen::Vector3d last = slam.poses.back().T_world_body.translation;
+    EXPECT_NEAR(last.x(), 2.0 * t_last_s * std::cos(heading_rad), 1.0);
+    EXPECT_NEAR(last.y(), 2.0 * t_last_s * std::sin(heading_rad), 1.0);
+  }
 }
 
 TEST_F(OfflineRunnerTest, BadInputIsRefusedWithTheFileNamed) {

@@ -1,5 +1,6 @@
 // XTF file header parsing, side-scan pair selection, ping time and sonar packet decoding.
 #include "drivers/xtf/xtf_format.hpp"
+#include "drivers/xtf/xtf_writer.hpp"
 
 #include <gtest/gtest.h>
 
@@ -64,6 +65,62 @@ TEST(XtfFormat, PairsOrderedByFrequency) {
   EXPECT_EQ(pairs[1].starboard, 1);
   EXPECT_FLOAT_EQ(xtf::frequencyHz(120.0f), 120000.0f);
   EXPECT_FLOAT_EQ(xtf::frequencyHz(455000.0f), 455000.0f);
+}
+
+// Navigation packets laid out byte by byte after pyxtf's structures (types 3, 42, 107).
+TEST(XtfFormat, DecodesAttitudeNavigationAndRawPositionPackets) {
+  using namespace sss::xtf;
+  std::vector<uint8_t> attitude = encodeOtherPacket(kHeaderAttitude, 64);
+  writeU32(attitude.data(), 22, 250000);      // EpochMicroseconds
+  writeU32(attitude.data(), 26, 1780300800);  // SourceEpoch: 2026-06-01T08:00:00Z
+  writeF32(attitude.data(), 30, 2.0f);        // pitch, nose up
+  writeF32(attitude.data(), 34, -3.0f);       // roll, port down
+  writeF32(attitude.data(), 50, -90.0f);      // heading: west
+  auto a = decodeNavigationPacket(attitude.data(), attitude.size());
+  ASSERT_TRUE(a);
+  EXPECT_EQ(a->utime_us, 1780300800250000LL);
+  EXPECT_NEAR(*a->pitch_rad, 2.0 * M_PI / 180.0, 1e-7);
+  EXPECT_NEAR(*a->roll_rad, -3.0 * M_PI / 180.0, 1e-7);
+  EXPECT_NEAR(*a->heading_rad, 1.5 * M_PI, 1e-6);
+  EXPECT_FALSE(a->y);
+
+  std::vector<uint8_t> navigation = encodeOtherPacket(kHeaderNavigation, 64);
+  writeU16(navigation.data(), 14, 2026);
+  navigation[16] = 6;
+  navigation[17] = 1;
+  navigation[18] = 8;
+  navigation[19] = 0;
+  navigation[20] = 1;
+  writeU32(navigation.data(), 21, 123456);  // microseconds
+  writeF64(navigation.data(), 33, 6580456.25);
+  writeF64(navigation.data(), 41, 650123.5);
+  auto n = decodeNavigationPacket(navigation.data(), navigation.size());
+  ASSERT_TRUE(n);
+  EXPECT_EQ(n->utime_us, 1780300801123456LL);
+  EXPECT_DOUBLE_EQ(*n->y, 6580456.25);
+  EXPECT_DOUBLE_EQ(*n->x, 650123.5);
+  EXPECT_FALSE(n->heading_rad);
+
+  std::vector<uint8_t> raw = encodeOtherPacket(kHeaderPosRawNavigation, 64);
+  writeU16(raw.data(), 14, 2026);
+  raw[16] = 6;
+  raw[17] = 1;
+  raw[18] = 8;
+  writeU16(raw.data(), 21, 5000);  // 0.5 s in units of 100 us
+  writeF64(raw.data(), 23, 59.35);
+  writeF64(raw.data(), 31, 18.07);
+  writeF32(raw.data(), 59, 370.0f);
+  auto p = decodeNavigationPacket(raw.data(), raw.size());
+  ASSERT_TRUE(p);
+  EXPECT_EQ(p->utime_us, 1780300800500000LL);
+  EXPECT_DOUBLE_EQ(*p->y, 59.35);
+  EXPECT_NEAR(*p->heading_rad, 10.0 * M_PI / 180.0, 1e-6);
+  // Too short, another type, an impossible date: nothing.
+  EXPECT_FALSE(decodeNavigationPacket(raw.data(), 63));
+  std::vector<uint8_t> notes = encodeOtherPacket(1, 64);
+  EXPECT_FALSE(decodeNavigationPacket(notes.data(), notes.size()));
+  raw[16] = 13;
+  EXPECT_FALSE(decodeNavigationPacket(raw.data(), raw.size()));
 }
 
 TEST(XtfFormat, CalendarToUtc) {

@@ -124,6 +124,10 @@ class PingSource {
   virtual bool read(std::deque<sss::edgetech::DriverPing>& out) = 0;
   virtual double fractionRead() const = 0;
   virtual uint64_t faults() const = 0;
+  // Navigation packets read so far (XTF types 3, 42, 107), and whether their coordinates are
+  // projected metres (XTF NavUnits 0).
+  virtual std::vector<sss::xtf::XtfNavigationRecord> takeNavigation() { return {}; }
+  virtual bool projectedUnits() const { return false; }
 };
 
 class JsfSource : public PingSource {
@@ -180,6 +184,8 @@ class XtfSource : public PingSource {
     return size_ > 0 ? static_cast<double>(reader_.bytesRead()) / static_cast<double>(size_) : 0.0;
   }
   uint64_t faults() const override { return reader_.counters().corruptRecords(); }
+  std::vector<sss::xtf::XtfNavigationRecord> takeNavigation() override { return reader_.takeNavigation(); }
+  bool projectedUnits() const override { return reader_.info().nav_units == sss::xtf::kNavUnitsMetres; }
 
  private:
   sss::xtf::XtfReader reader_;
@@ -232,7 +238,39 @@ class EmbeddedNavigation {
   const std::optional<Eigen::Vector2d>& projectedOrigin() const { return projected_origin_; }
   std::optional<NavInput> fromPing(const sss::edgetech::DriverPing& driver_ping) {
     const auto& side = driver_ping.ping.port ? *driver_ping.ping.port : *driver_ping.ping.starboard;
-    if (side.projected_position) return fromProjected(driver_ping.utime_us, side);
+    last_side_ = side;
+    last_side_.samples.clear();
+    return fromSide(driver_ping.utime_us, side);
+  }
+  // A navigation packet of an XTF whose pings carry no position (types 42 and 107 give one, 3
+  // and 107 attitude): each position goes with the newest packet attitude (else the last ping's),
+  // and the last ping's depth and altitude. Coordinates are in the file's NavUnits.
+  std::optional<NavInput> fromPacket(const sss::xtf::XtfNavigationRecord& record, bool projected_units) {
+    if (record.pitch_rad) packet_pitch_rad_ = record.pitch_rad;
+    if (record.roll_rad) packet_roll_rad_ = record.roll_rad;
+    if (record.heading_rad) packet_heading_rad_ = record.heading_rad;
+    if (!record.y || !record.x) return std::nullopt;
+    sss::edgetech::SonarChannelRecord side = last_side_;
+    side.pitch_rad = packet_pitch_rad_.value_or(side.pitch_rad);
+    side.roll_rad = packet_roll_rad_.value_or(side.roll_rad);
+    side.heading_rad = packet_heading_rad_.value_or(side.heading_rad);
+    side.projected_position = projected_units;
+    side.validity = static_cast<uint16_t>(side.validity & ~sss::edgetech::kValidLatLon);
+    if (projected_units) {
+      side.northing_m = *record.y;
+      side.easting_m = *record.x;
+    } else {
+      if (std::abs(*record.y) > 90.0 || std::abs(*record.x) > 180.0) return std::nullopt;
+      side.latitude_deg = *record.y;
+      side.longitude_deg = *record.x;
+      side.validity |= sss::edgetech::kValidLatLon;
+    }
+    return fromSide(record.utime_us, side);
+  }
+
+ private:
+  std::optional<NavInput> fromSide(int64_t utime_us, const sss::edgetech::SonarChannelRecord& side) {
+    if (side.projected_position) return fromProjected(utime_us, side);
     if (!(side.validity & sss::edgetech::kValidLatLon) && side.latitude_deg == 0.0 && side.longitude_deg == 0.0) {
       return std::nullopt;  // no position in this ping
     }
@@ -241,14 +279,13 @@ class EmbeddedNavigation {
       setOrigin({side.latitude_deg, side.longitude_deg});
     }
     NavInput nav;
-    nav.utime_us = driver_ping.utime_us;
+    nav.utime_us = utime_us;
     nav.origin = origin_;
     nav.position_ned_m = plane_->toNed({side.latitude_deg, side.longitude_deg, side.depth_m});
     fillAttitude(nav, side);
     return nav;
   }
 
- private:
   // Projected metres: processed in the file's own grid, north = northing - N0, east = easting -
   // E0 of the first fix (the CRS is not in the file, so no latitude/longitude). The heading is
   // used as recorded: true north, which differs from the grid's north by the projection's
@@ -273,6 +310,8 @@ class EmbeddedNavigation {
     nav.distance_travelled_m = distance_m_;
   }
   std::optional<Eigen::Vector2d> projected_origin_;
+  sss::edgetech::SonarChannelRecord last_side_;  // the last ping's header (depth, altitude, attitude)
+  std::optional<double> packet_pitch_rad_, packet_roll_rad_, packet_heading_rad_;
   void setOrigin(const sss::core::MissionOrigin& origin) {
     origin_ = origin;
     plane_.emplace(origin.latitude_deg, origin.longitude_deg);
@@ -296,7 +335,7 @@ std::vector<std::string> explainRun(const OfflineSummary& s, const Options& opti
   if (s.pings_with_pose == 0) {
     // The largest cause of loss first.
     const std::pair<uint64_t, std::string> causes[] = {
-        {s.pings_without_position,
+        {s.nav_from_packets > 0 ? 0 : s.pings_without_position,
          count(s.pings_without_position) + " of " + count(pings) + " ping headers carry no position: the file has no "
          "navigation of its own; give the INS file with --ins"},
         {fusion.dropped_no_altitude,
@@ -472,9 +511,13 @@ bool writeSummaryJson(const std::string& path, const OfflineRequest& request, co
       {"input_faults", s.input_faults}};
   for (const auto& [name, value] : counts) json.key(name).value(value);
   const auto& fusion = s.buffer.fusion;
+  json.key("navigation").beginObject();
+  json.key("ping_headers_without_position").value(s.pings_without_position);
+  json.key("samples_from_nav_packets").value(s.nav_from_packets);  // XTF attitude/navigation packets
+  json.key("samples_without_position").value(fusion.nav_without_position);
+  json.endObject();
   json.key("pings_dropped").beginObject();
   const std::pair<const char*, uint64_t> drops[] = {
-      {"no_position_in_header", s.pings_without_position},
       {"before_first_fix", fusion.dropped_before_first_fix},
       {"no_nav", fusion.dropped_no_nav},
       {"older_than_nav_history", fusion.dropped_too_old},
@@ -983,10 +1026,26 @@ OfflineResult runOffline(const OfflineRequest& request) {
     };
     std::deque<sss::edgetech::DriverPing> ping_queue;
     std::deque<sss_msgs::nav_t> nav_queue;
+    // Navigation packets of the sonar file (XTF 3/42/107), used while its pings carry no
+    // position of their own: fed in time order before the pings they precede.
+    std::deque<sss::xtf::XtfNavigationRecord> packet_queue;
+    bool ping_positions_seen = false;
+    auto feedPackets = [&](int64_t up_to_us) {
+      while (!packet_queue.empty() && packet_queue.front().utime_us <= up_to_us) {
+        if (embedded && !ping_positions_seen) {
+          if (auto nav = embedded->fromPacket(packet_queue.front(), pings->projectedUnits())) {
+            runner.addNav(*nav);
+            ++runner.summary().nav_from_packets;
+          }
+        }
+        packet_queue.pop_front();
+      }
+    };
     bool pings_left = true, nav_left = ins != nullptr;
     uint64_t without_nav = 0;
     for (;;) {
       while (pings_left && ping_queue.empty()) pings_left = pings->read(ping_queue);
+      for (auto& record : pings->takeNavigation()) packet_queue.push_back(record);
       while (nav_left && nav_queue.empty()) nav_left = ins->read(nav_queue);
       if (ping_queue.empty() && nav_queue.empty()) break;
       const bool nav_first =
@@ -999,8 +1058,10 @@ OfflineResult runOffline(const OfflineRequest& request) {
       }
       sss::edgetech::DriverPing ping = std::move(ping_queue.front());
       ping_queue.pop_front();
+      feedPackets(ping.utime_us);
       if (embedded) {
         if (auto nav = embedded->fromPing(ping)) {
+          ping_positions_seen = true;
           runner.addNav(*nav);
         } else {
           ++without_nav;
@@ -1012,13 +1073,14 @@ OfflineResult runOffline(const OfflineRequest& request) {
       runner.addPing(sss::subframe::fromPingMessage(message));
       runner.progress(pings->fractionRead(), false);
     }
+    feedPackets(INT64_MAX);  // the file's last navigation, after its last ping
     faults += pings->faults() + (ins ? ins->faults() : 0);
     if (runner.summary().pings == 0) {
       result.error = "no usable pings in " + request.sonar_path;
       return result;
     }
     if (embedded) projected_origin = embedded->projectedOrigin();
-    if (embedded && without_nav == runner.summary().pings) {
+    if (embedded && without_nav == runner.summary().pings && runner.summary().nav_from_packets == 0) {
       result.error = request.sonar_path + " carries no navigation in its ping headers; give an INS file with --ins";
       return result;
     }

@@ -69,6 +69,7 @@ struct OfflineSummary {
   sss::subframe::SubframeBufferCounters buffer;
   sss::subframe::BottomTrackerCounters bottom_track;
   uint64_t pings_without_position = 0;  // embedded navigation: a ping header without a position
+  uint64_t nav_from_packets = 0;        // navigation samples from the sonar file's own nav packets
   uint64_t survey_lines = 0;
   double nearest_other_line_m = -1.0;   // closest centres of subframes of different lines; < 0: none
   uint64_t pairs_few_matches = 0;       // pairs rejected for too few dense matches
