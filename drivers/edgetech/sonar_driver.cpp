@@ -22,12 +22,25 @@ void SonarDriver::onBytes(const uint8_t* data, size_t size, int64_t host_utime_u
   convert(assembled_, out);
 }
 
+std::vector<JsfNavigationRecord> SonarDriver::takeNavigation() {
+  std::vector<JsfNavigationRecord> records;
+  records.swap(navigation_records_);
+  return records;
+}
+
 void SonarDriver::handleMessages(int64_t host_utime_us, int64_t monotonic_us) {
   for (const JsfMessage& message : messages_) {
     if (isNavigationType(message.header.message_type)) {
       JsfNavigationDecodeResult nav = decodeNavigation(message.header, message.body.data(), message.body.size());
       if (nav.record) {
         ++navigation_messages_;
+        if (keep_navigation_) {
+          if (navigation_records_.size() >= kMaxKeptNavigation) {
+            navigation_records_.erase(navigation_records_.begin(),
+                                      navigation_records_.begin() + static_cast<std::ptrdiff_t>(kMaxKeptNavigation / 2));
+          }
+          navigation_records_.push_back(*nav.record);
+        }
         latest_navigation_ = std::move(nav.record);
       } else {
         ++sonar_decode_errors_;

@@ -66,6 +66,12 @@ class SonarDriver {
   uint64_t otherMessages() const { return other_messages_; }
   // The newest navigation message of the sonar's own sensors (2020/2080/2090/2091/2002).
   const std::optional<JsfNavigationRecord>& latestNavigation() const { return latest_navigation_; }
+  // With keepNavigation(true), every navigation message decoded since the last call, in stream
+  // order (the offline runner uses them as the navigation when the pings carry no position).
+  // Off by default (the live driver has the INS); bounded to the newest kMaxKeptNavigation.
+  void keepNavigation(bool keep) { keep_navigation_ = keep; }
+  std::vector<JsfNavigationRecord> takeNavigation();
+  static constexpr size_t kMaxKeptNavigation = 100000;
   uint64_t pingsWithoutOffset() const { return pings_without_offset_; }
   // host = sonar + offset; empty before enough pings.
   std::optional<int64_t> clockOffsetUs() const { return clock_.offsetUs(); }
@@ -86,6 +92,8 @@ class SonarDriver {
   uint64_t navigation_messages_ = 0;
   uint64_t other_messages_ = 0;
   std::optional<JsfNavigationRecord> latest_navigation_;
+  std::vector<JsfNavigationRecord> navigation_records_;
+  bool keep_navigation_ = false;
   uint64_t pings_without_offset_ = 0;
   std::vector<std::string> new_faults_;
   bool decode_error_reported_ = false;

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -26,6 +27,7 @@
 #include "tools/process/offline_runner.hpp"
 #include "pipeline/core/geodesy.hpp"
 #include "drivers/xtf/xtf_writer.hpp"
+#include "drivers/edgetech/jsf_format.hpp"
 
 namespace fs = std::filesystem;
 
@@ -575,6 +577,86 @@ TEST_F(OfflineRunnerTest, XtfNavigationPacketsOrShipCoordinatesPositionPingsWith
     EXPECT_NEAR(last.x(), 2.0 * t_last_s * std::cos(heading_rad), 1.0);
     EXPECT_NEAR(last.y(), 2.0 * t_last_s * std::sin(heading_rad), 1.0);
   }
+}
+
+// A JSF whose type 80 pings carry no position (no lat/lon bit) with 2090 situation messages
+// between them (latitude, longitude, depth, heading at 4 Hz, as the sonar's own INS sends):
+// the situation messages are the navigation.
+TEST_F(OfflineRunnerTest, JsfSituationMessagesPositionPingsWithoutPosition) {
+  const std::string path = root_ + "/situation.jsf";
+  const sss::core::LocalTangentPlane plane(-12.5, 130.8);
+  const double heading_rad = 250.0 * M_PI / 180.0;
+  {
+    std::ofstream out(path, std::ios::binary);
+    std::mt19937 random(8);
+    std::exponential_distribution<double> speckle(1.0);
+    uint8_t sequence = 0;
+    for (int i = 0; i < 600; ++i) {
+      const double t_s = 0.25 * i;
+      const int64_t utime_us = 1780300800000000LL + i * 250000LL;
+      // 2090, 50 ms before the ping.
+      std::vector<uint8_t> body(276, 0);
+      const int64_t nav_us = utime_us - 50000;
+      const int32_t seconds = static_cast<int32_t>(nav_us / 1000000);
+      const int32_t milliseconds = static_cast<int32_t>(nav_us / 1000 % 1000);
+      std::memcpy(body.data() + 0, &seconds, 4);
+      std::memcpy(body.data() + 4, &milliseconds, 4);
+      const uint32_t validity = 0x7Fu;
+      std::memcpy(body.data() + 12, &validity, 4);
+      const uint64_t microseconds = static_cast<uint64_t>(nav_us);
+      std::memcpy(body.data() + 20, &microseconds, 8);
+      const double nav_s = std::max(0.0, t_s - 0.05);
+      const auto geo = plane.toGeodetic(Eigen::Vector3d(2.0 * nav_s * std::cos(heading_rad), 2.0 * nav_s * std::sin(heading_rad), 0.0));
+      const double fields[] = {geo.latitude_deg, geo.longitude_deg, 30.0, 250.0, 0.0, 0.0};
+      for (int f = 0; f < 6; ++f) std::memcpy(body.data() + 28 + 8 * f, &fields[f], 8);
+      sss::edgetech::JsfMessageHeader header;
+      header.message_type = sss::edgetech::kJsfSituation;
+      header.byte_count = static_cast<int32_t>(body.size());
+      uint8_t header_bytes[16];
+      sss::edgetech::encodeHeader(header, header_bytes);
+      out.write(reinterpret_cast<const char*>(header_bytes), 16);
+      out.write(reinterpret_cast<const char*>(body.data()), static_cast<std::streamsize>(body.size()));
+      for (uint8_t channel : {sss::edgetech::kChannelPort, sss::edgetech::kChannelStarboard}) {
+        sss::edgetech::SonarChannelRecord record;
+        record.channel = channel;
+        record.ping_time_us = utime_us;
+        record.ping_number = static_cast<uint32_t>(i);
+        record.sample_interval_s = 4e-5;  // 3 cm
+        record.validity = sss::edgetech::kValidHeading | sss::edgetech::kValidSoundSpeed;  // no position, no altitude
+        record.heading_rad = heading_rad;
+        std::vector<float> magnitudes;
+        for (int k = 0; k < 2500; ++k) {
+          const double r = k * 0.03;
+          magnitudes.push_back(static_cast<float>((r < 15.0 ? 2.0 : 400.0 * 15.0 / r) * speckle(random)));
+        }
+        int16_t weighting = 0;
+        const auto codes = sss::edgetech::quantiseEnvelope(magnitudes, weighting);
+        record.weighting_factor = weighting;
+        const auto bytes = sss::edgetech::encodeSonarData(record, codes, sequence++);
+        out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+      }
+    }
+  }
+  sss::offline::OfflineRequest r;
+  r.sonar_path = path;
+  r.out_dir = root_ + "/run_situation";
+  r.write_mosaics = false;
+  const auto result = sss::offline::runOffline(r);
+  ASSERT_TRUE(result.ok) << result.error;
+  const auto& s = result.summary;
+  EXPECT_EQ(s.pings, 600u);
+  EXPECT_GE(s.pings_with_pose, 570u) << "95 % of the pings";
+  EXPECT_GE(s.nav_from_packets, 600u);
+  EXPECT_GE(s.subframes, 2u);
+  ASSERT_TRUE(s.origin);
+  EXPECT_NEAR(s.origin->latitude_deg, -12.5, 1e-4);
+  const auto slam = sss::eval::readTum(r.out_dir + "/slam.tum");
+  ASSERT_TRUE(slam.ok) << slam.error;
+  const double t_last_s = 1e-6 * static_cast<double>(slam.poses.back().utime_us - 1780300800000000LL);
+  const Eigen::Vector3d last = slam.poses.back().T_world_body.translation;
+  EXPECT_NEAR(last.x(), 2.0 * t_last_s * std::cos(heading_rad), 1.0);
+  EXPECT_NEAR(last.y(), 2.0 * t_last_s * std::sin(heading_rad), 1.0);
+  EXPECT_NEAR(last.z(), 30.0, 0.1) << "the depth of the situation messages";
 }
 
 TEST_F(OfflineRunnerTest, BadInputIsRefusedWithTheFileNamed) {

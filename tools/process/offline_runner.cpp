@@ -116,6 +116,17 @@ bool readOptions(const std::string& path, Options& options, std::string& error) 
 
 // ---- inputs in time order ----------------------------------------------------------------------
 
+// A navigation sample a sonar file carries apart from its pings (XTF packets 3, 42, 107; JSF
+// messages 2020, 2080, 2090, 2091), in the file's units: latitude/longitude degrees, or projected
+// northing/easting metres.
+struct FileNavigation {
+  int64_t utime_us = 0;
+  std::optional<double> y, x;
+  std::optional<double> depth_m;
+  std::optional<double> altitude_m;  // above the seabed (a DVL's), when the message says so
+  std::optional<double> pitch_rad, roll_rad, heading_rad;
+};
+
 // One source of pings and one of nav samples, each in file order; the runner merges them by time.
 class PingSource {
  public:
@@ -126,7 +137,7 @@ class PingSource {
   virtual uint64_t faults() const = 0;
   // Navigation packets read so far (XTF types 3, 42, 107), and whether their coordinates are
   // projected metres (XTF NavUnits 0).
-  virtual std::vector<sss::xtf::XtfNavigationRecord> takeNavigation() { return {}; }
+  virtual std::vector<FileNavigation> takeNavigation() { return {}; }
   virtual bool projectedUnits() const { return false; }
 };
 
@@ -136,6 +147,15 @@ class JsfSource : public PingSource {
       : file_(path, std::ios::binary), driver_(options) {
     std::error_code ec;
     size_ = fs::file_size(path, ec);
+    driver_.keepNavigation(true);
+  }
+  std::vector<FileNavigation> takeNavigation() override {
+    std::vector<FileNavigation> out;
+    for (const auto& r : driver_.takeNavigation()) {
+      out.push_back({r.time_us, r.latitude_deg, r.longitude_deg, r.depth_m, r.altitude_m, r.pitch_rad, r.roll_rad,
+                     r.heading_rad});
+    }
+    return out;
   }
   bool good() const { return file_.good(); }
   bool read(std::deque<sss::edgetech::DriverPing>& out) override {
@@ -184,7 +204,14 @@ class XtfSource : public PingSource {
     return size_ > 0 ? static_cast<double>(reader_.bytesRead()) / static_cast<double>(size_) : 0.0;
   }
   uint64_t faults() const override { return reader_.counters().corruptRecords(); }
-  std::vector<sss::xtf::XtfNavigationRecord> takeNavigation() override { return reader_.takeNavigation(); }
+  std::vector<FileNavigation> takeNavigation() override {
+    std::vector<FileNavigation> out;
+    for (const auto& r : reader_.takeNavigation()) {
+      // RawAltitude is the positioning system's height, not an altitude above the seabed.
+      out.push_back({r.utime_us, r.y, r.x, std::nullopt, std::nullopt, r.pitch_rad, r.roll_rad, r.heading_rad});
+    }
+    return out;
+  }
   bool projectedUnits() const override { return reader_.info().nav_units == sss::xtf::kNavUnitsMetres; }
 
  private:
@@ -245,15 +272,22 @@ class EmbeddedNavigation {
   // A navigation packet of an XTF whose pings carry no position (types 42 and 107 give one, 3
   // and 107 attitude): each position goes with the newest packet attitude (else the last ping's),
   // and the last ping's depth and altitude. Coordinates are in the file's NavUnits.
-  std::optional<NavInput> fromPacket(const sss::xtf::XtfNavigationRecord& record, bool projected_units) {
+  std::optional<NavInput> fromPacket(const FileNavigation& record, bool projected_units) {
     if (record.pitch_rad) packet_pitch_rad_ = record.pitch_rad;
     if (record.roll_rad) packet_roll_rad_ = record.roll_rad;
     if (record.heading_rad) packet_heading_rad_ = record.heading_rad;
+    if (record.depth_m) packet_depth_m_ = record.depth_m;
+    if (record.altitude_m) packet_altitude_m_ = record.altitude_m;
     if (!record.y || !record.x) return std::nullopt;
     sss::edgetech::SonarChannelRecord side = last_side_;
     side.pitch_rad = packet_pitch_rad_.value_or(side.pitch_rad);
     side.roll_rad = packet_roll_rad_.value_or(side.roll_rad);
     side.heading_rad = packet_heading_rad_.value_or(side.heading_rad);
+    side.depth_m = packet_depth_m_.value_or(side.depth_m);
+    if (packet_altitude_m_ && *packet_altitude_m_ > 0.0) {
+      side.altitude_m = *packet_altitude_m_;
+      side.validity |= sss::edgetech::kValidAltitude;
+    }
     side.projected_position = projected_units;
     side.validity = static_cast<uint16_t>(side.validity & ~sss::edgetech::kValidLatLon);
     if (projected_units) {
@@ -311,7 +345,7 @@ class EmbeddedNavigation {
   }
   std::optional<Eigen::Vector2d> projected_origin_;
   sss::edgetech::SonarChannelRecord last_side_;  // the last ping's header (depth, altitude, attitude)
-  std::optional<double> packet_pitch_rad_, packet_roll_rad_, packet_heading_rad_;
+  std::optional<double> packet_pitch_rad_, packet_roll_rad_, packet_heading_rad_, packet_depth_m_, packet_altitude_m_;
   void setOrigin(const sss::core::MissionOrigin& origin) {
     origin_ = origin;
     plane_.emplace(origin.latitude_deg, origin.longitude_deg);
@@ -1028,7 +1062,7 @@ OfflineResult runOffline(const OfflineRequest& request) {
     std::deque<sss_msgs::nav_t> nav_queue;
     // Navigation packets of the sonar file (XTF 3/42/107), used while its pings carry no
     // position of their own: fed in time order before the pings they precede.
-    std::deque<sss::xtf::XtfNavigationRecord> packet_queue;
+    std::deque<FileNavigation> packet_queue;
     bool ping_positions_seen = false;
     auto feedPackets = [&](int64_t up_to_us) {
       while (!packet_queue.empty() && packet_queue.front().utime_us <= up_to_us) {
