@@ -659,6 +659,69 @@ TEST_F(OfflineRunnerTest, JsfSituationMessagesPositionPingsWithoutPosition) {
   EXPECT_NEAR(last.z(), 30.0, 0.1) << "the depth of the situation messages";
 }
 
+// The towed record of the real-file issue, rebuilt: an XTF in latitude/longitude with altitude and
+// depth 0 in every ping, 1446 pings along a 311 m line that curves through 30 degrees. Every ping
+// gets a pose, the bottom track gives the altitude, and the curve still makes subframes.
+TEST_F(OfflineRunnerTest, TowedCurvedLineWithoutAltitudeOrDepthGivesSubframes) {
+  sss::xtf::XtfWriterOptions options;
+  sss::xtf::XtfWriterChannel port, starboard;
+  starboard.type_of_channel = sss::xtf::kChannelStarboard;
+  options.channels = {port, starboard};
+  const std::string path = root_ + "/towed_curve.xtf";
+  const sss::core::LocalTangentPlane plane(51.2, 2.9);
+  constexpr int kPings = 1446;
+  const double length_m = 311.0, turn_rad = 30.0 * M_PI / 180.0, radius_m = length_m / turn_rad;
+  const double period_s = 0.143;  // 7 Hz at 1.5 m/s
+  {
+    sss::xtf::XtfWriter writer(path, options);
+    ASSERT_TRUE(writer.isOpen());
+    std::mt19937 random(12);
+    std::exponential_distribution<double> speckle(1.0);
+    for (int i = 0; i < kPings; ++i) {
+      const double s_m = length_m * i / (kPings - 1), angle = s_m / radius_m;  // heading from north, turning right
+      const Eigen::Vector3d ned(radius_m * std::sin(angle), radius_m * (1.0 - std::cos(angle)), 0.0);
+      const auto geo = plane.toGeodetic(ned);
+      sss::xtf::XtfPingInput ping;
+      ping.ping_number = static_cast<uint32_t>(i);
+      ping.ping_time_us = 1780300800000000LL + static_cast<int64_t>(std::llround(i * period_s * 1e6));
+      ping.sensor_y = geo.latitude_deg;
+      ping.sensor_x = geo.longitude_deg;
+      ping.heading_deg = static_cast<float>(angle * 180.0 / M_PI);  // depth and altitude stay 0
+      for (uint16_t channel = 0; channel < 2; ++channel) {
+        sss::xtf::XtfChannelData data;
+        data.channel_number = channel;
+        data.slant_range_m = 50.0f;
+        for (int k = 0; k < 1600; ++k) {
+          const double r = k * 0.03125;
+          data.samples.push_back(static_cast<float>((r < 9.0 ? 20.0 : 4000.0 * 9.0 / r) * speckle(random)));
+        }
+        ping.channels.push_back(std::move(data));
+      }
+      ASSERT_TRUE(writer.write(ping));
+    }
+  }
+  sss::offline::OfflineRequest r;
+  r.sonar_path = path;
+  r.out_dir = root_ + "/run_towed_curve";
+  const auto result = sss::offline::runOffline(r);
+  ASSERT_TRUE(result.ok) << result.error;
+  const auto& s = result.summary;
+  std::printf("towed curved line: %llu of %llu pings with a pose, %llu subframes, %llu lines, %llu bottom-tracked\n",
+              static_cast<unsigned long long>(s.pings_with_pose), static_cast<unsigned long long>(s.pings),
+              static_cast<unsigned long long>(s.subframes), static_cast<unsigned long long>(s.survey_lines),
+              static_cast<unsigned long long>(s.buffer.fusion.altitude_from_bottom_track));
+  EXPECT_EQ(s.pings, static_cast<uint64_t>(kPings));
+  EXPECT_GE(s.pings_with_pose, static_cast<uint64_t>(0.95 * kPings));
+  EXPECT_EQ(s.buffer.fusion.altitude_from_bottom_track, s.pings_with_pose);
+  EXPECT_GE(s.subframes, 1u);
+  EXPECT_TRUE(fs::is_regular_file(r.out_dir + "/mosaic_dr.png"));
+  // DR only, and the run says why: one pass, not lines too far apart for the swath.
+  ASSERT_EQ(s.findings.size(), 1u);
+  EXPECT_NE(s.findings[0].find("follow one another along one track"), std::string::npos) << s.findings[0];
+  std::printf("towed curved line: %llu pairs tried, %llu closures; %s\n", static_cast<unsigned long long>(s.pairs_attempted),
+              static_cast<unsigned long long>(s.matcher_closures), s.findings.empty() ? "" : s.findings[0].c_str());
+}
+
 TEST_F(OfflineRunnerTest, BadInputIsRefusedWithTheFileNamed) {
   auto missing = request("missing");
   missing.sonar_path = root_ + "/no_such_file.jsf";

@@ -422,11 +422,15 @@ std::vector<std::string> explainRun(const OfflineSummary& s, const Options& opti
     if (s.survey_lines < 2) {
       findings.push_back("no pair to match: every subframe is on one survey line; loop closures need a second line "
                          "over the same seabed (the result is dead reckoning)");
+    } else if (s.nearest_other_line_m < 0.0) {
+      findings.push_back("no pair to match: the " + count(s.survey_lines) + " survey lines follow one another along "
+                         "one track (split where the heading changed), none runs beside another; loop closures need "
+                         "a second pass over the same seabed (the result is dead reckoning)");
     } else {
       char text[512];
       std::snprintf(text, sizeof text,
                     "no pair to match: no two subframes of different lines overlap within the canonical swath of "
-                    "%.0f m per side (nearest centres of different lines: %.0f m apart); widen it with "
+                    "%.0f m per side (the nearest lines run %.0f m apart); widen it with "
                     "subframe_buffer.canonical.bins_per_side x bin_size_m up to the sonar's range",
                     swath_m, s.nearest_other_line_m);
       findings.push_back(text);
@@ -729,12 +733,16 @@ class Runner {
       if (std::find(lines.begin(), lines.end(), line) == lines.end()) lines.push_back(line);
     }
     summary_.survey_lines = lines.size();
+    // Of two subframes of different lines, the one's centre in the other's frame: side by side
+    // (more across than along) is a pair the swath could cover; ahead or behind is the same track
+    // going on (a line split where the heading changed).
     double nearest = -1.0;
     for (size_t i = 0; i < centres_.size(); ++i) {
-      for (size_t j = i + 1; j < centres_.size(); ++j) {
+      for (size_t j = 0; j < centres_.size(); ++j) {
         if (centres_[i].first == centres_[j].first) continue;
-        const double d = (centres_[i].second - centres_[j].second).head<2>().norm();
-        if (nearest < 0.0 || d < nearest) nearest = d;
+        const Eigen::Vector3d in_i = centres_[i].second.inverse() * centres_[j].second.translation;
+        if (std::abs(in_i.x()) > std::abs(in_i.y())) continue;
+        if (nearest < 0.0 || std::abs(in_i.y()) < nearest) nearest = std::abs(in_i.y());
       }
     }
     summary_.nearest_other_line_m = nearest;
@@ -811,7 +819,7 @@ class Runner {
   void handleSubframes() {
     for (sss::subframe::Subframe& subframe : subframes_) {
       ++summary_.subframes;
-      centres_.push_back({subframe.line_id, subframe.centre().T_world_body.translation});
+      centres_.push_back({subframe.line_id, subframe.centre().T_world_body});
       optimiser_.addSubframe(subframe);
       if (request_.write_mosaics) mosaic_subframes_.push_back(decimateForMosaic(subframe, mosaic_factor_));
       addOutcomes(timedMatch([&] { return matcher_.addSubframe(std::move(subframe)); }));
@@ -828,7 +836,7 @@ class Runner {
   sss::optimiser::OptimiserEngine optimiser_;
   std::vector<sss::subframe::Subframe> subframes_;  // reused
   std::vector<sss::subframe::Subframe> mosaic_subframes_;
-  std::vector<std::pair<int, Eigen::Vector3d>> centres_;  // line id and DR centre of every subframe
+  std::vector<std::pair<int, sss::core::Pose>> centres_;  // line id and DR centre pose of every subframe
   std::vector<sss::optimiser::StampedPose> dr_per_ping_;
   struct PingAltitude {
     int64_t utime_us;

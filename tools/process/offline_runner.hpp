@@ -71,7 +71,9 @@ struct OfflineSummary {
   uint64_t pings_without_position = 0;  // embedded navigation: a ping header without a position
   uint64_t nav_from_packets = 0;        // navigation samples from the sonar file's own nav packets
   uint64_t survey_lines = 0;
-  double nearest_other_line_m = -1.0;   // closest centres of subframes of different lines; < 0: none
+  // Across-track distance of the nearest subframe of another line lying beside one (more across
+  // than along); < 0: none beside another (one line, or lines following one another).
+  double nearest_other_line_m = -1.0;
   uint64_t pairs_few_matches = 0;       // pairs rejected for too few dense matches
   uint64_t pairs_pose_rejected = 0;     // pairs whose relative pose failed
   std::string first_pair_rejection;
