@@ -12,6 +12,8 @@ void readCanonicalTransformOptions(sss::core::ConfigSection& section, CanonicalT
   section.optional("bins_per_side", options.bins_per_side, {inRange(16, 16384)});
   section.optional("bin_size_m", options.bin_size_m, {inRange(0.001, 10.0)});
   section.optional("first_bin_range_m", options.first_bin_range_m, {inRange(0.0, 1000.0)});
+  section.optional("swath_from_range", options.swath_from_range);
+  section.optional("max_bins_per_side", options.max_bins_per_side, {inRange(16, 16384)});
   section.optional("lambertian_correction", options.lambertian_correction);
   section.optional("min_cos2", options.min_cos2, {inRange(1e-6, 1.0)});
   section.optional("normalise_profile", options.normalise_profile);

@@ -1,6 +1,9 @@
 // The subframe buffer's pipeline of library stages. See subframe_buffer.hpp.
 #include "pipeline/subframe/subframe_buffer.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 namespace sss::subframe {
 
 void readSubframeBufferOptions(sss::core::ConfigSection& section, SubframeBufferOptions& options) {
@@ -33,8 +36,29 @@ SubframeBuffer::SubframeBuffer(const SubframeBufferOptions& options)
     : options_(options),
       geometry_(geometryOf(options)),
       fusion_(options.fusion),
-      canonical_(options.canonical),
-      builder_(options.lines, options.subframes, geometry_) {}
+      canonical_(std::make_unique<CanonicalTransform>(options.canonical)),
+      builder_(std::make_unique<SubframeBuilder>(options.lines, options.subframes, geometry_)),
+      swath_fixed_(!options.canonical.swath_from_range) {}
+
+void SubframeBuffer::fitSwathTo(const FusedPing& first) {
+  swath_fixed_ = true;
+  const PingInput& ping = first.ping;
+  const double last_slant_m =
+      ping.start_range_m + ping.sampleSpacingM() * static_cast<double>(std::max(ping.port.size(), ping.starboard.size()));
+  if (!(last_slant_m > first.altitude_m)) return;
+  const double ground_m = std::sqrt(last_slant_m * last_slant_m - first.altitude_m * first.altitude_m);
+  const CanonicalTransformOptions& c = options_.canonical;
+  const int bins = std::min(c.max_bins_per_side,
+                            static_cast<int>(std::ceil((ground_m - c.first_bin_range_m) / c.bin_size_m)));
+  if (bins <= c.bins_per_side) return;
+  // Nothing transformed yet: the stages start again on the wider axis (keeping the numbering).
+  const SubframeNumbering numbering = builder_->numbering();
+  options_.canonical.bins_per_side = bins;
+  geometry_ = geometryOf(options_);
+  canonical_ = std::make_unique<CanonicalTransform>(options_.canonical);
+  builder_ = std::make_unique<SubframeBuilder>(options_.lines, options_.subframes, geometry_);
+  builder_->resumeNumbering(numbering);
+}
 
 void SubframeBuffer::addNav(const NavInput& nav, std::vector<Subframe>& out) {
   fusion_.addNav(nav, fused_);
@@ -49,15 +73,16 @@ void SubframeBuffer::addPing(PingInput ping, std::vector<Subframe>& out) {
 void SubframeBuffer::finish(std::vector<Subframe>& out) {
   fusion_.finish(fused_);
   process(out);
-  builder_.finish(out);
+  builder_->finish(out);
 }
 
 void SubframeBuffer::process(std::vector<Subframe>& out) {
   for (FusedPing& fused : fused_) {
     if (observer_) observer_(fused);
-    CanonicalPing row = canonical_.transform(std::move(fused));
+    if (!swath_fixed_) fitSwathTo(fused);
+    CanonicalPing row = canonical_->transform(std::move(fused));
     if (row.turn) ++turn_rows_;
-    builder_.addPing(std::move(row), out);
+    builder_->addPing(std::move(row), out);
   }
   fused_.clear();
 }
@@ -65,13 +90,13 @@ void SubframeBuffer::process(std::vector<Subframe>& out) {
 SubframeBufferCounters SubframeBuffer::counters() const {
   SubframeBufferCounters counters;
   counters.fusion = fusion_.counters();
-  counters.builder = builder_.counters();
+  counters.builder = builder_->counters();
   counters.turn_rows = turn_rows_;
   return counters;
 }
 
 size_t SubframeBuffer::memoryBytes() const {
-  return fusion_.memoryBytes() + canonical_.memoryBytes() + builder_.memoryBytes();
+  return fusion_.memoryBytes() + canonical_->memoryBytes() + builder_->memoryBytes();
 }
 
 }  // namespace sss::subframe

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "pipeline/core/config.hpp"
@@ -41,9 +42,11 @@ class SubframeBuffer {
 
   SubframeBufferCounters counters() const;
   const BottomTrackerCounters& bottomTrackCounters() const { return fusion_.bottomTrackCounters(); }
-  SubframeNumbering numbering() const { return builder_.numbering(); }
-  void resumeNumbering(const SubframeNumbering& numbering) { builder_.resumeNumbering(numbering); }
+  SubframeNumbering numbering() const { return builder_->numbering(); }
+  void resumeNumbering(const SubframeNumbering& numbering) { builder_->resumeNumbering(numbering); }
   const SubframeBufferOptions& options() const { return options_; }
+  // The ground-range axis: the configured one, widened by the first ping with a pose when
+  // canonical.swath_from_range (see CanonicalTransformOptions).
   const SubframeGeometry& geometry() const { return geometry_; }
   // Bytes held by the buffers (nav history, waiting pings, rows of the open subframe).
   size_t memoryBytes() const;
@@ -53,12 +56,14 @@ class SubframeBuffer {
 
  private:
   void process(std::vector<Subframe>& out);
+  void fitSwathTo(const FusedPing& first);
 
   SubframeBufferOptions options_;
   SubframeGeometry geometry_;
   PingNavFusion fusion_;
-  CanonicalTransform canonical_;
-  SubframeBuilder builder_;
+  std::unique_ptr<CanonicalTransform> canonical_;
+  std::unique_ptr<SubframeBuilder> builder_;
+  bool swath_fixed_ = false;
   std::vector<FusedPing> fused_;  // reused
   uint64_t turn_rows_ = 0;
   std::function<void(const FusedPing&)> observer_;

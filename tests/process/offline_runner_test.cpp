@@ -580,10 +580,11 @@ TEST_F(OfflineRunnerTest, XtfNavigationPacketsOrShipCoordinatesPositionPingsWith
 }
 
 // A JSF whose type 80 pings carry no position (no lat/lon bit) with 2090 situation messages
-// between them (latitude, longitude, depth, heading at 4 Hz, as the sonar's own INS sends):
-// the situation messages are the navigation.
-TEST_F(OfflineRunnerTest, JsfSituationMessagesPositionPingsWithoutPosition) {
-  const std::string path = root_ + "/situation.jsf";
+// between them (latitude, longitude, depth, heading at 4 Hz, as the sonar's own INS sends), or
+// 2002 NMEA messages with GGA sentences: those messages are the navigation.
+TEST_F(OfflineRunnerTest, JsfSituationOrNmeaMessagesPositionPingsWithoutPosition) {
+ for (const bool nmea : {false, true}) {
+  const std::string path = root_ + (nmea ? "/nmea.jsf" : "/situation.jsf");
   const sss::core::LocalTangentPlane plane(-12.5, 130.8);
   const double heading_rad = 250.0 * M_PI / 180.0;
   {
@@ -611,6 +612,22 @@ TEST_F(OfflineRunnerTest, JsfSituationMessagesPositionPingsWithoutPosition) {
       for (int f = 0; f < 6; ++f) std::memcpy(body.data() + 28 + 8 * f, &fields[f], 8);
       sss::edgetech::JsfMessageHeader header;
       header.message_type = sss::edgetech::kJsfSituation;
+      if (nmea) {  // the same fix as a GGA sentence from byte 12 (ddmm.mmmmmm, S and E)
+        const double lat = -geo.latitude_deg, lon = geo.longitude_deg;
+        char sentence[128];
+        std::snprintf(sentence, sizeof sentence, "GPGGA,080000.00,%02d%09.6f,S,%03d%09.6f,E,1,10,0.8,0.0,M,,M,,",
+                      static_cast<int>(lat), (lat - static_cast<int>(lat)) * 60.0, static_cast<int>(lon),
+                      (lon - static_cast<int>(lon)) * 60.0);
+        unsigned checksum = 0;
+        for (const char* c = sentence; *c; ++c) checksum ^= static_cast<unsigned char>(*c);
+        char text[160];
+        std::snprintf(text, sizeof text, "$%s*%02X\r\n", sentence, checksum);
+        body.assign(12, 0);
+        std::memcpy(body.data() + 0, &seconds, 4);
+        std::memcpy(body.data() + 4, &milliseconds, 4);
+        body.insert(body.end(), text, text + std::strlen(text));
+        header.message_type = sss::edgetech::kJsfNmea;
+      }
       header.byte_count = static_cast<int32_t>(body.size());
       uint8_t header_bytes[16];
       sss::edgetech::encodeHeader(header, header_bytes);
@@ -639,7 +656,7 @@ TEST_F(OfflineRunnerTest, JsfSituationMessagesPositionPingsWithoutPosition) {
   }
   sss::offline::OfflineRequest r;
   r.sonar_path = path;
-  r.out_dir = root_ + "/run_situation";
+  r.out_dir = root_ + (nmea ? "/run_nmea" : "/run_situation");
   r.write_mosaics = false;
   const auto result = sss::offline::runOffline(r);
   ASSERT_TRUE(result.ok) << result.error;
@@ -656,7 +673,10 @@ TEST_F(OfflineRunnerTest, JsfSituationMessagesPositionPingsWithoutPosition) {
   const Eigen::Vector3d last = slam.poses.back().T_world_body.translation;
   EXPECT_NEAR(last.x(), 2.0 * t_last_s * std::cos(heading_rad), 1.0);
   EXPECT_NEAR(last.y(), 2.0 * t_last_s * std::sin(heading_rad), 1.0);
-  EXPECT_NEAR(last.z(), 30.0, 0.1) << "the depth of the situation messages";
+  if (!nmea) {
+    EXPECT_NEAR(last.z(), 30.0, 0.1) << "the depth of the situation messages";
+  }
+ }
 }
 
 // The towed record of the real-file issue, rebuilt: an XTF in latitude/longitude with altitude and

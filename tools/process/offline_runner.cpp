@@ -24,6 +24,7 @@
 #include "drivers/edgetech/sonar_driver.hpp"
 #include "drivers/ins/ins_bridge.hpp"
 #include "drivers/ins/nav_message.hpp"
+#include "drivers/ins/nmea_gga.hpp"
 #include "drivers/xtf/xtf_reader.hpp"
 #include "pipeline/core/config.hpp"
 #include "pipeline/core/geodesy.hpp"
@@ -152,8 +153,15 @@ class JsfSource : public PingSource {
   std::vector<FileNavigation> takeNavigation() override {
     std::vector<FileNavigation> out;
     for (const auto& r : driver_.takeNavigation()) {
-      out.push_back({r.time_us, r.latitude_deg, r.longitude_deg, r.depth_m, r.altitude_m, r.pitch_rad, r.roll_rad,
-                     r.heading_rad});
+      FileNavigation nav{r.time_us, r.latitude_deg, r.longitude_deg, r.depth_m, r.altitude_m, r.pitch_rad, r.roll_rad,
+                         r.heading_rad};
+      if (r.nmea) {  // 2002: a GGA fix gives the position, at the message's (sonar clock) time
+        if (const auto fix = sss::ins::parseGga(*r.nmea)) {
+          nav.y = fix->latitude_deg;
+          nav.x = fix->longitude_deg;
+        }
+      }
+      out.push_back(nav);
     }
     return out;
   }
@@ -417,7 +425,7 @@ std::vector<std::string> explainRun(const OfflineSummary& s, const Options& opti
     findings.push_back("no subframe: " + why);
     return findings;
   }
-  const double swath_m = options.buffer.canonical.bins_per_side * options.buffer.canonical.bin_size_m;
+  const double swath_m = s.canonical_swath_m;
   if (s.pairs_attempted == 0) {
     if (s.survey_lines < 2) {
       findings.push_back("no pair to match: every subframe is on one survey line; loop closures need a second line "
@@ -428,11 +436,20 @@ std::vector<std::string> explainRun(const OfflineSummary& s, const Options& opti
                          "a second pass over the same seabed (the result is dead reckoning)");
     } else {
       char text[512];
-      std::snprintf(text, sizeof text,
-                    "no pair to match: no two subframes of different lines overlap within the canonical swath of "
-                    "%.0f m per side (the nearest lines run %.0f m apart); widen it with "
-                    "subframe_buffer.canonical.bins_per_side x bin_size_m up to the sonar's range",
-                    swath_m, s.nearest_other_line_m);
+      if (options.buffer.canonical.swath_from_range && s.nearest_other_line_m > 2.0 * swath_m) {
+        std::snprintf(text, sizeof text,
+                      "no pair to match: the nearest lines run %.0f m apart, more than twice the %.0f m of seabed "
+                      "the sonar records per side: no seabed is seen from two lines (closer lines or a longer "
+                      "range would overlap)",
+                      s.nearest_other_line_m, swath_m);
+      } else {
+        std::snprintf(text, sizeof text,
+                      "no pair to match: no two subframes of different lines overlap within the canonical swath of "
+                      "%.0f m per side (the nearest lines run %.0f m apart); subframe_buffer.canonical."
+                      "swath_from_range: true widens it to the sonar's recorded range (or set bins_per_side x "
+                      "bin_size_m)",
+                      swath_m, s.nearest_other_line_m);
+      }
       findings.push_back(text);
     }
     return findings;
@@ -583,6 +600,7 @@ bool writeSummaryJson(const std::string& path, const OfflineRequest& request, co
   json.key("turn_pings").value(s.buffer.builder.turn_pings);
   json.key("short_tail_pings").value(s.buffer.builder.dropped_tail_pings);
   json.key("nearest_other_line_m").value(s.nearest_other_line_m, 6);
+  json.key("canonical_swath_m").value(s.canonical_swath_m, 6);
   json.endObject();
   json.key("pairs_rejected").beginObject();
   json.key("few_dense_matches").value(s.pairs_few_matches);
@@ -728,6 +746,7 @@ class Runner {
   void countStages() {
     summary_.buffer = buffer_.counters();
     summary_.bottom_track = buffer_.bottomTrackCounters();
+    summary_.canonical_swath_m = buffer_.geometry().bins_per_side * buffer_.geometry().bin_size_m;
     std::vector<int> lines;
     for (const auto& [line, centre] : centres_) {
       if (std::find(lines.begin(), lines.end(), line) == lines.end()) lines.push_back(line);

@@ -74,6 +74,7 @@ struct OfflineSummary {
   // Across-track distance of the nearest subframe of another line lying beside one (more across
   // than along); < 0: none beside another (one line, or lines following one another).
   double nearest_other_line_m = -1.0;
+  double canonical_swath_m = 0.0;       // ground range per side of the subframes (bins x bin size)
   uint64_t pairs_few_matches = 0;       // pairs rejected for too few dense matches
   uint64_t pairs_pose_rejected = 0;     // pairs whose relative pose failed
   std::string first_pair_rejection;
