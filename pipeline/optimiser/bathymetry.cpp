@@ -252,11 +252,14 @@ bool writeHeightmapFiles(const std::string& yaml_path, const HeightmapGrid& grid
   return writeHeightmapPng(prefix + ".png", grid, error);
 }
 
-bool writeSeabedPly(const std::string& path, const std::vector<SeabedPoint>& points, std::string& error) {
+bool writeSeabedPly(const std::string& path, const std::vector<SeabedPoint>& points, std::string& error,
+                    const std::optional<sss::core::MissionOrigin>& origin) {
   std::ofstream out(path, std::ios::binary);
   out << "ply\nformat binary_little_endian 1.0\n"
-      << "comment sss-slam quasi-dense bathymetry: x north, y east, z down (m, local NED of the mission origin)\n"
-      << "element vertex " << points.size() << "\n"
+      << "comment sss-slam quasi-dense bathymetry: x north, y east, z down (m, local NED of the mission origin)\n";
+  // The origin's line without its '#': PLY comments take one line of text.
+  if (origin) out << "comment" << sss::core::originCommentLine(*origin).substr(1) << "\n";
+  out << "element vertex " << points.size() << "\n"
       << "property double x\nproperty double y\nproperty double z\n"
       << "property float range_residual\nproperty float plane_residual\nend_header\n";
   for (const SeabedPoint& point : points) {

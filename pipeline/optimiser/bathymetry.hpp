@@ -80,6 +80,8 @@ bool writeHeightmapFiles(const std::string& yaml_path, const HeightmapGrid& grid
                          std::string& error, const std::optional<sss::core::MissionOrigin>& origin = std::nullopt);
 
 // Binary little-endian PLY: x = north, y = east, z = down (metres, local NED), plus the residuals.
-bool writeSeabedPly(const std::string& path, const std::vector<SeabedPoint>& points, std::string& error);
+// origin, when known, goes into a header comment ("comment origin_latitude_deg .. origin_longitude_deg ..").
+bool writeSeabedPly(const std::string& path, const std::vector<SeabedPoint>& points, std::string& error,
+                    const std::optional<sss::core::MissionOrigin>& origin = std::nullopt);
 
 }  // namespace sss::optimiser

@@ -102,7 +102,7 @@ bool writeProducts(OptimiserEngine& engine, const std::string& directory,
     return false;
   }
   const auto points = engine.seabedPoints(false);
-  bool ok = sss::optimiser::writeSeabedPly(directory + "/bathymetry.ply", points, error);
+  bool ok = sss::optimiser::writeSeabedPly(directory + "/bathymetry.ply", points, error, origin);
   if (ok && !points.empty()) {
     ok = sss::optimiser::writeHeightmapFiles(directory + "/heightmap.yaml",
                                              sss::optimiser::gridSeabedPoints(points, engine.options().bathymetry),

@@ -297,6 +297,8 @@ TEST_F(OfflineRunnerTest, OriginComesFromTheDataWhereverTheMissionIs) {
       ASSERT_TRUE(sss::eval::readHeightmap(r.out_dir + "/heightmap.yaml", heightmap, error)) << error;
       ASSERT_TRUE(heightmap.origin);
       EXPECT_DOUBLE_EQ(heightmap.origin->longitude_deg, s.origin->longitude_deg);
+      const std::string ply = readFile(r.out_dir + "/bathymetry.ply");
+      EXPECT_NE(ply.substr(0, ply.find("end_header")).find("comment origin_latitude_deg"), std::string::npos);
 
       // Against the truth in the simulator's frame: DR starts at the truth, and SLAM beats DR by
       // as much as at the default origin (measured there: DR 0.57 m, SLAM 0.30 m).

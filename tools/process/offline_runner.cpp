@@ -926,8 +926,8 @@ bool Runner::writeOutputs(std::string& error) {
   const std::vector<sss::optimiser::SeabedPoint> points = optimiser_.seabedPoints(false);
   const std::vector<sss::optimiser::SeabedPoint> points_dr = optimiser_.seabedPoints(true);
   summary_.seabed_points = points.size();
-  if (!sss::optimiser::writeSeabedPly(dir + "/bathymetry.ply", points, error)) return false;
-  if (!sss::optimiser::writeSeabedPly(dir + "/bathymetry_dr.ply", points_dr, error)) return false;
+  if (!sss::optimiser::writeSeabedPly(dir + "/bathymetry.ply", points, error, origin_)) return false;
+  if (!sss::optimiser::writeSeabedPly(dir + "/bathymetry_dr.ply", points_dr, error, origin_)) return false;
   if (!points.empty() &&
       !sss::optimiser::writeHeightmapFiles(dir + "/heightmap.yaml", sss::optimiser::gridSeabedPoints(points, bathymetry),
                                            "sss-process: seabed re-triangulated with the SLAM poses", error, origin_)) {
