@@ -33,6 +33,24 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// Both channels of a synthetic XTF ping: `samples` samples `spacing_m` apart (sample 0 at the
+// sonar), a dark water column down to the seabed at `altitude_m`, then seabed falling off as
+// 1/range, all with one-look (exponential) speckle.
+void addSeabedChannels(sss::xtf::XtfPingInput& ping, int samples, double spacing_m, double altitude_m,
+                       std::mt19937& random) {
+  std::exponential_distribution<double> speckle(1.0);
+  for (uint16_t channel = 0; channel < 2; ++channel) {
+    sss::xtf::XtfChannelData data;
+    data.channel_number = channel;
+    data.slant_range_m = static_cast<float>(samples * spacing_m);
+    for (int k = 0; k < samples; ++k) {
+      const double r = k * spacing_m;
+      data.samples.push_back(static_cast<float>((r < altitude_m ? 20.0 : 4000.0 * altitude_m / r) * speckle(random)));
+    }
+    ping.channels.push_back(std::move(data));
+  }
+}
+
 std::string readFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::ostringstream text;
@@ -402,7 +420,6 @@ TEST_F(OfflineRunnerTest, XtfInProjectedMetresWithoutAltitudeIsProcessedInItsGri
     sss::xtf::XtfWriter writer(path, options);
     ASSERT_TRUE(writer.isOpen());
     std::mt19937 random(3);
-    std::exponential_distribution<double> speckle(1.0);
     const double heading_rad = 30.0 * M_PI / 180.0, speed_m_s = 2.0, altitude_m = 15.0, spacing_m = 0.03;
     for (int i = 0; i < 600; ++i) {  // 150 s at 4 Hz: 300 m
       sss::xtf::XtfPingInput ping;
@@ -413,17 +430,7 @@ TEST_F(OfflineRunnerTest, XtfInProjectedMetresWithoutAltitudeIsProcessedInItsGri
       ping.sensor_y = 6580456.0 + speed_m_s * 0.25 * i * std::cos(heading_rad);  // northing
       ping.depth_m = 30.0f;
       ping.heading_deg = 30.0f;
-      for (uint16_t channel = 0; channel < 2; ++channel) {
-        sss::xtf::XtfChannelData data;
-        data.channel_number = channel;
-        data.slant_range_m = 75.0f;
-        for (int k = 0; k < 2500; ++k) {
-          const double r = k * spacing_m;
-          const double mean = r < altitude_m ? 20.0 : 4000.0 * altitude_m / r;
-          data.samples.push_back(static_cast<float>(mean * speckle(random)));
-        }
-        ping.channels.push_back(std::move(data));
-      }
+      addSeabedChannels(ping, 2500, spacing_m, altitude_m, random);
       ASSERT_TRUE(writer.write(ping));
       ASSERT_TRUE(writer.writeBytes(sss::xtf::encodeOtherPacket(3, 64)));  // an attitude packet
     }
@@ -502,7 +509,6 @@ TEST_F(OfflineRunnerTest, XtfNavigationPacketsOrShipCoordinatesPositionPingsWith
       sss::xtf::XtfWriter writer(path, options);
       ASSERT_TRUE(writer.isOpen());
       std::mt19937 random(5);
-      std::exponential_distribution<double> speckle(1.0);
       for (int i = 0; i < 600; ++i) {  // 150 s at 4 Hz
         const double t_s = 0.25 * i;
         const int64_t utime_us = 1780300800000000LL + i * 250000LL;
@@ -535,16 +541,7 @@ TEST_F(OfflineRunnerTest, XtfNavigationPacketsOrShipCoordinatesPositionPingsWith
         ping.depth_m = 30.0f;
         ping.altitude_m = 15.0f;
         ping.heading_deg = 100.0f;
-        for (uint16_t channel = 0; channel < 2; ++channel) {
-          sss::xtf::XtfChannelData data;
-          data.channel_number = channel;
-          data.slant_range_m = 75.0f;
-          for (int k = 0; k < 2500; ++k) {
-            const double r = k * 0.03;
-            data.samples.push_back(static_cast<float>((r < 15.0 ? 20.0 : 4000.0 * 15.0 / r) * speckle(random)));
-          }
-          ping.channels.push_back(std::move(data));
-        }
+        addSeabedChannels(ping, 2500, 0.03, 15.0, random);
         std::vector<uint8_t> packet = sss::xtf::encodeSonarPacket(options, ping);
         if (ship) {  // SensorY/X stay 0: the vessel's position only
           const auto geo = positionAt(t_s);
@@ -698,7 +695,6 @@ TEST_F(OfflineRunnerTest, TowedCurvedLineWithoutAltitudeOrDepthGivesSubframes) {
     sss::xtf::XtfWriter writer(path, options);
     ASSERT_TRUE(writer.isOpen());
     std::mt19937 random(12);
-    std::exponential_distribution<double> speckle(1.0);
     for (int i = 0; i < kPings; ++i) {
       const double s_m = length_m * i / (kPings - 1), angle = s_m / radius_m;  // heading from north, turning right
       const Eigen::Vector3d ned(radius_m * std::sin(angle), radius_m * (1.0 - std::cos(angle)), 0.0);
@@ -709,16 +705,7 @@ TEST_F(OfflineRunnerTest, TowedCurvedLineWithoutAltitudeOrDepthGivesSubframes) {
       ping.sensor_y = geo.latitude_deg;
       ping.sensor_x = geo.longitude_deg;
       ping.heading_deg = static_cast<float>(angle * 180.0 / M_PI);  // depth and altitude stay 0
-      for (uint16_t channel = 0; channel < 2; ++channel) {
-        sss::xtf::XtfChannelData data;
-        data.channel_number = channel;
-        data.slant_range_m = 50.0f;
-        for (int k = 0; k < 1600; ++k) {
-          const double r = k * 0.03125;
-          data.samples.push_back(static_cast<float>((r < 9.0 ? 20.0 : 4000.0 * 9.0 / r) * speckle(random)));
-        }
-        ping.channels.push_back(std::move(data));
-      }
+      addSeabedChannels(ping, 1600, 0.03125, 9.0, random);
       ASSERT_TRUE(writer.write(ping));
     }
   }
