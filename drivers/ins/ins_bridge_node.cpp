@@ -261,6 +261,10 @@ int main(int argc, char** argv) {
     health.setCounter("ins_epochs_out_of_order", static_cast<double>(bridge.epochsOutOfOrder()));
     health.setCounter("odometer_m", bridge.odometer().distance_travelled_m);
     health.setCounter("odometer_write_failures", static_cast<double>(odometer_write_failures));
+    if (bridge.origin()) {  // the mission frame, for the operator (NaN-free: only once it is known)
+      health.setCounter("origin_latitude_deg", bridge.origin()->latitude_deg);
+      health.setCounter("origin_longitude_deg", bridge.origin()->longitude_deg);
+    }
     loop.reportFaults("ins_input", bridge.takeNewFaultMessages());
   });
 

@@ -135,13 +135,20 @@ TEST(InsBridgeLink, WithoutConfiguredOriginTheFirstFixIsKeptAcrossARestart) {
   {
     std::ofstream config(config_path);
     config << "ins_bridge:\n  source: udp\n  bind_address: 127.0.0.1\n  udp_port: " << udp_port
-           << "\n  lcm_url: \"" << lcm_url << "\"\n  state_directory: " << dir << "\n  log_level: warn\n";
+           << "\n  lcm_url: \"" << lcm_url << "\"\n  state_directory: " << dir
+           << "\n  status_period_s: 0.1\n  log_level: warn\n";
   }
   sss::core::HealthMonitor health(sss::core::monotonicUtime());
   sss::transport::LcmBus bus(lcm_url, health);
   ASSERT_TRUE(bus.good());
   std::vector<sss_msgs::nav_t> navs;
   bus.subscribe<sss_msgs::nav_t>("SSS_NAV", [&](const sss_msgs::nav_t& nav) { navs.push_back(nav); });
+  double status_origin_latitude_deg = 0.0;
+  bus.subscribe<sss_msgs::status_t>("SSS_STATUS", [&](const sss_msgs::status_t& status) {
+    for (int i = 0; i < status.num_counters; ++i) {
+      if (status.counter_name[i] == "origin_latitude_deg") status_origin_latitude_deg = status.counter_value[i];
+    }
+  });
   const int socket_fd = ::socket(AF_INET, SOCK_DGRAM, 0);
   ASSERT_GE(socket_fd, 0);
   sockaddr_in to{};
@@ -161,8 +168,10 @@ TEST(InsBridgeLink, WithoutConfiguredOriginTheFirstFixIsKeptAcrossARestart) {
       ::sendto(socket_fd, burst.data(), burst.size(), 0, reinterpret_cast<const sockaddr*>(&to), sizeof to);
       bus.handleTimeout(10);
     }
-    const int64_t end = sss::core::monotonicUtime() + 500'000;
-    while (sss::core::monotonicUtime() < end && navs.size() < 20) bus.handleTimeout(20);
+    const int64_t end = sss::core::monotonicUtime() + 1'500'000;
+    while (sss::core::monotonicUtime() < end && (navs.size() < 20 || status_origin_latitude_deg == 0.0)) {
+      bus.handleTimeout(20);
+    }
     ::kill(bridge, SIGTERM);
     int status = 0;
     ::waitpid(bridge, &status, 0);
@@ -178,6 +187,7 @@ TEST(InsBridgeLink, WithoutConfiguredOriginTheFirstFixIsKeptAcrossARestart) {
   const auto saved = sss::core::readOriginState(dir + "/origin", error);
   ASSERT_TRUE(saved) << error;
   EXPECT_DOUBLE_EQ(saved->latitude_deg, navs.front().origin_latitude_deg);
+  EXPECT_DOUBLE_EQ(status_origin_latitude_deg, saved->latitude_deg) << "SSS_STATUS names the origin";
 
   run(50);  // restarted 5 s later, 10 m further east
   ASSERT_GE(navs.size(), 18u);
