@@ -1,10 +1,13 @@
 // GGA parsing, see nmea_gga.hpp.
 #include "drivers/ins/nmea_gga.hpp"
 
+#include "drivers/ins/ixblue_nmea.hpp"
+
 #include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <string_view>
 #include <vector>
 
 namespace sss::ins {
@@ -36,28 +39,21 @@ bool parseAngle(const std::string& text, const std::string& hemisphere, int degr
 }  // namespace
 
 std::optional<GgaFix> parseGga(const std::string& sentence) {
-  std::string body = sentence;
-  while (!body.empty() && (body.back() == '\r' || body.back() == '\n')) body.pop_back();
-  if (!body.empty() && body[0] == '$') body.erase(0, 1);
+  std::string_view body = sentence;
+  while (!body.empty() && (body.back() == '\r' || body.back() == '\n')) body.remove_suffix(1);
+  if (!body.empty() && body.front() == '$') body.remove_prefix(1);
   const size_t star = body.find('*');
-  if (star != std::string::npos) {
-    unsigned checksum = 0;
-    for (size_t i = 0; i < star; ++i) checksum ^= static_cast<unsigned char>(body[i]);
+  if (star != std::string_view::npos) {
     char expected[3];
-    std::snprintf(expected, sizeof expected, "%02X", checksum);
-    const std::string given = body.substr(star + 1);
+    std::snprintf(expected, sizeof expected, "%02X", nmeaChecksum(body.substr(0, star)));
+    const std::string_view given = body.substr(star + 1);
     if (given.size() != 2 || std::toupper(given[0]) != expected[0] || std::toupper(given[1]) != expected[1]) {
       return std::nullopt;
     }
-    body.resize(star);
+    body = body.substr(0, star);
   }
-  std::vector<std::string> fields;
-  for (size_t start = 0;;) {
-    const size_t comma = body.find(',', start);
-    fields.push_back(body.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
+  const std::vector<std::string_view> view = splitFields(body);
+  const std::vector<std::string> fields(view.begin(), view.end());
   if (fields.size() < 10 || fields[0].size() != 5 || fields[0].compare(2, 3, "GGA") != 0) return std::nullopt;
   GgaFix fix;
   double time = 0.0, quality = 0.0;

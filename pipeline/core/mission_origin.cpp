@@ -51,6 +51,13 @@ std::string originCommentLine(const MissionOrigin& origin) {
   return line;
 }
 
+std::string originYamlKeys(const MissionOrigin& origin) {
+  char keys[128];
+  std::snprintf(keys, sizeof keys, "origin_latitude_deg: %.15g\norigin_longitude_deg: %.15g\n", origin.latitude_deg,
+                origin.longitude_deg);
+  return keys;
+}
+
 std::optional<MissionOrigin> parseOriginCommentLine(const std::string& line) {
   std::istringstream in(line);
   std::string word;

@@ -43,6 +43,9 @@ std::optional<MissionOrigin> readMissionOrigin(ConfigSection& mission);
 // The comment line that records an origin in text products (TUM files, YAML headers):
 // "# origin_latitude_deg 59.350000000 origin_longitude_deg 18.070000000" (9 decimals: < 0.1 mm).
 std::string originCommentLine(const MissionOrigin& origin);
+// The same as YAML keys, for the geo-references beside rasters (heightmaps, mosaics):
+// "origin_latitude_deg: 59.35\norigin_longitude_deg: 18.07\n" (15 significant digits).
+std::string originYamlKeys(const MissionOrigin& origin);
 // The origin in such a line (with or without the leading '#'); nullopt when the line holds none.
 std::optional<MissionOrigin> parseOriginCommentLine(const std::string& line);
 

@@ -239,10 +239,7 @@ bool writeHeightmapFiles(const std::string& yaml_path, const HeightmapGrid& grid
        << "\nnorth_min_m: " << grid.north_min_m << "\neast_min_m: " << grid.east_min_m
        << "\ndepth_file: " << std::filesystem::path(depth_path).filename().string()
        << "\ndepth_units: \"metres below the origin (NED z, positive down)\"\n";
-  if (origin) {
-    yaml.precision(15);
-    yaml << "origin_latitude_deg: " << origin->latitude_deg << "\norigin_longitude_deg: " << origin->longitude_deg << "\n";
-  }
+  if (origin) yaml << sss::core::originYamlKeys(*origin);
   std::ofstream out(prefix + ".yaml");
   out << yaml.str();
   if (!out) {

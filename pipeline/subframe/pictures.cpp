@@ -138,10 +138,7 @@ bool writeMosaic(const std::vector<Subframe>& subframes,
           "resolution_m.\n"
        << "resolution_m: " << res << "\nnorth_max_m: " << n_min + rows * res << "\neast_min_m: " << e_min
        << "\nrows: " << rows << "\ncols: " << cols << "\n";
-  if (origin) {
-    yaml.precision(15);
-    yaml << "origin_latitude_deg: " << origin->latitude_deg << "\norigin_longitude_deg: " << origin->longitude_deg << "\n";
-  }
+  if (origin) yaml << sss::core::originYamlKeys(*origin);
   if (!yaml) {
     error = "cannot write " + yaml_path;
     return false;

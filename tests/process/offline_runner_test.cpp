@@ -28,6 +28,7 @@
 #include "pipeline/core/geodesy.hpp"
 #include "drivers/xtf/xtf_writer.hpp"
 #include "drivers/edgetech/jsf_format.hpp"
+#include "drivers/ins/ixblue_nmea.hpp"
 
 namespace fs = std::filesystem;
 
@@ -617,14 +618,11 @@ TEST_F(OfflineRunnerTest, JsfSituationOrNmeaMessagesPositionPingsWithoutPosition
         std::snprintf(sentence, sizeof sentence, "GPGGA,080000.00,%02d%09.6f,S,%03d%09.6f,E,1,10,0.8,0.0,M,,M,,",
                       static_cast<int>(lat), (lat - static_cast<int>(lat)) * 60.0, static_cast<int>(lon),
                       (lon - static_cast<int>(lon)) * 60.0);
-        unsigned checksum = 0;
-        for (const char* c = sentence; *c; ++c) checksum ^= static_cast<unsigned char>(*c);
-        char text[160];
-        std::snprintf(text, sizeof text, "$%s*%02X\r\n", sentence, checksum);
+        const std::string text = sss::ins::frameSentence(sentence);
         body.assign(12, 0);
         std::memcpy(body.data() + 0, &seconds, 4);
         std::memcpy(body.data() + 4, &milliseconds, 4);
-        body.insert(body.end(), text, text + std::strlen(text));
+        body.insert(body.end(), text.begin(), text.end());
         header.message_type = sss::edgetech::kJsfNmea;
       }
       header.byte_count = static_cast<int32_t>(body.size());

@@ -205,11 +205,7 @@ bool writeHeightmap(const std::string& path, const HeightmapRaster& raster, std:
        << "rows: " << raster.rows << "\ncols: " << raster.cols << "\nresolution_m: " << raster.resolution_m
        << "\nnorth_min_m: " << raster.north_min_m << "\neast_min_m: " << raster.east_min_m
        << "\ndepth_file: " << fs::path(depth_path).filename().string() << "\ndepth_units: \"" << raster.units << "\"\n";
-  if (raster.origin) {
-    yaml.precision(15);
-    yaml << "origin_latitude_deg: " << raster.origin->latitude_deg << "\norigin_longitude_deg: "
-         << raster.origin->longitude_deg << "\n";
-  }
+  if (raster.origin) yaml << sss::core::originYamlKeys(*raster.origin);
   std::ofstream out(yaml_path, std::ios::binary);
   out << yaml.str();
   out.close();

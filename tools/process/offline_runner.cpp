@@ -273,8 +273,13 @@ class EmbeddedNavigation {
   const std::optional<Eigen::Vector2d>& projectedOrigin() const { return projected_origin_; }
   std::optional<NavInput> fromPing(const sss::edgetech::DriverPing& driver_ping) {
     const auto& side = driver_ping.ping.port ? *driver_ping.ping.port : *driver_ping.ping.starboard;
-    last_side_ = side;
-    last_side_.samples.clear();
+    // The header fields a navigation packet borrows (not the samples: this runs for every ping).
+    last_side_.validity = side.validity;
+    last_side_.depth_m = side.depth_m;
+    last_side_.altitude_m = side.altitude_m;
+    last_side_.heading_rad = side.heading_rad;
+    last_side_.pitch_rad = side.pitch_rad;
+    last_side_.roll_rad = side.roll_rad;
     return fromSide(driver_ping.utime_us, side);
   }
   // A navigation packet of an XTF whose pings carry no position (types 42 and 107 give one, 3
