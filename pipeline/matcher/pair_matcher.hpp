@@ -81,7 +81,9 @@ struct PairMatcherOptions {
   // published covariance is scaled by this factor and floored, calibrated on those surveys
   // (matcher_engine_test prints the batch NEES).
   // 30 with the robust refinement: mean horizontal NEES 1.4 (default mission), 2.4 (cross-line
-  // survey) by sss-eval --closures; 0.5 on the flat 3-line survey of matcher_engine_test.
+  // survey) by sss-eval --closures; 0.5 on the flat 3-line survey of matcher_engine_test; 1.5-7.6
+  // on randomised missions. With RelativePoseOptions::covariance_cluster_m > 0 the covariance comes
+  // from the residuals instead: set this to 1 then.
   double covariance_scale = 30.0;
   double min_translation_sigma_m = 0.05;
   double min_rotation_sigma_rad = 0.001;

@@ -8,6 +8,7 @@
 #include <ceres/rotation.h>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -159,8 +160,147 @@ struct Solved {
   double range_cost = 0.0;  // mean squared whitened residual over A and B bins
   double plane_cost = 0.0;
   bool usable = false;
-  std::optional<sss::core::Matrix6d> covariance;
+  std::optional<sss::core::Matrix6d> covariance;        // model-based: Ceres, the assumed sigmas
+  std::optional<sss::core::Matrix6d> robust_covariance; // cluster-robust sandwich (from residuals)
+  sss::core::Vector6d per_seabed_offset = sss::core::Vector6d::Zero();
+  int clusters = 0;
 };
+
+// Cluster-robust ("sandwich") covariance of the pose at the solution (anchor = solution, delta 0).
+// Ceres' covariance, H^-1, assumes every match independent with the sigmas of the options. Dense
+// matches are neither: neighbours share texture pixels and, above all, the same seabed-model error
+// (relief the plane does not hold, a shadow seen from the other side), so their errors move
+// together. The sandwich H^-1 M H^-1 takes the spread from the residuals themselves: M sums, per
+// cluster of matches on the same patch of seabed, the outer product of the cluster's total
+// gradient (landmarks eliminated). A cluster that pulls the pose one way and another that pulls
+// it the other way (near range against far range over relief) make the direction they disagree
+// in weak; matches that agree better than the sigmas assumed make it tighter. The DR prior is one
+// more cluster with its model information. G / (G - 1): the small-sample correction (CR1).
+struct ClusterRobust {
+  sss::core::Matrix6d covariance = sss::core::Matrix6d::Zero();
+  // How far the pose moves per metre the seabed under the matches is higher than the seabed prior
+  // says, all landmarks alike (d pose / d depth offset, tangent [dt, dr]). Relief between two lines
+  // moves every match the same way, so no spread between clusters shows it; see seabedReliefSigma.
+  sss::core::Vector6d per_seabed_offset = sss::core::Vector6d::Zero();
+  int clusters = 0;
+  bool ok = false;
+};
+
+ClusterRobust clusterRobustCovariance(const std::vector<Measurement>& measurements, const std::vector<int>& subset,
+                                      const std::vector<Eigen::Vector3d>& landmarks, const Pose* anchor,
+                                      const Pose& dr, const Eigen::Matrix<double, 6, 6>& sqrt_information,
+                                      const RelativePoseOptions& options, bool robust) {
+  using Matrix6d = sss::core::Matrix6d;
+  using Vector6d = sss::core::Vector6d;
+  ClusterRobust out;
+  const double zero_delta[6] = {0, 0, 0, 0, 0, 0};
+  const double cluster_m = options.covariance_cluster_m;
+  std::map<std::pair<long, long>, Vector6d> gradient_by_cluster;
+  Matrix6d information = Matrix6d::Zero();
+  Vector6d seabed_offset_gradient = Vector6d::Zero();  // d (reduced gradient) / d (prior depth offset)
+  std::unique_ptr<ceres::LossFunction> loss;
+  if (robust && options.robust_loss_scale > 0.0) loss = std::make_unique<ceres::CauchyLoss>(options.robust_loss_scale);
+  // sqrt(rho'(|r|^2)): the iteratively reweighted least-squares weight of a robustified block.
+  auto weight = [&](const double* r, int size) {
+    if (!loss) return 1.0;
+    double s = 0.0;
+    for (int k = 0; k < size; ++k) s += r[k] * r[k];
+    double rho[3];
+    loss->Evaluate(s, rho);
+    return std::sqrt(std::max(rho[1], 0.0));
+  };
+  for (size_t i = 0; i < subset.size(); ++i) {
+    const Measurement& m = measurements[subset[i]];
+    // Rows: A's range and plane, B's range and plane, the seabed prior.
+    Eigen::Matrix<double, 5, 1> r = Eigen::Matrix<double, 5, 1>::Zero();
+    Eigen::Matrix<double, 5, 6> J_pose = Eigen::Matrix<double, 5, 6>::Zero();
+    Eigen::Matrix<double, 5, 3> J_landmark = Eigen::Matrix<double, 5, 3>::Zero();
+    const double* x = landmarks[i].data();
+    {
+      ceres::AutoDiffCostFunction<BinResidualA, 2, 3> cost(
+          new BinResidualA{m.a, options.range_sigma_m, m.a.slant_range_m * options.beam_width_rad});
+      Eigen::Matrix<double, 2, 3, Eigen::RowMajor> J_l;
+      double* jacobians[1] = {J_l.data()};
+      const double* parameters[1] = {x};
+      if (!cost.Evaluate(parameters, r.data(), jacobians)) return out;
+      const double w = weight(r.data(), 2);
+      r.segment<2>(0) *= w;
+      J_landmark.block<2, 3>(0, 0) = w * J_l;
+    }
+    {
+      ceres::AutoDiffCostFunction<BinResidualB, 2, 6, 3> cost(
+          new BinResidualB{m.b, anchor, options.range_sigma_m, m.b.slant_range_m * options.beam_width_rad});
+      Eigen::Matrix<double, 2, 6, Eigen::RowMajor> J_p;
+      Eigen::Matrix<double, 2, 3, Eigen::RowMajor> J_l;
+      double* jacobians[2] = {J_p.data(), J_l.data()};
+      const double* parameters[2] = {zero_delta, x};
+      if (!cost.Evaluate(parameters, r.data() + 2, jacobians)) return out;
+      const double w = weight(r.data() + 2, 2);
+      r.segment<2>(2) *= w;
+      J_pose.block<2, 6>(2, 0) = w * J_p;
+      J_landmark.block<2, 3>(2, 0) = w * J_l;
+    }
+    if (options.use_seabed_prior) {
+      const SeabedResidual seabed{m.down_a, m.seabed_depth_a_m, options.seabed_sigma_m};
+      seabed(x, r.data() + 4);
+      J_landmark.row(4) = m.down_a.transpose() / options.seabed_sigma_m;
+    }
+    // Eliminate the landmark (its own Schur complement): the pose information and gradient this
+    // match carries once its landmark is free to move.
+    const Eigen::Matrix3d A_ll = J_landmark.transpose() * J_landmark;
+    const Eigen::LDLT<Eigen::Matrix3d> ldlt(A_ll);
+    if (ldlt.info() != Eigen::Success || !(A_ll.determinant() > 0.0)) return out;
+    const Eigen::Matrix<double, 6, 3> A_pl = J_pose.transpose() * J_landmark;
+    information += J_pose.transpose() * J_pose - A_pl * ldlt.solve(A_pl.transpose());
+    const Vector6d gradient = J_pose.transpose() * r - A_pl * ldlt.solve(J_landmark.transpose() * r);
+    // The seabed row is (down . x - depth - offset) / sigma and does not involve the pose.
+    if (options.use_seabed_prior)
+      seabed_offset_gradient += A_pl * ldlt.solve(m.down_a) / (options.seabed_sigma_m * options.seabed_sigma_m);
+    const std::pair<long, long> cell =
+        cluster_m > 0.0 ? std::make_pair(static_cast<long>(std::floor(landmarks[i].x() / cluster_m)),
+                                         static_cast<long>(std::floor(landmarks[i].y() / cluster_m)))
+                        : std::make_pair(static_cast<long>(i), 0L);
+    auto [it, inserted] = gradient_by_cluster.try_emplace(cell, Vector6d::Zero());
+    it->second += gradient;
+  }
+  // The DR prior: its information, as a cluster of its own whose covariance is known.
+  {
+    ceres::AutoDiffCostFunction<OdometryResidual, 6, 6> cost(new OdometryResidual{anchor, dr, sqrt_information});
+    Eigen::Matrix<double, 6, 1> r;
+    Eigen::Matrix<double, 6, 6, Eigen::RowMajor> J;
+    double* jacobians[1] = {J.data()};
+    const double* parameters[1] = {zero_delta};
+    if (!cost.Evaluate(parameters, r.data(), jacobians)) return out;
+    information += J.transpose() * J;
+    out.covariance = J.transpose() * J;  // the meat starts with it
+  }
+  out.clusters = static_cast<int>(gradient_by_cluster.size());
+  if (out.clusters < 2) return out;
+  Matrix6d meat = Matrix6d::Zero();
+  for (const auto& entry : gradient_by_cluster) meat += entry.second * entry.second.transpose();
+  meat *= static_cast<double>(out.clusters) / (out.clusters - 1);
+  meat += out.covariance;
+  // In the coordinates where the model covariance H^-1 is the identity, the sandwich is the meat
+  // itself: its eigenvalues are how much wider (or narrower) than the model each direction is.
+  // A few clusters estimate the mean inflation well but not every direction: G cluster gradients
+  // span at most G - 1 directions, so some come out far too small (a known small-sample bias of
+  // the sandwich). No direction is taken narrower than the mean inflation.
+  const Eigen::LLT<Matrix6d> bread(information);
+  if (bread.info() != Eigen::Success) return out;
+  out.per_seabed_offset = -bread.solve(seabed_offset_gradient);
+  const Matrix6d L_inverse = bread.matrixL().solve(Matrix6d::Identity());
+  Matrix6d meat_whitened = L_inverse * meat * L_inverse.transpose();
+  meat_whitened = 0.5 * (meat_whitened + meat_whitened.transpose());
+  const Eigen::SelfAdjointEigenSolver<Matrix6d> eigen(meat_whitened);
+  if (eigen.info() != Eigen::Success) return out;
+  const double mean_inflation = eigen.eigenvalues().mean();
+  const Vector6d inflation = eigen.eigenvalues().cwiseMax(mean_inflation);
+  const Matrix6d whitened_covariance = eigen.eigenvectors() * inflation.asDiagonal() * eigen.eigenvectors().transpose();
+  out.covariance = L_inverse.transpose() * whitened_covariance * L_inverse;
+  out.covariance = 0.5 * (out.covariance + out.covariance.transpose());
+  out.ok = out.covariance.allFinite();
+  return out;
+}
 
 // Builds and solves eq. (3) over the given measurements; optionally the pose covariance, taken
 // after re-anchoring at the solution so that delta = 0 is exactly our [dt, dr] tangent there.
@@ -248,6 +388,11 @@ Solved solve(const std::vector<Measurement>& measurements, const std::vector<int
       covariance.GetCovarianceBlock(delta, delta, c.data());  // row-major; symmetric anyway
       out.covariance = 0.5 * (c + c.transpose());
     }
+    const ClusterRobust cluster_robust =
+        clusterRobustCovariance(measurements, subset, landmarks, &anchor, dr, sqrt_information, options, robust);
+    out.clusters = cluster_robust.clusters;
+    out.per_seabed_offset = cluster_robust.per_seabed_offset;
+    if (cluster_robust.ok) out.robust_covariance = cluster_robust.covariance;
   }
   return out;
 }
@@ -315,6 +460,37 @@ Score scoreHypothesis(const std::vector<Measurement>& measurements, const std::v
     score.plane_cost += same_side ? std::min(r(1) * r(1) + r(3) * r(3), threshold2) : threshold2;
   }
   return score;
+}
+
+}  // namespace
+
+namespace {
+
+// Relief of the seabed at the scale of a subframe, from the altimetry both lines recorded: the
+// seabed under each ping (sonar depth + altitude) about a straight line fitted along the
+// subframe, RMS over both. The seabed prior is a plane between the two lines' nadirs; relief of
+// this size between them shifts all landmarks alike and, through the ranges, the lateral offset.
+double seabedReliefSigma(const RelativePoseInput& input) {
+  double sum_squares = 0.0;
+  int count = 0;
+  auto addLine = [&](const std::vector<Pose>& poses, const std::vector<double>& altitude_m) {
+    const int n = static_cast<int>(poses.size());
+    if (n < 3) return;
+    Eigen::MatrixXd design(n, 2);
+    Eigen::VectorXd depth(n);
+    for (int i = 0; i < n; ++i) {
+      design(i, 0) = 1.0;
+      design(i, 1) = i;
+      depth(i) = poses[i].translation.z() + altitude_m[i];
+    }
+    const Eigen::VectorXd residual = depth - design * design.colPivHouseholderQr().solve(depth);
+    if (!residual.allFinite()) return;
+    sum_squares += residual.squaredNorm();
+    count += n - 2;
+  };
+  addLine(input.dr_poses_a, input.altitude_a_m);
+  addLine(input.dr_poses_b, input.altitude_b_m);
+  return count > 0 ? std::sqrt(sum_squares / count) : 0.0;
 }
 
 }  // namespace
@@ -507,11 +683,28 @@ RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const Re
   result.range_cost = refined.range_cost;
   result.plane_cost = refined.plane_cost;
   result.total_cost = refined.final_cost;
-  if (refined.covariance) result.covariance = *refined.covariance;
+  if (refined.covariance) result.model_covariance = *refined.covariance;
+  result.covariance_clusters = refined.clusters;
+  const bool cluster_robust = options.covariance_cluster_m > 0.0;
+  if (cluster_robust && refined.robust_covariance) {
+    result.covariance = *refined.robust_covariance;
+    if (options.seabed_relief_covariance && options.use_seabed_prior) {
+      result.seabed_relief_sigma_m = seabedReliefSigma(input);
+      const double sigma = result.seabed_relief_sigma_m;
+      result.covariance += sigma * sigma * refined.per_seabed_offset * refined.per_seabed_offset.transpose();
+    }
+  }
+  if (!cluster_robust && refined.covariance) result.covariance = *refined.covariance;
 
   std::ostringstream text;
   if (!refined.usable || !refined.covariance) {
     text << "final refinement failed (" << inliers.size() << " inliers): no usable solution or covariance";
+  } else if (cluster_robust && refined.clusters < options.min_covariance_clusters) {
+    text << "inliers on only " << refined.clusters << " seabed patches of " << options.covariance_cluster_m
+         << " m (min_covariance_clusters " << options.min_covariance_clusters
+         << "): too few independent looks to estimate the closure's uncertainty";
+  } else if (cluster_robust && !refined.robust_covariance) {
+    text << "cluster-robust covariance failed (singular information): the matches do not constrain the pose";
   } else if (result.num_inliers < options.min_inliers) {
     text << result.num_inliers << " inliers, below min_inliers " << options.min_inliers;
   } else if (result.num_inliers < options.min_inlier_fraction * n) {
@@ -543,6 +736,9 @@ std::vector<std::string> validateRelativePoseOptions(const RelativePoseOptions& 
   if (!(o.max_mean_cost > 0.0)) problems.push_back("max_mean_cost must be > 0");
   if (o.max_solver_iterations < 1) problems.push_back("max_solver_iterations must be >= 1");
   if (!(o.time_limit_s >= 0.0)) problems.push_back("time_limit_s must be >= 0 (0: no wall-clock cap)");
+  if (!(o.covariance_cluster_m >= 0.0))
+    problems.push_back("covariance_cluster_m must be >= 0 (0: Ceres' covariance with the assumed sigmas)");
+  if (o.min_covariance_clusters < 2) problems.push_back("min_covariance_clusters must be >= 2");
   return problems;
 }
 
@@ -569,6 +765,9 @@ void readRelativePoseOptions(sss::core::ConfigSection& section, RelativePoseOpti
   section.optional("seabed_between_lines", options.seabed_between_lines);
   options.seed = static_cast<std::uint64_t>(seed);
   section.optional("time_limit_s", options.time_limit_s, {sss::core::atLeast(0.0)});
+  section.optional("covariance_cluster_m", options.covariance_cluster_m, {sss::core::atLeast(0.0)});
+  section.optional("min_covariance_clusters", options.min_covariance_clusters, {inRange(2, 100000)});
+  section.optional("seabed_relief_covariance", options.seabed_relief_covariance);
   if (options.max_correspondences < options.ransac_subset)
     section.addProblem("max_correspondences", std::to_string(options.max_correspondences),
                        "must be >= ransac_subset (" + std::to_string(options.ransac_subset) + ")");

@@ -48,6 +48,22 @@ struct RelativePoseOptions {
   // a cap makes the result depend on machine load, so offline runs and tests leave it at 0.
   // When set, RANSAC stops at 60 % of it and the refinement uses the rest.
   double time_limit_s = 0.0;
+  // Closure covariance from the residuals (cluster-robust sandwich, see relative_pose.cpp): the
+  // matches are grouped into square patches of seabed of this side (in A's centre frame), whose
+  // errors are taken as independent of one another's; inside a patch they may all move together.
+  // 20 m is twice the 10 m matching patch, so that matches of two clusters share no texture pixel.
+  // 0 (default): Ceres' covariance, which takes every match as independent with the sigmas above
+  // (PairMatcherOptions::covariance_scale then inflates it). Not the default yet: on randomised
+  // missions the error common to a whole pair, which no spread inside the pair shows, is 3-8x the
+  // cluster-robust sigma (README, "Closure covariance from the residuals").
+  double covariance_cluster_m = 0.0;
+  // Fewer patches than this: the spread between them says too little to be trusted (rejected).
+  int min_covariance_clusters = 4;
+  // Relief between the lines moves every landmark alike, which no spread between clusters shows:
+  // the covariance also gets the pose's sensitivity to a common offset of the seabed under the
+  // matches, times the seabed relief both lines' altimetry measured along their subframes (so a
+  // closure over rough ground says its lateral direction is weak; a flat seabed costs nothing).
+  bool seabed_relief_covariance = true;
 };
 
 // Everything the estimator needs from the two subframes, in each subframe's own DR frame.
@@ -70,7 +86,11 @@ struct RelativePoseResult {
   bool accepted = false;
   std::string reason;                       // why rejected (empty when accepted)
   sss::core::Pose T_a_b;                    // B's centre body frame in A's centre body frame
-  sss::core::Matrix6d covariance = sss::core::Matrix6d::Zero();  // [dt, dr] at T_a_b (boxPlus)
+  // [dt, dr] at T_a_b (boxPlus): cluster-robust (from the residuals) unless covariance_cluster_m is 0
+  sss::core::Matrix6d covariance = sss::core::Matrix6d::Zero();
+  sss::core::Matrix6d model_covariance = sss::core::Matrix6d::Zero();  // Ceres, the assumed sigmas
+  int covariance_clusters = 0;              // seabed patches the inliers of the refinement fall in
+  double seabed_relief_sigma_m = 0.0;       // from both lines' altimetry (seabed_relief_covariance)
   int num_inliers = 0;                      // among all matches, scored with the final pose
   double range_cost = 0.0;                  // mean squared whitened range residual (refinement)
   double plane_cost = 0.0;                  // mean squared whitened plane residual (refinement)
