@@ -256,6 +256,22 @@ TEST(RelativePose, CovarianceIsConsistentOverSeeds) {
   EXPECT_LT(nees_full, 3.0 * 6);
 }
 
+// Cluster-robust estimates over a run of seeds (parallel and anti-parallel alternately): every
+// pair must be accepted; `visit` sees each pair with its result.
+template <typename Visit>
+int forEachClusterRobustPair(std::uint64_t first_seed, int count, const PatchErrors& errors, Visit visit) {
+  for (std::uint64_t seed = first_seed; seed < first_seed + count; ++seed) {
+    const SyntheticPair pair = makePair(seed % 2 == 1, seed, 1000, 0.2, false, errors);
+    RelativePoseOptions options = clusterRobustOptions();
+    options.seed = seed;
+    const RelativePoseResult result = estimateRelativePose(pair.input, options);
+    EXPECT_TRUE(result.accepted) << "seed " << seed << ": " << result.reason;
+    if (!result.accepted) return 0;
+    visit(pair, result);
+  }
+  return count;
+}
+
 // Errors shared by the matches of one patch of seabed: Ceres' covariance, which counts every
 // match as an independent look, is far too small; the cluster-robust covariance takes the spread
 // between patches from the residuals and stays consistent. 20 seeds, a 40 m wide overlap strip
@@ -269,13 +285,7 @@ TEST(RelativePose, ClusterRobustCovarianceHoldsWhenNeighbouringMatchesShareTheir
   shared.east_max_m = 50.0;
   double nees_robust = 0.0, nees_model = 0.0, seconds = 0.0;
   double sigma_ratio = 0.0;
-  int runs = 0;
-  for (std::uint64_t seed = 200; seed < 220; ++seed) {
-    const SyntheticPair pair = makePair(seed % 2 == 1, seed, 1000, 0.2, false, shared);
-    RelativePoseOptions options = clusterRobustOptions();
-    options.seed = seed;
-    const RelativePoseResult result = estimateRelativePose(pair.input, options);
-    ASSERT_TRUE(result.accepted) << "seed " << seed << ": " << result.reason;
+  auto accumulate = [&](const SyntheticPair& pair, const RelativePoseResult& result) {
     EXPECT_GE(result.covariance_clusters, 8);
     const sss::core::Vector6d delta = sss::core::boxMinus(pair.T_a_b_true, result.T_a_b);
     const Eigen::Vector2d horizontal = delta.head<2>();
@@ -283,8 +293,9 @@ TEST(RelativePose, ClusterRobustCovarianceHoldsWhenNeighbouringMatchesShareTheir
     nees_model += horizontal.dot(result.model_covariance.topLeftCorner<2, 2>().ldlt().solve(horizontal));
     sigma_ratio += std::sqrt(result.covariance(1, 1) / result.model_covariance(1, 1));
     seconds += result.seconds;
-    ++runs;
-  }
+  };
+  const int runs = forEachClusterRobustPair(200, 20, shared, accumulate);
+  ASSERT_EQ(runs, 20);
   nees_robust /= runs;
   nees_model /= runs;
   sigma_ratio /= runs;
@@ -304,16 +315,11 @@ TEST(RelativePose, ClusterRobustCovarianceAgreesWithCeresForIndependentMatches) 
   wide.east_min_m = 10.0;
   wide.east_max_m = 50.0;
   double log_ratio = 0.0;
-  int runs = 0;
-  for (std::uint64_t seed = 300; seed < 310; ++seed) {
-    const SyntheticPair pair = makePair(seed % 2 == 1, seed, 1000, 0.2, false, wide);
-    RelativePoseOptions options = clusterRobustOptions();
-    options.seed = seed;
-    const RelativePoseResult result = estimateRelativePose(pair.input, options);
-    ASSERT_TRUE(result.accepted) << "seed " << seed << ": " << result.reason;
+  auto accumulate = [&](const SyntheticPair&, const RelativePoseResult& result) {
     log_ratio += 0.5 * std::log(result.covariance(1, 1) / result.model_covariance(1, 1));
-    ++runs;
-  }
+  };
+  const int runs = forEachClusterRobustPair(300, 10, wide, accumulate);
+  ASSERT_EQ(runs, 10);
   const double ratio = std::exp(log_ratio / runs);
   std::printf("independent matches: lateral sigma cluster-robust / Ceres, geometric mean %.2f\n", ratio);
   EXPECT_GT(ratio, 0.5);
