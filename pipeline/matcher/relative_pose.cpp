@@ -256,14 +256,13 @@ ClusterRobust clusterRobustCovariance(const std::vector<Measurement>& measuremen
     // The seabed row is (down . x - depth - offset) / sigma and does not involve the pose.
     if (options.use_seabed_prior)
       seabed_offset_gradient += A_pl * ldlt.solve(m.down_a) / (options.seabed_sigma_m * options.seabed_sigma_m);
-    const std::pair<long, long> cell =
-        cluster_m > 0.0 ? std::make_pair(static_cast<long>(std::floor(landmarks[i].x() / cluster_m)),
-                                         static_cast<long>(std::floor(landmarks[i].y() / cluster_m)))
-                        : std::make_pair(static_cast<long>(i), 0L);
+    const std::pair<long, long> cell{static_cast<long>(std::floor(landmarks[i].x() / cluster_m)),
+                                     static_cast<long>(std::floor(landmarks[i].y() / cluster_m))};
     auto [it, inserted] = gradient_by_cluster.try_emplace(cell, Vector6d::Zero());
     it->second += gradient;
   }
   // The DR prior: its information, as a cluster of its own whose covariance is known.
+  Matrix6d prior_information;
   {
     ceres::AutoDiffCostFunction<OdometryResidual, 6, 6> cost(new OdometryResidual{anchor, dr, sqrt_information});
     Eigen::Matrix<double, 6, 1> r;
@@ -271,15 +270,15 @@ ClusterRobust clusterRobustCovariance(const std::vector<Measurement>& measuremen
     double* jacobians[1] = {J.data()};
     const double* parameters[1] = {zero_delta};
     if (!cost.Evaluate(parameters, r.data(), jacobians)) return out;
-    information += J.transpose() * J;
-    out.covariance = J.transpose() * J;  // the meat starts with it
+    prior_information = J.transpose() * J;
   }
+  information += prior_information;
   out.clusters = static_cast<int>(gradient_by_cluster.size());
   if (out.clusters < 2) return out;
   Matrix6d meat = Matrix6d::Zero();
   for (const auto& entry : gradient_by_cluster) meat += entry.second * entry.second.transpose();
   meat *= static_cast<double>(out.clusters) / (out.clusters - 1);
-  meat += out.covariance;
+  meat += prior_information;
   // In the coordinates where the model covariance H^-1 is the identity, the sandwich is the meat
   // itself: its eigenvalues are how much wider (or narrower) than the model each direction is.
   // A few clusters estimate the mean inflation well but not every direction: G cluster gradients
@@ -388,11 +387,13 @@ Solved solve(const std::vector<Measurement>& measurements, const std::vector<int
       covariance.GetCovarianceBlock(delta, delta, c.data());  // row-major; symmetric anyway
       out.covariance = 0.5 * (c + c.transpose());
     }
-    const ClusterRobust cluster_robust =
-        clusterRobustCovariance(measurements, subset, landmarks, &anchor, dr, sqrt_information, options, robust);
-    out.clusters = cluster_robust.clusters;
-    out.per_seabed_offset = cluster_robust.per_seabed_offset;
-    if (cluster_robust.ok) out.robust_covariance = cluster_robust.covariance;
+    if (options.covariance_cluster_m > 0.0) {
+      const ClusterRobust cluster_robust =
+          clusterRobustCovariance(measurements, subset, landmarks, &anchor, dr, sqrt_information, options, robust);
+      out.clusters = cluster_robust.clusters;
+      out.per_seabed_offset = cluster_robust.per_seabed_offset;
+      if (cluster_robust.ok) out.robust_covariance = cluster_robust.covariance;
+    }
   }
   return out;
 }

@@ -89,7 +89,7 @@ struct RelativePoseResult {
   // [dt, dr] at T_a_b (boxPlus): cluster-robust (from the residuals) unless covariance_cluster_m is 0
   sss::core::Matrix6d covariance = sss::core::Matrix6d::Zero();
   sss::core::Matrix6d model_covariance = sss::core::Matrix6d::Zero();  // Ceres, the assumed sigmas
-  int covariance_clusters = 0;              // seabed patches the inliers of the refinement fall in
+  int covariance_clusters = 0;              // seabed patches of the refined inliers (0 unless covariance_cluster_m > 0)
   double seabed_relief_sigma_m = 0.0;       // from both lines' altimetry (seabed_relief_covariance)
   int num_inliers = 0;                      // among all matches, scored with the final pose
   double range_cost = 0.0;                  // mean squared whitened range residual (refinement)

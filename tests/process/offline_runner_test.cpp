@@ -78,6 +78,15 @@ class OfflineRunnerTest : public ::testing::Test {
     return r;
   }
 
+  // A run on a sonar file alone (the navigation in its headers or packets), without mosaics.
+  static sss::offline::OfflineResult runSonarFileOnly(const std::string& sonar_path, const std::string& out_dir) {
+    sss::offline::OfflineRequest r;
+    r.sonar_path = sonar_path;
+    r.out_dir = out_dir;
+    r.write_mosaics = false;
+    return sss::offline::runOffline(r);
+  }
+
   // Horizontal ATE RMSE of a TUM file against the mission's truth, in the truth's frame (runs
   // without a configured origin take theirs from the first fix).
   static double horizontalAte(const std::string& path, const std::string& mission = "mission") {
@@ -436,11 +445,8 @@ TEST_F(OfflineRunnerTest, XtfInProjectedMetresWithoutAltitudeIsProcessedInItsGri
       ASSERT_TRUE(writer.writeBytes(sss::xtf::encodeOtherPacket(3, 64)));  // an attitude packet
     }
   }
-  sss::offline::OfflineRequest r;
-  r.sonar_path = path;
-  r.out_dir = root_ + "/run_projected";
-  r.write_mosaics = false;
-  const auto result = sss::offline::runOffline(r);
+  const std::string out_dir = root_ + "/run_projected";
+  const auto result = runSonarFileOnly(path, out_dir);
   ASSERT_TRUE(result.ok) << result.error;
   const auto& s = result.summary;
   EXPECT_EQ(s.pings, 600u);
@@ -451,18 +457,18 @@ TEST_F(OfflineRunnerTest, XtfInProjectedMetresWithoutAltitudeIsProcessedInItsGri
   EXPECT_FALSE(s.origin);
   EXPECT_DOUBLE_EQ(s.projected_origin_easting_m, 650123.0);
   EXPECT_DOUBLE_EQ(s.projected_origin_northing_m, 6580456.0);
-  const std::string summary = readFile(r.out_dir + "/summary.json");
+  const std::string summary = readFile(out_dir + "/summary.json");
   EXPECT_NE(summary.find("projected_northing_m"), std::string::npos) << summary;
-  const auto slam = sss::eval::readTum(r.out_dir + "/slam.tum");
+  const auto slam = sss::eval::readTum(out_dir + "/slam.tum");
   ASSERT_TRUE(slam.ok) << slam.error;
   EXPECT_FALSE(slam.origin);
-  EXPECT_NE(readFile(r.out_dir + "/slam.tum").find("north = northing - 6580456.000"), std::string::npos);
+  EXPECT_NE(readFile(out_dir + "/slam.tum").find("north = northing - 6580456.000"), std::string::npos);
   // The last pose: 299.5 m along 30 deg from the first fix, in the grid.
   const Eigen::Vector3d last = slam.poses.back().T_world_body.translation;
   const double along_m = 2.0 * 0.25 * 599;
   EXPECT_NEAR(last.x(), along_m * std::cos(30.0 * M_PI / 180.0), 3.0);
   EXPECT_NEAR(last.y(), along_m * std::sin(30.0 * M_PI / 180.0), 3.0);
-  std::istringstream altitudes(readFile(r.out_dir + "/altitude.csv"));
+  std::istringstream altitudes(readFile(out_dir + "/altitude.csv"));
   size_t near_truth = 0, rows = 0;
   for (std::string line; std::getline(altitudes, line);) {
     if (line.empty() || line[0] == '#' || line[0] == 'u') continue;
@@ -552,11 +558,8 @@ TEST_F(OfflineRunnerTest, XtfNavigationPacketsOrShipCoordinatesPositionPingsWith
         ASSERT_TRUE(writer.writeBytes(packet));
       }
     }
-    sss::offline::OfflineRequest r;
-    r.sonar_path = path;
-    r.out_dir = root_ + (ship ? "/run_ship" : "/run_packets");
-    r.write_mosaics = false;
-    const auto result = sss::offline::runOffline(r);
+    const std::string out_dir = root_ + (ship ? "/run_ship" : "/run_packets");
+    const auto result = runSonarFileOnly(path, out_dir);
     ASSERT_TRUE(result.ok) << result.error;
     const auto& s = result.summary;
     EXPECT_GE(s.pings_with_pose, 570u) << (ship ? "ship" : "packets") << ": 95 % of the pings";
@@ -570,7 +573,7 @@ TEST_F(OfflineRunnerTest, XtfNavigationPacketsOrShipCoordinatesPositionPingsWith
     }
     ASSERT_TRUE(s.origin);
     EXPECT_NEAR(s.origin->latitude_deg, 43.0, 1e-4);
-    const auto slam = sss::eval::readTum(r.out_dir + "/slam.tum");
+    const auto slam = sss::eval::readTum(out_dir + "/slam.tum");
     ASSERT_TRUE(slam.ok) << slam.error;
     const double t_last_s = 1e-6 * static_cast<double>(slam.poses.back().utime_us - 1780300800000000LL);
     const Eigen::Vector3d last = slam.poses.back().T_world_body.translation;
@@ -651,11 +654,8 @@ TEST_F(OfflineRunnerTest, JsfSituationOrNmeaMessagesPositionPingsWithoutPosition
       }
     }
   }
-  sss::offline::OfflineRequest r;
-  r.sonar_path = path;
-  r.out_dir = root_ + (nmea ? "/run_nmea" : "/run_situation");
-  r.write_mosaics = false;
-  const auto result = sss::offline::runOffline(r);
+  const std::string out_dir = root_ + (nmea ? "/run_nmea" : "/run_situation");
+  const auto result = runSonarFileOnly(path, out_dir);
   ASSERT_TRUE(result.ok) << result.error;
   const auto& s = result.summary;
   EXPECT_EQ(s.pings, 600u);
@@ -664,7 +664,7 @@ TEST_F(OfflineRunnerTest, JsfSituationOrNmeaMessagesPositionPingsWithoutPosition
   EXPECT_GE(s.subframes, 2u);
   ASSERT_TRUE(s.origin);
   EXPECT_NEAR(s.origin->latitude_deg, -12.5, 1e-4);
-  const auto slam = sss::eval::readTum(r.out_dir + "/slam.tum");
+  const auto slam = sss::eval::readTum(out_dir + "/slam.tum");
   ASSERT_TRUE(slam.ok) << slam.error;
   const double t_last_s = 1e-6 * static_cast<double>(slam.poses.back().utime_us - 1780300800000000LL);
   const Eigen::Vector3d last = slam.poses.back().T_world_body.translation;

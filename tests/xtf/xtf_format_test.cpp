@@ -84,11 +84,15 @@ TEST(XtfFormat, DecodesAttitudeNavigationAndRawPositionPackets) {
   EXPECT_NEAR(*a->heading_rad, 1.5 * M_PI, 1e-6);
   EXPECT_FALSE(a->y);
 
+  // Types 42 and 107 both start their time with year (u16), month, day, hour at offset 14.
+  auto writeDateAndHour = [](std::vector<uint8_t>& packet) {  // 2026-06-01, 08 h
+    writeU16(packet.data(), 14, 2026);
+    packet[16] = 6;
+    packet[17] = 1;
+    packet[18] = 8;
+  };
   std::vector<uint8_t> navigation = encodeOtherPacket(kHeaderNavigation, 64);
-  writeU16(navigation.data(), 14, 2026);
-  navigation[16] = 6;
-  navigation[17] = 1;
-  navigation[18] = 8;
+  writeDateAndHour(navigation);
   navigation[19] = 0;
   navigation[20] = 1;
   writeU32(navigation.data(), 21, 123456);  // microseconds
@@ -102,10 +106,7 @@ TEST(XtfFormat, DecodesAttitudeNavigationAndRawPositionPackets) {
   EXPECT_FALSE(n->heading_rad);
 
   std::vector<uint8_t> raw = encodeOtherPacket(kHeaderPosRawNavigation, 64);
-  writeU16(raw.data(), 14, 2026);
-  raw[16] = 6;
-  raw[17] = 1;
-  raw[18] = 8;
+  writeDateAndHour(raw);
   writeU16(raw.data(), 21, 5000);  // 0.5 s in units of 100 us
   writeF64(raw.data(), 23, 59.35);
   writeF64(raw.data(), 31, 18.07);
