@@ -35,6 +35,7 @@
 #include <stdexcept>
 
 #include "pipeline/optimiser/pose_manifold.hpp"
+#include "pipeline/optimiser/variance_components.hpp"
 
 namespace sss::optimiser {
 
@@ -109,6 +110,15 @@ std::vector<std::string> validatePoseGraphOptions(const PoseGraphOptions& o) {
   if (o.max_iterations < 1) problems.push_back("max_iterations must be >= 1");
   nonNegative(o.max_solver_time_s, "max_solver_time_s");
   if (o.full_smoothing_max_iterations < 1) problems.push_back("full_smoothing_max_iterations must be >= 1");
+  if (o.closure_reweighting != "none" && o.closure_reweighting != "dr_bound" &&
+      o.closure_reweighting != "variance_components")
+    problems.push_back("closure_reweighting must be one of none, dr_bound, variance_components (got '" +
+                       o.closure_reweighting + "')");
+  if (o.variance_component_iterations < 1) problems.push_back("variance_component_iterations must be >= 1");
+  positive(o.variance_factor_min, "variance_factor_min");
+  positive(o.variance_factor_max, "variance_factor_max");
+  if (o.variance_factor_min > 1.0 || o.variance_factor_max < 1.0)
+    problems.push_back("variance_factor_min must be <= 1 <= variance_factor_max (1: the configured covariance)");
   positive(o.degraded_after_s, "degraded_after_s");
   positive(o.nominal_speed_m_s, "nominal_speed_m_s");
   return problems;
@@ -143,6 +153,11 @@ void readPoseGraphOptions(sss::core::ConfigSection& section, PoseGraphOptions& o
   section.optional("max_iterations", options.max_iterations, {inRange(1, 1000)});
   section.optional("max_solver_time_s", options.max_solver_time_s, {atLeast(0.0)});
   section.optional("full_smoothing_max_iterations", options.full_smoothing_max_iterations, {inRange(1, 10000)});
+  section.optional("closure_reweighting", options.closure_reweighting,
+                   {sss::core::oneOf({"none", "dr_bound", "variance_components"})});
+  section.optional("variance_component_iterations", options.variance_component_iterations, {inRange(1, 100)});
+  section.optional("variance_factor_min", options.variance_factor_min, {inRange(1e-6, 1.0)});
+  section.optional("variance_factor_max", options.variance_factor_max, {inRange(1.0, 1e6)});
   section.optional("degraded_after_s", options.degraded_after_s, {greaterThan(0.0)});
   section.optional("nominal_speed_m_s", options.nominal_speed_m_s, {greaterThan(0.0)});
   if (options.min_consistent_closures > options.pcm_max_closures)
@@ -383,7 +398,7 @@ std::vector<int> SlidingWindowPoseGraph::factorNodes(const Factor& f) const {
 }
 
 Matrix6d SlidingWindowPoseGraph::closureCovarianceInWindow(const Closure& c) const {
-  Matrix6d sigma = c.record.closure.covariance;
+  Matrix6d sigma = variance_factors_.closure * c.record.closure.covariance;
   // e = boxMinus(T_a^-1 T_b, Z): a right perturbation d of T_a enters as -Ad(Z^-1) d, one of T_b
   // as d itself (to first order).
   if (!isActive(c.a)) {
@@ -409,13 +424,15 @@ ceres::CostFunction* SlidingWindowPoseGraph::makeCost(const Factor& f) const {
       return InsAbsoluteError::create(nodes_[f.index].dr, w);
     }
     case FactorKind::kOdometry:
-      return RelativePoseError::create(nodes_[f.index].odometry, nodes_[f.index].odometry_sqrt_information);
+      return RelativePoseError::create(nodes_[f.index].odometry, nodes_[f.index].odometry_sqrt_information /
+                                                                     std::sqrt(variance_factors_.odometry));
     case FactorKind::kClosure: {
       const Closure& c = closures_[f.index];
-      Matrix6d sqrt_information = c.sqrt_information;
+      Matrix6d sqrt_information = c.sqrt_information / std::sqrt(variance_factors_.closure);
       if (!isActive(c.a) || !isActive(c.b)) {
         // Inflated covariance stays positive definite: a sum of a PD and a PSD matrix.
-        if (!sqrtInformation(closureCovarianceInWindow(c), sqrt_information)) sqrt_information = c.sqrt_information;
+        Matrix6d inflated;
+        if (sqrtInformation(closureCovarianceInWindow(c), inflated)) sqrt_information = inflated;
       }
       return RelativePoseError::create(c.record.closure.T_a_b, sqrt_information);
     }
@@ -713,6 +730,61 @@ bool SlidingWindowPoseGraph::solve(const std::vector<Factor>& factors, int max_i
   return true;
 }
 
+void SlidingWindowPoseGraph::reweighFromResiduals(const std::vector<Factor>& factors, UpdateReport& report) {
+  enum Group { kClosures = 0, kOdometry = 1, kGroups = 2 };
+  // With "none" one pass: the components are measured (DR's strain is a diagnostic), nothing changes.
+  const bool reweigh = options_.closure_reweighting != "none";
+  for (int iteration = 0; iteration < (reweigh ? options_.variance_component_iterations : 1); ++iteration) {
+    // Whitened with the current factors (makeCost) and the robust weights at this estimate, so the
+    // estimate is a correction of the current factor, and an outlying closure weighs as it does in
+    // the solve.
+    std::vector<WhitenedFactor> whitened;
+    whitened.reserve(factors.size());
+    for (const Factor& f : factors) {
+      LinearisedFactor lf;
+      if (!linearise(f, lf)) continue;
+      const int group = f.kind == FactorKind::kClosure ? kClosures : f.kind == FactorKind::kOdometry ? kOdometry : -1;
+      whitened.push_back({lf.nodes, std::move(lf.jacobian), std::move(lf.residual), group});
+    }
+    const VarianceFactors before = variance_factors_;
+    std::vector<VarianceComponent> components;
+    if (!estimateVarianceComponents(whitened, static_cast<int>(nodes_.size()), kGroups, components)) return;
+    // A group the solution absorbs (no closures yet, or too few to disagree) keeps its factor.
+    auto usable = [](const VarianceComponent& c) { return c.redundancy >= 1.0 && std::isfinite(c.varianceFactor()); };
+    bool settled = true;
+    auto scale = [&](double& factor, double ratio) {
+      const double next = std::clamp(factor * ratio, options_.variance_factor_min, options_.variance_factor_max);
+      settled = settled && std::abs(next / factor - 1.0) < 0.01;  // converges linearly: stop at 1 %
+      factor = next;
+    };
+    const VarianceComponent& closures = components[kClosures];
+    const VarianceComponent& odometry = components[kOdometry];
+    if (!reweigh) {
+      // measured only
+    } else if (options_.closure_reweighting == "dr_bound") {
+      // Only ever widens the closures, by what DR's residuals exceed their model.
+      if (usable(odometry) && odometry.varianceFactor() > 1.0) scale(variance_factors_.closure, odometry.varianceFactor());
+    } else {
+      if (usable(closures)) scale(variance_factors_.closure, closures.varianceFactor());
+      if (usable(odometry)) scale(variance_factors_.odometry, odometry.varianceFactor());
+    }
+    variance_factors_.closure_redundancy = closures.redundancy;
+    variance_factors_.odometry_redundancy = odometry.redundancy;
+    variance_factors_.odometry_strain = odometry.varianceFactor();
+    variance_factors_.closures = closures.factors;
+    if (!reweigh) return;
+    ++variance_factors_.iterations;
+    if (settled) return;
+    UpdateReport again;
+    if (!solve(factors, options_.full_smoothing_max_iterations, again)) {
+      variance_factors_ = before;  // the estimate stays the last good one, and so do its weights
+      return;
+    }
+    report.iterations += again.iterations;
+    report.solve_s += again.solve_s;
+  }
+}
+
 void SlidingWindowPoseGraph::marginaliseOldest() {
   const int m = first_active_;
   const std::vector<Factor> factors = factorsTouching(m);
@@ -871,6 +943,7 @@ UpdateReport SlidingWindowPoseGraph::fullSmoothing() {
   first_active_ = 0;
   const std::vector<Factor> factors = allFactors();
   const bool ok = solve(factors, options_.full_smoothing_max_iterations, report);
+  if (ok) reweighFromResiduals(factors, report);
   if (ok) {
     // Re-derive the window's prior at the smoothed estimate, eliminating the old nodes in order.
     prior_ = Prior();

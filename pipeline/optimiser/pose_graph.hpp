@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <optional>
 #include <string>
@@ -78,6 +79,24 @@ struct PoseGraphOptions {
   int max_iterations = 10;            // per window update; deterministic bound
   double max_solver_time_s = 0.0;     // > 0 adds a wall-clock bound (then results depend on load)
   int full_smoothing_max_iterations = 100;
+
+  // ---- weights from the residuals (variance components, variance_components.hpp) -----------------
+  // At full smoothing, factors on the configured closure and odometry covariances from the
+  // solution's own residuals and each group's redundancy, iterated up to
+  // variance_component_iterations times:
+  //   "none": the configured covariances as they are;
+  //   "dr_bound": the odometry model is a specification DR stays within, so closures may not strain
+  //     it beyond: when the odometry residuals exceed their model (factor > 1) the closures are
+  //     widened by that factor until they fit, else nothing changes. Closures whose errors are
+  //     common to a pair (relief at far range) agree with each other and only DR can show them;
+  //   "variance_components": both factors estimated (Förstner); measured worse on the randomised
+  //     missions: a pair-common closure error is absorbed by stretching DR.
+  // Each factor stays within [variance_factor_min, variance_factor_max]. Whatever the mode, full
+  // smoothing measures DR's strain (VarianceFactors::odometry_strain).
+  std::string closure_reweighting = "none";
+  int variance_component_iterations = 20;
+  double variance_factor_min = 0.1;
+  double variance_factor_max = 100.0;
 
   // ---- corrections --------------------------------------------------------------------------------
   double degraded_after_s = 1800.0;   // status DEGRADED when the newest accepted closure is older
@@ -176,6 +195,22 @@ struct UpdateReport {
   int closures_decided = 0;  // closures whose status changed in this update
 };
 
+// Factors on the configured closure and odometry covariances (1 until full smoothing estimates them,
+// see PoseGraphOptions::variance_component_iterations), with what the last estimate rested on.
+struct VarianceFactors {
+  double closure = 1.0;
+  double odometry = 1.0;
+  double closure_redundancy = 0.0;   // rows of the accepted closures the solution does not absorb
+  double odometry_redundancy = 0.0;
+  // Odometry residuals over their model at the last full smoothing, with the final weights: above 1
+  // the closures bend DR further than its own error model allows, a sign of closures with a common
+  // error (measured on randomised missions: above 1 exactly where SLAM ended worse than DR). NaN
+  // before any full smoothing or when nothing is redundant.
+  double odometry_strain = std::numeric_limits<double>::quiet_NaN();
+  int closures = 0;                  // accepted closures in the last estimate
+  int iterations = 0;                // estimates over the mission
+};
+
 enum class CorrectionStatus { kDrOnly, kCorrected, kDegraded };
 
 // corrected = T_corrected_dr * T_world_body_dr for the same time (world-frame correction).
@@ -225,6 +260,7 @@ class SlidingWindowPoseGraph {
   std::vector<ClosureRecord> closures() const;  // in arrival order
   const PoseGraphCounters& counters() const { return counters_; }
   const WindowStats& windowStats() const { return window_stats_; }
+  const VarianceFactors& varianceFactors() const { return variance_factors_; }
   const PoseGraphOptions& options() const { return options_; }
   Correction correctionAt(int64_t utime_us) const;
 
@@ -307,6 +343,9 @@ class SlidingWindowPoseGraph {
   bool pairConsistent(const Closure& i, const Closure& j) const;
   sss::core::Matrix6d chainCovariance(int from, int to) const;
   bool solve(const std::vector<Factor>& factors, int max_iterations, UpdateReport& report);
+  // Variance components of closures and odometry at the current estimate, solving again with the
+  // new factors until they settle (full smoothing, every node active).
+  void reweighFromResiduals(const std::vector<Factor>& factors, UpdateReport& report);
   void marginaliseOldest();
   // Joint covariance of the active nodes (6 x 6 blocks in node order); slot[n - first_active_] is
   // the block of node n.
@@ -330,6 +369,7 @@ class SlidingWindowPoseGraph {
   Prior prior_;
   PoseGraphCounters counters_;
   WindowStats window_stats_;
+  VarianceFactors variance_factors_;
   int64_t update_utime_us_ = 0;
   // Newest node time of an accepted closure that left the PCM horizon (its decision is final).
   int64_t frozen_newest_accepted_utime_us_ = -1;

@@ -19,7 +19,8 @@ using sss::core::Pose;
 namespace {
 
 constexpr const char* kMagic = "sss-pose-graph-checkpoint";
-constexpr int kVersion = 1;
+// 2 adds the variance factors; a version 1 file (before them) restores with factors of 1.
+constexpr int kVersion = 2;
 constexpr size_t kMaxFileBytes = size_t{1} << 31;  // 2 GiB: far above any mission
 
 using checkpoint::TextReader;
@@ -88,6 +89,16 @@ std::string SlidingWindowPoseGraph::checkpointText() const {
   w.real(k.last_solve_s);
   w.integer(k.last_iterations);
   w.endLine();
+  const VarianceFactors& v = variance_factors_;
+  w.word("weights");
+  w.real(v.closure);
+  w.real(v.odometry);
+  w.real(v.closure_redundancy);
+  w.real(v.odometry_redundancy);
+  w.real(v.odometry_strain);
+  w.integer(v.closures);
+  w.integer(v.iterations);
+  w.endLine();
   const WindowStats& s = window_stats_;
   w.word("window");
   for (int v : {s.active_nodes, s.variable_blocks, s.constant_blocks, s.residual_blocks, s.prior_nodes, s.prior_rows,
@@ -120,8 +131,9 @@ Status SlidingWindowPoseGraph::restoreCheckpointText(const std::string& text) {
   int64_t version = 0;
   if (!r.expect(kMagic)) return fail("not a pose-graph checkpoint");
   if (!r.integer(version)) return fail("bad version field");
-  if (version != kVersion)
-    return fail("version " + std::to_string(version) + " not supported (expected " + std::to_string(kVersion) + ")");
+  if (version != kVersion && version != 1)
+    return fail("version " + std::to_string(version) + " not supported (expected 1 or " + std::to_string(kVersion) +
+                ")");
 
   SlidingWindowPoseGraph g(options_);
   int64_t num_nodes = 0, num_closures = 0, first_active = 0, horizon = 0;
@@ -214,6 +226,15 @@ Status SlidingWindowPoseGraph::restoreCheckpointText(const std::string& text) {
   if (!r.real(k.last_update_s) || !r.real(k.last_solve_s) ||
       !r.boundedInt(k.last_iterations, -1, std::numeric_limits<int>::max()))
     return fail("bad counters record");
+  if (version >= 2) {
+    VarianceFactors& v = g.variance_factors_;
+    if (!r.expect("weights") || !r.real(v.closure) || !r.real(v.odometry) || !r.real(v.closure_redundancy) ||
+        !r.real(v.odometry_redundancy) || !r.real(v.odometry_strain) || !r.boundedInt(v.closures, 0, std::numeric_limits<int>::max()) ||
+        !r.boundedInt(v.iterations, 0, std::numeric_limits<int>::max()))
+      return fail("bad weights record");
+    if (!(v.closure > 0.0) || !(v.odometry > 0.0) || !std::isfinite(v.closure) || !std::isfinite(v.odometry))
+      return fail("weights record: variance factors must be finite and > 0");
+  }
   WindowStats& s = g.window_stats_;
   if (!r.expect("window")) return fail("bad window record");
   for (int* v : {&s.active_nodes, &s.variable_blocks, &s.constant_blocks, &s.residual_blocks, &s.prior_nodes,

@@ -471,6 +471,19 @@ std::vector<std::string> explainRun(const OfflineSummary& s, const Options& opti
                        " (inconsistent with dead reckoning and with each other; see loop_closures.csv); the result is "
                        "dead reckoning");
   }
+  // DR strained beyond its own error model: on the randomised missions this marked exactly the
+  // runs SLAM made worse than DR (closures with an error common to a pair, relief at far range).
+  const double strain = s.variance_factors.odometry_strain;
+  if (s.closures_accepted > 0 && std::isfinite(strain) && strain > 1.0) {
+    char text[512];
+    std::snprintf(text, sizeof(text),
+                  "the accepted closures bend dead reckoning %.1fx beyond its error model (variance; "
+                  "optimiser.graph.odometry_*): closures sharing an error (a biased pair, relief at far range) are "
+                  "likely; compare loop_closures.csv with the DR and SLAM mosaics, or trust DR more with "
+                  "optimiser.graph.closure_reweighting: dr_bound",
+                  strain);
+    findings.push_back(text);
+  }
   return findings;
 }
 
@@ -599,6 +612,15 @@ bool writeSummaryJson(const std::string& path, const OfflineRequest& request, co
   json.key("one_side_only").value(s.bottom_track.one_side_only);
   json.key("outliers").value(s.bottom_track.outliers);
   json.key("scale_applied").value(fusion.bottom_track_scale, 6);
+  json.endObject();
+  json.key("variance_factors").beginObject();  // what the graph learnt of its own weights
+  json.key("closure").value(s.variance_factors.closure, 6);
+  json.key("odometry").value(s.variance_factors.odometry, 6);
+  json.key("closure_redundancy").value(s.variance_factors.closure_redundancy, 4);
+  json.key("odometry_redundancy").value(s.variance_factors.odometry_redundancy, 4);
+  json.key("odometry_strain").value(s.variance_factors.odometry_strain, 4);
+  json.key("closures").value(static_cast<uint64_t>(s.variance_factors.closures));
+  json.key("iterations").value(static_cast<uint64_t>(s.variance_factors.iterations));
   json.endObject();
   json.key("lines").beginObject();
   json.key("survey_lines").value(s.survey_lines);
@@ -925,6 +947,7 @@ bool Runner::writeOutputs(std::string& error) {
   summary_.closures_rejected = counters.closures_rejected_gate + counters.closures_rejected_inconsistent +
                                counters.closures_rejected_no_support;
   summary_.closures_superseded = counters.closures_superseded;
+  summary_.variance_factors = optimiser_.graph().varianceFactors();
 
   // Bathymetry: SLAM poses (the product) and DR poses (the baseline the map error is compared to).
   const auto& bathymetry = options_.optimiser.bathymetry;

@@ -12,6 +12,7 @@
 #include <string>
 
 #include "pipeline/core/mission_origin.hpp"
+#include "pipeline/optimiser/pose_graph.hpp"
 #include "pipeline/subframe/subframe_buffer.hpp"
 #include <vector>
 
@@ -63,6 +64,9 @@ struct OfflineSummary {
   uint64_t closures_accepted = 0;  // by the optimiser, after full smoothing
   uint64_t closures_rejected = 0;
   uint64_t closures_superseded = 0;
+  // Factors on the closure and odometry covariances learnt from the residuals at the final
+  // smoothing (1 when optimiser.graph.variance_component_iterations is 0).
+  sss::optimiser::VarianceFactors variance_factors;
   uint64_t seabed_points = 0;
   uint64_t input_faults = 0;       // corrupt records, bad messages, dropped pings
   // Where the pings went: the fusion's drops by cause and altitude sources, the line builder's.
