@@ -479,8 +479,8 @@ std::vector<std::string> explainRun(const OfflineSummary& s, const Options& opti
     std::snprintf(text, sizeof(text),
                   "the accepted closures bend dead reckoning %.1fx beyond its error model (variance; "
                   "optimiser.graph.odometry_*): closures sharing an error (a biased pair, relief at far range) are "
-                  "likely; compare loop_closures.csv with the DR and SLAM mosaics, or trust DR more with "
-                  "optimiser.graph.closure_reweighting: dr_bound",
+                  "likely, and SLAM may be worse than dead reckoning here: compare loop_closures.csv with the DR "
+                  "and SLAM mosaics before using slam.tum over dead_reckoning.tum",
                   strain);
     findings.push_back(text);
   }
