@@ -242,7 +242,8 @@ PairMatch matchPair(const sss::subframe::Subframe& a, const std::vector<sss::cor
   result.pose = estimateRelativePose(input, options.pose);
   if (result.pose.accepted) {
     sss::core::Matrix6d& covariance = result.pose.covariance;
-    covariance *= options.covariance_scale;
+    // The scale calibrates the matches' model; the relief term is already a physical size.
+    covariance = options.covariance_scale * (covariance - result.pose.relief_covariance) + result.pose.relief_covariance;
     for (int i = 0; i < 6; ++i) {
       const double floor = i < 3 ? options.min_translation_sigma_m : options.min_rotation_sigma_rad;
       covariance(i, i) = std::max(covariance(i, i), floor * floor);

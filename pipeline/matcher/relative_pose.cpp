@@ -256,8 +256,11 @@ ClusterRobust clusterRobustCovariance(const std::vector<Measurement>& measuremen
     // The seabed row is (down . x - depth - offset) / sigma and does not involve the pose.
     if (options.use_seabed_prior)
       seabed_offset_gradient += A_pl * ldlt.solve(m.down_a) / (options.seabed_sigma_m * options.seabed_sigma_m);
-    const std::pair<long, long> cell{static_cast<long>(std::floor(landmarks[i].x() / cluster_m)),
-                                     static_cast<long>(std::floor(landmarks[i].y() / cluster_m))};
+    // Without clusters (cluster_m 0: only the seabed sensitivity is wanted) every match is one cell.
+    const std::pair<long, long> cell =
+        cluster_m > 0.0 ? std::pair<long, long>{static_cast<long>(std::floor(landmarks[i].x() / cluster_m)),
+                                                static_cast<long>(std::floor(landmarks[i].y() / cluster_m))}
+                        : std::pair<long, long>{0, 0};
     auto [it, inserted] = gradient_by_cluster.try_emplace(cell, Vector6d::Zero());
     it->second += gradient;
   }
@@ -273,6 +276,9 @@ ClusterRobust clusterRobustCovariance(const std::vector<Measurement>& measuremen
     prior_information = J.transpose() * J;
   }
   information += prior_information;
+  const Eigen::LLT<Matrix6d> bread(information);
+  if (bread.info() != Eigen::Success) return out;
+  out.per_seabed_offset = -bread.solve(seabed_offset_gradient);
   out.clusters = static_cast<int>(gradient_by_cluster.size());
   if (out.clusters < 2) return out;
   Matrix6d meat = Matrix6d::Zero();
@@ -284,9 +290,6 @@ ClusterRobust clusterRobustCovariance(const std::vector<Measurement>& measuremen
   // A few clusters estimate the mean inflation well but not every direction: G cluster gradients
   // span at most G - 1 directions, so some come out far too small (a known small-sample bias of
   // the sandwich). No direction is taken narrower than the mean inflation.
-  const Eigen::LLT<Matrix6d> bread(information);
-  if (bread.info() != Eigen::Success) return out;
-  out.per_seabed_offset = -bread.solve(seabed_offset_gradient);
   const Matrix6d L_inverse = bread.matrixL().solve(Matrix6d::Identity());
   Matrix6d meat_whitened = L_inverse * meat * L_inverse.transpose();
   meat_whitened = 0.5 * (meat_whitened + meat_whitened.transpose());
@@ -387,12 +390,16 @@ Solved solve(const std::vector<Measurement>& measurements, const std::vector<int
       covariance.GetCovarianceBlock(delta, delta, c.data());  // row-major; symmetric anyway
       out.covariance = 0.5 * (c + c.transpose());
     }
-    if (options.covariance_cluster_m > 0.0) {
+    // The sandwich when asked for; the pose's sensitivity to a common seabed offset always (the
+    // relief term of the covariance needs it whichever covariance it is added to).
+    if (options.covariance_cluster_m > 0.0 || options.use_seabed_prior) {
       const ClusterRobust cluster_robust =
           clusterRobustCovariance(measurements, subset, landmarks, &anchor, dr, sqrt_information, options, robust);
-      out.clusters = cluster_robust.clusters;
       out.per_seabed_offset = cluster_robust.per_seabed_offset;
-      if (cluster_robust.ok) out.robust_covariance = cluster_robust.covariance;
+      if (options.covariance_cluster_m > 0.0) {
+        out.clusters = cluster_robust.clusters;
+        if (cluster_robust.ok) out.robust_covariance = cluster_robust.covariance;
+      }
     }
   }
   return out;
@@ -687,15 +694,17 @@ RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const Re
   if (refined.covariance) result.model_covariance = *refined.covariance;
   result.covariance_clusters = refined.clusters;
   const bool cluster_robust = options.covariance_cluster_m > 0.0;
-  if (cluster_robust && refined.robust_covariance) {
-    result.covariance = *refined.robust_covariance;
-    if (options.seabed_relief_covariance && options.use_seabed_prior) {
-      result.seabed_relief_sigma_m = seabedReliefSigma(input);
-      const double sigma = result.seabed_relief_sigma_m;
-      result.covariance += sigma * sigma * refined.per_seabed_offset * refined.per_seabed_offset.transpose();
-    }
-  }
+  if (cluster_robust && refined.robust_covariance) result.covariance = *refined.robust_covariance;
   if (!cluster_robust && refined.covariance) result.covariance = *refined.covariance;
+  // Relief between the lines: a common offset of the seabed under the matches moves the pose along
+  // per_seabed_offset (mostly laterally), and no residual shows it; its size is the relief both
+  // lines' altimetry recorded along the subframes. Added to whichever covariance is in use.
+  if (options.use_seabed_prior && options.seabed_relief_covariance && (refined.robust_covariance || refined.covariance)) {
+    result.seabed_relief_sigma_m = seabedReliefSigma(input);
+    const double sigma = result.seabed_relief_sigma_m;
+    result.relief_covariance = sigma * sigma * refined.per_seabed_offset * refined.per_seabed_offset.transpose();
+    result.covariance += result.relief_covariance;
+  }
 
   std::ostringstream text;
   if (!refined.usable || !refined.covariance) {

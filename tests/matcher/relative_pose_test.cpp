@@ -359,6 +359,36 @@ TEST(RelativePose, RoughSeabedUnderTheLinesWidensTheLateralSigma) {
   EXPECT_GT(on_rough.covariance(1, 1), 4.0 * rough_without.covariance(1, 1));
 }
 
+// The same relief term on Ceres' covariance (the deployed default): it is reported on its own
+// (relief_covariance) so that PairMatcherOptions::covariance_scale, a calibration of the matches'
+// model, does not scale a physical size; the lateral sigma reaches the relief's
+// h dz (1 / g_a + 1 / g_b), and on a flat seabed nothing is added.
+TEST(RelativePose, RoughSeabedWidensCeresCovarianceToo) {
+  const SyntheticPair flat = makePair(false, 13);
+  SyntheticPair rough = flat;
+  for (int i = 0; i < kPings; ++i) {
+    const double undulation_m = 0.5 * std::sin(2.0 * M_PI * i * kPingSpacingM / 40.0);
+    rough.input.altitude_a_m[i] += undulation_m;
+    rough.input.altitude_b_m[i] -= undulation_m;
+  }
+  RelativePoseOptions options = testOptions();
+  ASSERT_TRUE(options.seabed_relief_covariance) << "on by default";
+  const RelativePoseResult on_flat = estimateRelativePose(flat.input, options);
+  const RelativePoseResult on_rough = estimateRelativePose(rough.input, options);
+  ASSERT_TRUE(on_flat.accepted) << on_flat.reason;
+  ASSERT_TRUE(on_rough.accepted) << on_rough.reason;
+  EXPECT_LT(on_flat.relief_covariance.norm(), 1e-9);
+  EXPECT_LT((on_flat.covariance - on_flat.model_covariance).norm(), 1e-12);
+  EXPECT_LT((on_rough.covariance - on_rough.model_covariance - on_rough.relief_covariance).norm(),
+            1e-9 * on_rough.covariance.norm());
+  const double expected_lateral_m = kAltitudeM * (0.5 / std::sqrt(2.0)) * (2.0 / 30.0);
+  std::printf("Ceres covariance: lateral sigma model %.3f m, relief %.3f m (expected %.3f m), total %.3f m\n",
+              std::sqrt(on_rough.model_covariance(1, 1)), std::sqrt(on_rough.relief_covariance(1, 1)),
+              expected_lateral_m, std::sqrt(on_rough.covariance(1, 1)));
+  EXPECT_NEAR(std::sqrt(on_rough.relief_covariance(1, 1)), expected_lateral_m, 0.1 * expected_lateral_m + 0.04);
+  EXPECT_GT(on_rough.covariance(1, 1), 4.0 * on_rough.model_covariance(1, 1));
+}
+
 TEST(RelativePose, TooFewPatchesOfSeabedAreRejectedWithAReason) {
   PatchErrors narrow;
   narrow.east_min_m = 21.0;  // one 20 m patch across, and the matches only 15 m along track
