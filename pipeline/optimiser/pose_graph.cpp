@@ -46,6 +46,16 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
+// A Gaussian prior on a scalar parameter: (x - mean) / sigma.
+struct ScalarPriorError {
+  double mean, inverse_sigma;
+  template <typename T>
+  bool operator()(const T* x, T* residual) const {
+    residual[0] = (x[0] - T(mean)) * T(inverse_sigma);
+    return true;
+  }
+};
+
 double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
@@ -115,6 +125,10 @@ std::vector<std::string> validatePoseGraphOptions(const PoseGraphOptions& o) {
     problems.push_back("closure_reweighting must be one of none, dr_bound, variance_components (got '" +
                        o.closure_reweighting + "')");
   if (o.variance_component_iterations < 1) problems.push_back("variance_component_iterations must be >= 1");
+  if (!(o.separation_bias_sigma_m >= 0.0)) problems.push_back("separation_bias_sigma_m must be >= 0 (0: off)");
+  if (!(o.separation_bias_min_lateral_m >= 0.0)) problems.push_back("separation_bias_min_lateral_m must be >= 0");
+  if (!(o.separation_bias_significance >= 0.0))
+    problems.push_back("separation_bias_significance must be >= 0 (sigmas; 0: always applied)");
   positive(o.variance_factor_min, "variance_factor_min");
   positive(o.variance_factor_max, "variance_factor_max");
   if (o.variance_factor_min > 1.0 || o.variance_factor_max < 1.0)
@@ -156,6 +170,9 @@ void readPoseGraphOptions(sss::core::ConfigSection& section, PoseGraphOptions& o
   section.optional("closure_reweighting", options.closure_reweighting,
                    {sss::core::oneOf({"none", "dr_bound", "variance_components"})});
   section.optional("variance_component_iterations", options.variance_component_iterations, {inRange(1, 100)});
+  section.optional("separation_bias_sigma_m", options.separation_bias_sigma_m, {inRange(0.0, 100.0)});
+  section.optional("separation_bias_min_lateral_m", options.separation_bias_min_lateral_m, {inRange(0.0, 10000.0)});
+  section.optional("separation_bias_significance", options.separation_bias_significance, {inRange(0.0, 100.0)});
   section.optional("variance_factor_min", options.variance_factor_min, {inRange(1e-6, 1.0)});
   section.optional("variance_factor_max", options.variance_factor_max, {inRange(1.0, 1e6)});
   section.optional("degraded_after_s", options.degraded_after_s, {greaterThan(0.0)});
@@ -434,7 +451,10 @@ ceres::CostFunction* SlidingWindowPoseGraph::makeCost(const Factor& f) const {
         Matrix6d inflated;
         if (sqrtInformation(closureCovarianceInWindow(c), inflated)) sqrt_information = inflated;
       }
-      return RelativePoseError::create(c.record.closure.T_a_b, sqrt_information);
+      // The last estimate of the separation bias, held constant (a variable only at full smoothing).
+      Pose measured = c.record.closure.T_a_b;
+      measured.translation += separation_bias_.estimate_m * separationDirection(c);
+      return RelativePoseError::create(measured, sqrt_information);
     }
     case FactorKind::kPrior:
       return new MarginalPriorCost(prior_.linearisation, prior_.jacobian, prior_.residual);
@@ -669,7 +689,21 @@ void SlidingWindowPoseGraph::decideClosures(UpdateReport& report) {
 
 // ---- solving ----------------------------------------------------------------------------------
 
-bool SlidingWindowPoseGraph::solve(const std::vector<Factor>& factors, int max_iterations, UpdateReport& report) {
+Eigen::Vector3d SlidingWindowPoseGraph::separationDirection(const Closure& c) const {
+  if (!(options_.separation_bias_sigma_m > 0.0)) return Eigen::Vector3d::Zero();
+  const Pose& T_a_b = c.record.closure.T_a_b;
+  // Parallel or anti-parallel lines: B's forward axis within 30 deg of A's, either way.
+  const Eigen::Vector3d forward_b = T_a_b.rotation * Eigen::Vector3d::UnitX();
+  const double cos_heading = forward_b.head<2>().normalized().x();
+  if (!(std::abs(cos_heading) > std::cos(30.0 * M_PI / 180.0))) return Eigen::Vector3d::Zero();
+  // B off to one side of A: the overlap lies between them and each looks at it from its own side.
+  const double lateral_m = T_a_b.translation.y();
+  if (!(std::abs(lateral_m) > options_.separation_bias_min_lateral_m)) return Eigen::Vector3d::Zero();
+  return Eigen::Vector3d(0.0, lateral_m > 0.0 ? 1.0 : -1.0, 0.0);
+}
+
+bool SlidingWindowPoseGraph::solve(const std::vector<Factor>& factors, int max_iterations, UpdateReport& report,
+                                   bool estimate_separation_bias) {
   PoseManifold manifold;  // outlives the problem, which does not own it
   ceres::Problem::Options problem_options;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -688,10 +722,31 @@ bool SlidingWindowPoseGraph::solve(const std::vector<Factor>& factors, int max_i
     problem.AddParameterBlock(parameters[s].data(), kPoseAmbientSize, &manifold);
     if (!isActive(node_of_slot[s])) problem.SetParameterBlockConstant(parameters[s].data());
   }
+  // The separation bias as a variable: opposite-side closures take it as a third block, a zero-mean
+  // prior of separation_bias_sigma_m holds it where DR cannot tell.
+  double separation_bias_m = separation_bias_.estimate_m;
+  int biased_closures = 0;
   for (const Factor& f : factors) {
     std::vector<double*> blocks;
     for (int n : factorNodes(f)) blocks.push_back(parameters[slot_of[n]].data());
+    if (estimate_separation_bias && f.kind == FactorKind::kClosure) {
+      const Closure& c = closures_[f.index];
+      const Eigen::Vector3d direction = separationDirection(c);
+      if (direction.squaredNorm() > 0.0) {
+        Matrix6d sqrt_information = c.sqrt_information / std::sqrt(variance_factors_.closure);
+        blocks.push_back(&separation_bias_m);
+        problem.AddResidualBlock(
+            BiasedRelativePoseError::create(c.record.closure.T_a_b, direction, sqrt_information), makeLoss(f), blocks);
+        ++biased_closures;
+        continue;
+      }
+    }
     problem.AddResidualBlock(makeCost(f), makeLoss(f), blocks);
+  }
+  if (estimate_separation_bias && biased_closures > 0) {
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<ScalarPriorError, 1, 1>(
+                                 new ScalarPriorError{0.0, 1.0 / options_.separation_bias_sigma_m}),
+                             nullptr, &separation_bias_m);
   }
 
   ceres::Solver::Options solver_options;
@@ -727,6 +782,19 @@ bool SlidingWindowPoseGraph::solve(const std::vector<Factor>& factors, int max_i
     nodes_[n].estimate = normalisedPose(pose);
   }
   window_stats_.residual_blocks = problem.NumResidualBlocks();
+  if (estimate_separation_bias && biased_closures > 0 && std::isfinite(separation_bias_m)) {
+    separation_bias_.estimate_m = separation_bias_.tested_m = separation_bias_m;
+    separation_bias_.applied = true;  // fullSmoothing() tests it
+    separation_bias_.closures = biased_closures;
+    // Its sigma: the bias's marginal covariance (every node a variable at full smoothing).
+    ceres::Covariance::Options covariance_options;
+    covariance_options.algorithm_type = ceres::SPARSE_QR;
+    ceres::Covariance covariance(covariance_options);
+    const std::vector<std::pair<const double*, const double*>> blocks = {{&separation_bias_m, &separation_bias_m}};
+    double variance = std::numeric_limits<double>::quiet_NaN();
+    if (covariance.Compute(blocks, &problem)) covariance.GetCovarianceBlock(&separation_bias_m, &separation_bias_m, &variance);
+    separation_bias_.sigma_m = variance >= 0.0 ? std::sqrt(variance) : std::numeric_limits<double>::quiet_NaN();
+  }
   return true;
 }
 
@@ -776,7 +844,7 @@ void SlidingWindowPoseGraph::reweighFromResiduals(const std::vector<Factor>& fac
     ++variance_factors_.iterations;
     if (settled) return;
     UpdateReport again;
-    if (!solve(factors, options_.full_smoothing_max_iterations, again)) {
+    if (!solve(factors, options_.full_smoothing_max_iterations, again, separation_bias_.applied)) {
       variance_factors_ = before;  // the estimate stays the last good one, and so do its weights
       return;
     }
@@ -942,7 +1010,17 @@ UpdateReport SlidingWindowPoseGraph::fullSmoothing() {
   const int boundary = first_active_;
   first_active_ = 0;
   const std::vector<Factor> factors = allFactors();
-  const bool ok = solve(factors, options_.full_smoothing_max_iterations, report);
+  bool ok = solve(factors, options_.full_smoothing_max_iterations, report, options_.separation_bias_sigma_m > 0.0);
+  if (ok && separation_bias_.applied &&
+      !(std::abs(separation_bias_.tested_m) >= options_.separation_bias_significance * separation_bias_.sigma_m)) {
+    // Not significant: the closures are taken as they are, and solved again without it.
+    separation_bias_.estimate_m = 0.0;
+    separation_bias_.applied = false;
+    UpdateReport again;
+    ok = solve(factors, options_.full_smoothing_max_iterations, again);
+    report.iterations += again.iterations;
+    report.solve_s += again.solve_s;
+  }
   if (ok) reweighFromResiduals(factors, report);
   if (ok) {
     // Re-derive the window's prior at the smoothed estimate, eliminating the old nodes in order.

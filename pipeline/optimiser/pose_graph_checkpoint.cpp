@@ -20,7 +20,8 @@ namespace {
 
 constexpr const char* kMagic = "sss-pose-graph-checkpoint";
 // 2 adds the variance factors; a version 1 file (before them) restores with factors of 1.
-constexpr int kVersion = 2;
+// 3 adds the separation bias; older files restore without one (0, not applied).
+constexpr int kVersion = 3;
 constexpr size_t kMaxFileBytes = size_t{1} << 31;  // 2 GiB: far above any mission
 
 using checkpoint::TextReader;
@@ -99,6 +100,14 @@ std::string SlidingWindowPoseGraph::checkpointText() const {
   w.integer(v.closures);
   w.integer(v.iterations);
   w.endLine();
+  const SeparationBias& b = separation_bias_;
+  w.word("separation_bias");
+  w.real(b.estimate_m);
+  w.real(b.tested_m);
+  w.real(b.sigma_m);
+  w.integer(b.applied ? 1 : 0);
+  w.integer(b.closures);
+  w.endLine();
   const WindowStats& s = window_stats_;
   w.word("window");
   for (int v : {s.active_nodes, s.variable_blocks, s.constant_blocks, s.residual_blocks, s.prior_nodes, s.prior_rows,
@@ -131,8 +140,8 @@ Status SlidingWindowPoseGraph::restoreCheckpointText(const std::string& text) {
   int64_t version = 0;
   if (!r.expect(kMagic)) return fail("not a pose-graph checkpoint");
   if (!r.integer(version)) return fail("bad version field");
-  if (version != kVersion && version != 1)
-    return fail("version " + std::to_string(version) + " not supported (expected 1 or " + std::to_string(kVersion) +
+  if (version < 1 || version > kVersion)
+    return fail("version " + std::to_string(version) + " not supported (expected 1 to " + std::to_string(kVersion) +
                 ")");
 
   SlidingWindowPoseGraph g(options_);
@@ -234,6 +243,16 @@ Status SlidingWindowPoseGraph::restoreCheckpointText(const std::string& text) {
       return fail("bad weights record");
     if (!(v.closure > 0.0) || !(v.odometry > 0.0) || !std::isfinite(v.closure) || !std::isfinite(v.odometry))
       return fail("weights record: variance factors must be finite and > 0");
+  }
+  if (version >= 3) {
+    SeparationBias& b = g.separation_bias_;
+    int applied = 0;
+    if (!r.expect("separation_bias") || !r.real(b.estimate_m) || !r.real(b.tested_m) || !r.real(b.sigma_m) ||
+        !r.boundedInt(applied, 0, 1) || !r.boundedInt(b.closures, 0, std::numeric_limits<int>::max()))
+      return fail("bad separation_bias record");
+    if (!std::isfinite(b.estimate_m) || !std::isfinite(b.tested_m))
+      return fail("separation_bias record: the bias must be finite");
+    b.applied = applied == 1;
   }
   WindowStats& s = g.window_stats_;
   if (!r.expect("window")) return fail("bad window record");

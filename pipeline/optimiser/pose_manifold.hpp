@@ -103,6 +103,35 @@ struct RelativePoseError {
   }
 };
 
+// A loop closure whose measured B is moved along a fixed direction (A's frame) by a shared bias
+// parameter b: e = boxMinus(T_a^-1 T_b, Z'), Z' = (R_Z, t_Z + b u). The separation bias of
+// opposite-side closures (PoseGraphOptions::separation_bias_sigma_m).
+struct BiasedRelativePoseError {
+  sss::core::Pose measured;
+  Eigen::Vector3d direction;
+  sss::core::Matrix6d sqrt_information;
+
+  template <typename T>
+  bool operator()(const T* x_a, const T* x_b, const T* bias, T* residual) const {
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_a(x_a), t_b(x_b);
+    const Eigen::Map<const Eigen::Quaternion<T>> q_a(x_a + 3), q_b(x_b + 3);
+    const Eigen::Quaternion<T> q_a_inverse = q_a.conjugate();
+    const Eigen::Matrix<T, 3, 1> t_ab = q_a_inverse * (t_b - t_a);
+    const Eigen::Quaternion<T> q_ab = q_a_inverse * q_b;
+    const Eigen::Matrix<T, 3, 1> t_measured = measured.translation.cast<T>() + bias[0] * direction.cast<T>();
+    const Eigen::Matrix<T, 6, 1> e = detail::boxMinus<T>(t_ab, q_ab, t_measured, measured.rotation.cast<T>());
+    Eigen::Map<Eigen::Matrix<T, 6, 1>> whitened(residual);
+    whitened = sqrt_information.cast<T>() * e;
+    return true;
+  }
+
+  static ceres::CostFunction* create(const sss::core::Pose& measured, const Eigen::Vector3d& direction,
+                                     const sss::core::Matrix6d& sqrt_information) {
+    return new ceres::AutoDiffCostFunction<BiasedRelativePoseError, 6, kPoseAmbientSize, kPoseAmbientSize, 1>(
+        new BiasedRelativePoseError{measured, direction, sqrt_information});
+  }
+};
+
 // Error of an absolute pose prior: e = boxMinus(T, prior), whitened.
 struct PosePriorError {
   sss::core::Pose prior;

@@ -622,6 +622,12 @@ bool writeSummaryJson(const std::string& path, const OfflineRequest& request, co
   json.key("closures").value(static_cast<uint64_t>(s.variance_factors.closures));
   json.key("iterations").value(static_cast<uint64_t>(s.variance_factors.iterations));
   json.endObject();
+  json.key("separation_bias").beginObject();  // how much closer opposite-side closures put the lines
+  json.key("estimate_m").value(s.separation_bias.tested_m, 4);
+  json.key("sigma_m").value(s.separation_bias.sigma_m, 4);
+  json.key("applied").value(s.separation_bias.applied);
+  json.key("closures").value(static_cast<uint64_t>(s.separation_bias.closures));
+  json.endObject();
   json.key("lines").beginObject();
   json.key("survey_lines").value(s.survey_lines);
   json.key("turn_pings").value(s.buffer.builder.turn_pings);
@@ -948,6 +954,7 @@ bool Runner::writeOutputs(std::string& error) {
                                counters.closures_rejected_no_support;
   summary_.closures_superseded = counters.closures_superseded;
   summary_.variance_factors = optimiser_.graph().varianceFactors();
+  summary_.separation_bias = optimiser_.graph().separationBias();
 
   // Bathymetry: SLAM poses (the product) and DR poses (the baseline the map error is compared to).
   const auto& bathymetry = options_.optimiser.bathymetry;

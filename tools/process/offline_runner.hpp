@@ -67,6 +67,7 @@ struct OfflineSummary {
   // Factors on the closure and odometry covariances learnt from the residuals at the final
   // smoothing (1 when optimiser.graph.variance_component_iterations is 0).
   sss::optimiser::VarianceFactors variance_factors;
+  sss::optimiser::SeparationBias separation_bias;
   uint64_t seabed_points = 0;
   uint64_t input_faults = 0;       // corrupt records, bad messages, dropped pings
   // Where the pings went: the fusion's drops by cause and altitude sources, the line builder's.
