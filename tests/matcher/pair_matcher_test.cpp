@@ -64,6 +64,17 @@ void expectPairRecoversDrError(const PairCase& pair_case) {
   EXPECT_GT(dr_error.head<2>().norm(), 0.9 * std::hypot(pair_case.dr_along_m, pair_case.dr_lateral_m));
   EXPECT_LT(std::abs(error.x()), 0.3);
   EXPECT_LT(std::abs(error.y()), 0.3);
+  // The published covariance: covariance_scale calibrates the matches' model, the seabed relief
+  // term is added unscaled (a physical size), then the floors.
+  const sss::core::Matrix6d& relief = match.pose.relief_covariance;
+  EXPECT_GT(relief(1, 1), 0.0) << "the simulated seabed has relief under the lines";
+  for (int i = 0; i < 6; ++i) {
+    const double floor = i < 3 ? options.min_translation_sigma_m : options.min_rotation_sigma_rad;
+    const double expected = options.covariance_scale * match.pose.model_covariance(i, i) + relief(i, i);
+    if (expected > floor * floor) {
+      EXPECT_NEAR(match.pose.covariance(i, i), expected, 1e-9 * expected) << "row " << i;
+    }
+  }
 }
 
 TEST(PairMatcher, AntiParallelSimulatedPairRecovers3mAlongAnd2mLateralDrError) {
