@@ -172,6 +172,7 @@ void readPoseGraphOptions(sss::core::ConfigSection& section, PoseGraphOptions& o
   section.optional("variance_component_iterations", options.variance_component_iterations, {inRange(1, 100)});
   section.optional("separation_bias_sigma_m", options.separation_bias_sigma_m, {inRange(0.0, 100.0)});
   section.optional("separation_bias_min_lateral_m", options.separation_bias_min_lateral_m, {inRange(0.0, 10000.0)});
+  section.optional("separation_bias_apply", options.separation_bias_apply);
   section.optional("separation_bias_significance", options.separation_bias_significance, {inRange(0.0, 100.0)});
   section.optional("variance_factor_min", options.variance_factor_min, {inRange(1e-6, 1.0)});
   section.optional("variance_factor_max", options.variance_factor_max, {inRange(1.0, 1e6)});
@@ -782,10 +783,12 @@ bool SlidingWindowPoseGraph::solve(const std::vector<Factor>& factors, int max_i
     nodes_[n].estimate = normalisedPose(pose);
   }
   window_stats_.residual_blocks = problem.NumResidualBlocks();
+  if (estimate_separation_bias) {
+    separation_bias_.closures = biased_closures;
+    separation_bias_.sigma_m = std::numeric_limits<double>::quiet_NaN();
+  }
   if (estimate_separation_bias && biased_closures > 0 && std::isfinite(separation_bias_m)) {
     separation_bias_.estimate_m = separation_bias_.tested_m = separation_bias_m;
-    separation_bias_.applied = true;  // fullSmoothing() tests it
-    separation_bias_.closures = biased_closures;
     // Its sigma: the bias's marginal covariance (every node a variable at full smoothing).
     ceres::Covariance::Options covariance_options;
     covariance_options.algorithm_type = ceres::SPARSE_QR;
@@ -1010,16 +1013,30 @@ UpdateReport SlidingWindowPoseGraph::fullSmoothing() {
   const int boundary = first_active_;
   first_active_ = 0;
   const std::vector<Factor> factors = allFactors();
-  bool ok = solve(factors, options_.full_smoothing_max_iterations, report, options_.separation_bias_sigma_m > 0.0);
-  if (ok && separation_bias_.applied &&
-      !(std::abs(separation_bias_.tested_m) >= options_.separation_bias_significance * separation_bias_.sigma_m)) {
-    // Not significant: the closures are taken as they are, and solved again without it.
-    separation_bias_.estimate_m = 0.0;
-    separation_bias_.applied = false;
-    UpdateReport again;
-    ok = solve(factors, options_.full_smoothing_max_iterations, again);
-    report.iterations += again.iterations;
-    report.solve_s += again.solve_s;
+  bool ok = true;
+  if (options_.separation_bias_sigma_m > 0.0) {
+    // The separation bias as a variable. Kept only when significant and asked for; otherwise the
+    // graph is solved again from where it was, without it (its estimate stays as a diagnostic).
+    std::vector<Pose> start;
+    start.reserve(nodes_.size());
+    for (const Node& n : nodes_) start.push_back(n.estimate);
+    UpdateReport measured;
+    const bool estimated = solve(factors, options_.full_smoothing_max_iterations, measured, true);
+    report.iterations += measured.iterations;
+    report.solve_s += measured.solve_s;
+    // sigma_m is NaN when no opposite-side closure was accepted or the covariance failed.
+    separation_bias_.significant =
+        estimated && std::abs(separation_bias_.tested_m) >= options_.separation_bias_significance * separation_bias_.sigma_m;
+    separation_bias_.applied = separation_bias_.significant && options_.separation_bias_apply;
+    if (!separation_bias_.applied) {
+      for (size_t i = 0; i < nodes_.size(); ++i) nodes_[i].estimate = start[i];
+      separation_bias_.estimate_m = 0.0;
+      ok = solve(factors, options_.full_smoothing_max_iterations, report);
+    } else {
+      ok = estimated;
+    }
+  } else {
+    ok = solve(factors, options_.full_smoothing_max_iterations, report);
   }
   if (ok) reweighFromResiduals(factors, report);
   if (ok) {

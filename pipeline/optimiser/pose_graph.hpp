@@ -103,16 +103,19 @@ struct PoseGraphOptions {
   // covariance nor their consistency can. At full smoothing one bias for the whole survey is
   // estimated against DR with a zero-mean prior of this sigma; closures between parallel or
   // anti-parallel lines (relative heading within 30 deg) more than separation_bias_min_lateral_m
-  // apart are corrected by it (window updates use the last estimate). 0: off, the default.
+  // apart are corrected by it (window updates use the last estimate) when separation_bias_apply is
+  // set; otherwise it is only measured (a diagnostic solve whose estimate is discarded), so a run
+  // can say that its closures and DR disagree on the lines' separation. 0: neither.
   // The bias is applied only when the data say it is there: |estimate| at least
   // separation_bias_significance of its own sigma. Estimating it costs lateral accuracy (the
   // survey's width then rests on DR alone): on the synthetic lawnmower with truthful closures a
   // free bias of 0.1-0.4 +- 0.3 m per pair spreads the lines and doubles the ATE.
-  // Off by default because on a lawnmower it is confounded with DR: a DVL scale factor lengthens
+  // Not applied by default because on a lawnmower it is confounded with DR: a DVL scale factor lengthens
   // every turn between lines alike, which moves DR's line separations by the same amount (0.6 % of
   // a 157 m turn: 0.9 m), and the test then takes DR's error for the closures' (README, measured:
   // high-drift 1.72 -> 3.31 m). Absolute fixes or cross lines would tell the two apart.
-  double separation_bias_sigma_m = 0.0;
+  double separation_bias_sigma_m = 2.0;
+  bool separation_bias_apply = false;
   double separation_bias_min_lateral_m = 10.0;
   double separation_bias_significance = 3.0;
 
@@ -239,7 +242,8 @@ struct SeparationBias {
   double estimate_m = 0.0;  // applied to the closures (0 unless significant)
   double tested_m = 0.0;    // the last full smoothing's estimate, applied or not
   double sigma_m = std::numeric_limits<double>::quiet_NaN();  // of tested_m; NaN until estimated
-  bool applied = false;     // |tested_m| >= separation_bias_significance x sigma_m
+  bool significant = false; // |tested_m| >= separation_bias_significance x sigma_m
+  bool applied = false;     // significant and separation_bias_apply
   int closures = 0;         // accepted opposite-side closures at the last estimate
 };
 

@@ -105,6 +105,7 @@ std::string SlidingWindowPoseGraph::checkpointText() const {
   w.real(b.estimate_m);
   w.real(b.tested_m);
   w.real(b.sigma_m);
+  w.integer(b.significant ? 1 : 0);
   w.integer(b.applied ? 1 : 0);
   w.integer(b.closures);
   w.endLine();
@@ -246,10 +247,12 @@ Status SlidingWindowPoseGraph::restoreCheckpointText(const std::string& text) {
   }
   if (version >= 3) {
     SeparationBias& b = g.separation_bias_;
-    int applied = 0;
+    int significant = 0, applied = 0;
     if (!r.expect("separation_bias") || !r.real(b.estimate_m) || !r.real(b.tested_m) || !r.real(b.sigma_m) ||
-        !r.boundedInt(applied, 0, 1) || !r.boundedInt(b.closures, 0, std::numeric_limits<int>::max()))
+        !r.boundedInt(significant, 0, 1) || !r.boundedInt(applied, 0, 1) ||
+        !r.boundedInt(b.closures, 0, std::numeric_limits<int>::max()))
       return fail("bad separation_bias record");
+    b.significant = significant == 1;
     if (!std::isfinite(b.estimate_m) || !std::isfinite(b.tested_m))
       return fail("separation_bias record: the bias must be finite");
     b.applied = applied == 1;

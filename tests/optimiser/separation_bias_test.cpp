@@ -32,6 +32,7 @@ PoseGraphOptions withBias(PoseGraphOptions options) {
   options.odometry_random_walk_m_per_sqrt_m = 0.01;
   options.odometry_drift_fraction = 0.002;
   options.separation_bias_sigma_m = 2.0;
+  options.separation_bias_apply = true;
   return options;
 }
 
@@ -91,6 +92,26 @@ TEST(SeparationBias, ACommonShorteningOfOppositeSideClosuresIsEstimatedAndUndone
   }
 }
 
+// The default measures it and applies nothing: the bias is found significant, and the trajectory
+// is the one the graph gives without it, bit for bit.
+TEST(SeparationBias, ByDefaultItIsMeasuredNotApplied) {
+  const PoseGraphOptions defaults;
+  EXPECT_GT(defaults.separation_bias_sigma_m, 0.0);
+  EXPECT_FALSE(defaults.separation_bias_apply);
+  PoseGraphOptions off = withBias(graphOptions());
+  off.separation_bias_sigma_m = 0.0;
+  PoseGraphOptions measured = withBias(graphOptions());
+  measured.separation_bias_apply = false;
+  const synthetic::Mission biased = shortened(synthetic::makeLawnmowerMission(goodInsMission(3)), 1.5);
+  const Solved plain = smooth(biased, off);
+  const Solved diagnosed = smooth(biased, measured);
+  EXPECT_TRUE(diagnosed.bias.significant);
+  EXPECT_FALSE(diagnosed.bias.applied);
+  EXPECT_EQ(diagnosed.bias.estimate_m, 0.0);
+  EXPECT_NEAR(diagnosed.bias.tested_m, 1.5, 2.0 * diagnosed.bias.sigma_m);
+  EXPECT_EQ(diagnosed.ate_m, plain.ate_m);
+}
+
 // Truthful closures: the estimate is within 2 sigma of 0, is not significant and so is not applied:
 // the trajectory is that of the graph without it. (Applied, a free bias of 0.1-0.4 +- 0.3 m per pair
 // spread the lines and doubled the ATE on these seeds: hence the significance test.)
@@ -107,6 +128,7 @@ TEST(SeparationBias, TruthfulClosuresGiveNoBias) {
                 estimated.ate_m);
     EXPECT_LT(std::abs(estimated.bias.tested_m), 2.0 * estimated.bias.sigma_m) << "seed " << seed;
     EXPECT_FALSE(estimated.bias.applied) << "seed " << seed;
+    EXPECT_FALSE(estimated.bias.significant) << "seed " << seed;
     EXPECT_EQ(estimated.bias.estimate_m, 0.0);
     EXPECT_NEAR(estimated.ate_m, plain.ate_m, 0.01 * plain.ate_m) << "seed " << seed;
   }
@@ -139,6 +161,7 @@ TEST(SeparationBias, SurvivesACheckpointAndOlderCheckpointsRestoreWithout) {
   feed(graph, biased, 0, biased.nodes.size());
   ASSERT_TRUE(graph.fullSmoothing().ok);
   ASSERT_TRUE(graph.separationBias().applied);
+  ASSERT_TRUE(graph.separationBias().significant);
   const std::string text = graph.checkpointText();
   SlidingWindowPoseGraph restored(options);
   ASSERT_TRUE(restored.restoreCheckpointText(text).ok);
@@ -147,6 +170,7 @@ TEST(SeparationBias, SurvivesACheckpointAndOlderCheckpointsRestoreWithout) {
   EXPECT_EQ(restored.separationBias().sigma_m, graph.separationBias().sigma_m);
   EXPECT_EQ(restored.separationBias().closures, graph.separationBias().closures);
   EXPECT_TRUE(restored.separationBias().applied);
+  EXPECT_TRUE(restored.separationBias().significant);
 
   // The same state as version 2 wrote it: no separation_bias record.
   std::string version_2 = text;

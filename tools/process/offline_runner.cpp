@@ -484,6 +484,19 @@ std::vector<std::string> explainRun(const OfflineSummary& s, const Options& opti
                   strain);
     findings.push_back(text);
   }
+  // Opposite-side closures and DR disagree on how far apart the lines run, all pairs alike.
+  const sss::optimiser::SeparationBias& bias = s.separation_bias;
+  if (bias.significant && !bias.applied) {
+    char text[640];
+    std::snprintf(text, sizeof(text),
+                  "the closures between lines that look at their overlap from opposite sides put the lines %.2f m "
+                  "%s together than dead reckoning does (+- %.2f m, over %d closures, every pair alike): either raised "
+                  "features (rocks, boulders) show each line their near face and bias the matches, or dead reckoning's "
+                  "turns between lines are off (a DVL scale factor); cross lines or fixes tell the two apart. "
+                  "optimiser.graph.separation_bias_apply: true corrects the closures by it",
+                  std::abs(bias.tested_m), bias.tested_m > 0.0 ? "closer" : "further", bias.sigma_m, bias.closures);
+    findings.push_back(text);
+  }
   return findings;
 }
 
@@ -625,6 +638,7 @@ bool writeSummaryJson(const std::string& path, const OfflineRequest& request, co
   json.key("separation_bias").beginObject();  // how much closer opposite-side closures put the lines
   json.key("estimate_m").value(s.separation_bias.tested_m, 4);
   json.key("sigma_m").value(s.separation_bias.sigma_m, 4);
+  json.key("significant").value(s.separation_bias.significant);
   json.key("applied").value(s.separation_bias.applied);
   json.key("closures").value(static_cast<uint64_t>(s.separation_bias.closures));
   json.endObject();
