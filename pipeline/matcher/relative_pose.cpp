@@ -390,9 +390,9 @@ Solved solve(const std::vector<Measurement>& measurements, const std::vector<int
       covariance.GetCovarianceBlock(delta, delta, c.data());  // row-major; symmetric anyway
       out.covariance = 0.5 * (c + c.transpose());
     }
-    // The sandwich when asked for; the pose's sensitivity to a common seabed offset always (the
-    // relief term of the covariance needs it whichever covariance it is added to).
-    if (options.covariance_cluster_m > 0.0 || options.use_seabed_prior) {
+    // The sandwich when asked for; the pose's sensitivity to a common seabed offset whenever the
+    // relief term will use it (whichever covariance it is added to).
+    if (options.covariance_cluster_m > 0.0 || (options.use_seabed_prior && options.seabed_relief_covariance)) {
       const ClusterRobust cluster_robust =
           clusterRobustCovariance(measurements, subset, landmarks, &anchor, dr, sqrt_information, options, robust);
       out.per_seabed_offset = cluster_robust.per_seabed_offset;

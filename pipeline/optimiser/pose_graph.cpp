@@ -427,6 +427,10 @@ Matrix6d SlidingWindowPoseGraph::closureCovarianceInWindow(const Closure& c) con
   return sigma;
 }
 
+Matrix6d SlidingWindowPoseGraph::closureSqrtInformation(const Closure& c) const {
+  return c.sqrt_information / std::sqrt(variance_factors_.closure);
+}
+
 ceres::CostFunction* SlidingWindowPoseGraph::makeCost(const Factor& f) const {
   switch (f.kind) {
     case FactorKind::kFirstNode: {
@@ -446,7 +450,7 @@ ceres::CostFunction* SlidingWindowPoseGraph::makeCost(const Factor& f) const {
                                                                      std::sqrt(variance_factors_.odometry));
     case FactorKind::kClosure: {
       const Closure& c = closures_[f.index];
-      Matrix6d sqrt_information = c.sqrt_information / std::sqrt(variance_factors_.closure);
+      Matrix6d sqrt_information = closureSqrtInformation(c);
       if (!isActive(c.a) || !isActive(c.b)) {
         // Inflated covariance stays positive definite: a sum of a PD and a PSD matrix.
         Matrix6d inflated;
@@ -730,14 +734,15 @@ bool SlidingWindowPoseGraph::solve(const std::vector<Factor>& factors, int max_i
   for (const Factor& f : factors) {
     std::vector<double*> blocks;
     for (int n : factorNodes(f)) blocks.push_back(parameters[slot_of[n]].data());
+    // Full smoothing: every node is a variable, so the closure's own weight is the whole of it.
     if (estimate_separation_bias && f.kind == FactorKind::kClosure) {
       const Closure& c = closures_[f.index];
       const Eigen::Vector3d direction = separationDirection(c);
       if (direction.squaredNorm() > 0.0) {
-        Matrix6d sqrt_information = c.sqrt_information / std::sqrt(variance_factors_.closure);
         blocks.push_back(&separation_bias_m);
         problem.AddResidualBlock(
-            BiasedRelativePoseError::create(c.record.closure.T_a_b, direction, sqrt_information), makeLoss(f), blocks);
+            BiasedRelativePoseError::create(c.record.closure.T_a_b, direction, closureSqrtInformation(c)),
+            makeLoss(f), blocks);
         ++biased_closures;
         continue;
       }

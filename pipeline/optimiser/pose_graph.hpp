@@ -373,6 +373,8 @@ class SlidingWindowPoseGraph {
   ceres::CostFunction* makeCost(const Factor& factor) const;
   ceres::LossFunction* makeLoss(const Factor& factor) const;
   sss::core::Matrix6d closureCovarianceInWindow(const Closure& closure) const;
+  // The closure's own whitening with the current variance factor (no window inflation).
+  sss::core::Matrix6d closureSqrtInformation(const Closure& closure) const;
   bool linearise(const Factor& factor, LinearisedFactor& out) const;
 
   void decideClosures(UpdateReport& report);

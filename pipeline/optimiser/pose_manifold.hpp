@@ -85,16 +85,23 @@ struct RelativePoseError {
 
   template <typename T>
   bool operator()(const T* x_a, const T* x_b, T* residual) const {
+    whitenedRelativeError<T>(x_a, x_b, measured.translation.cast<T>(), measured, sqrt_information, residual);
+    return true;
+  }
+
+  // The residual of both functors: W boxMinus(T_a^-1 T_b, (R_Z, t_measured)).
+  template <typename T>
+  static void whitenedRelativeError(const T* x_a, const T* x_b, const Eigen::Matrix<T, 3, 1>& t_measured,
+                                    const sss::core::Pose& measured, const sss::core::Matrix6d& sqrt_information,
+                                    T* residual) {
     const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_a(x_a), t_b(x_b);
     const Eigen::Map<const Eigen::Quaternion<T>> q_a(x_a + 3), q_b(x_b + 3);
     const Eigen::Quaternion<T> q_a_inverse = q_a.conjugate();
     const Eigen::Matrix<T, 3, 1> t_ab = q_a_inverse * (t_b - t_a);
     const Eigen::Quaternion<T> q_ab = q_a_inverse * q_b;
-    const Eigen::Matrix<T, 6, 1> e =
-        detail::boxMinus<T>(t_ab, q_ab, measured.translation.cast<T>(), measured.rotation.cast<T>());
+    const Eigen::Matrix<T, 6, 1> e = detail::boxMinus<T>(t_ab, q_ab, t_measured, measured.rotation.cast<T>());
     Eigen::Map<Eigen::Matrix<T, 6, 1>> whitened(residual);
     whitened = sqrt_information.cast<T>() * e;
-    return true;
   }
 
   static ceres::CostFunction* create(const sss::core::Pose& measured, const sss::core::Matrix6d& sqrt_information) {
@@ -113,15 +120,8 @@ struct BiasedRelativePoseError {
 
   template <typename T>
   bool operator()(const T* x_a, const T* x_b, const T* bias, T* residual) const {
-    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_a(x_a), t_b(x_b);
-    const Eigen::Map<const Eigen::Quaternion<T>> q_a(x_a + 3), q_b(x_b + 3);
-    const Eigen::Quaternion<T> q_a_inverse = q_a.conjugate();
-    const Eigen::Matrix<T, 3, 1> t_ab = q_a_inverse * (t_b - t_a);
-    const Eigen::Quaternion<T> q_ab = q_a_inverse * q_b;
     const Eigen::Matrix<T, 3, 1> t_measured = measured.translation.cast<T>() + bias[0] * direction.cast<T>();
-    const Eigen::Matrix<T, 6, 1> e = detail::boxMinus<T>(t_ab, q_ab, t_measured, measured.rotation.cast<T>());
-    Eigen::Map<Eigen::Matrix<T, 6, 1>> whitened(residual);
-    whitened = sqrt_information.cast<T>() * e;
+    RelativePoseError::whitenedRelativeError<T>(x_a, x_b, t_measured, measured, sqrt_information, residual);
     return true;
   }
 
