@@ -128,7 +128,7 @@ std::vector<std::string> validatePoseGraphOptions(const PoseGraphOptions& o) {
   if (!(o.separation_bias_sigma_m >= 0.0)) problems.push_back("separation_bias_sigma_m must be >= 0 (0: off)");
   if (!(o.separation_bias_min_lateral_m >= 0.0)) problems.push_back("separation_bias_min_lateral_m must be >= 0");
   if (!(o.separation_bias_significance >= 0.0))
-    problems.push_back("separation_bias_significance must be >= 0 (sigmas; 0: always applied)");
+    problems.push_back("separation_bias_significance must be >= 0 (sigmas; 0: always significant)");
   positive(o.variance_factor_min, "variance_factor_min");
   positive(o.variance_factor_max, "variance_factor_max");
   if (o.variance_factor_min > 1.0 || o.variance_factor_max < 1.0)
@@ -788,8 +788,9 @@ bool SlidingWindowPoseGraph::solve(const std::vector<Factor>& factors, int max_i
     nodes_[n].estimate = normalisedPose(pose);
   }
   window_stats_.residual_blocks = problem.NumResidualBlocks();
-  if (estimate_separation_bias) {
+  if (estimate_separation_bias) {  // no stale figures from an earlier smoothing
     separation_bias_.closures = biased_closures;
+    separation_bias_.tested_m = 0.0;
     separation_bias_.sigma_m = std::numeric_limits<double>::quiet_NaN();
   }
   if (estimate_separation_bias && biased_closures > 0 && std::isfinite(separation_bias_m)) {
