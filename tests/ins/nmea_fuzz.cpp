@@ -1,5 +1,7 @@
-// libFuzzer target for the INS NMEA path (stream parser + sentence parser + assembler + encoder).
+// libFuzzer target for the INS NMEA path (stream parser + sentence parser + assembler + encoder)
+// and the position fix reader (GGA/GST/ZDA/RMC).
 // Also linked into nmea_fuzz_regression_test, which replays the corpus with any compiler.
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -9,6 +11,7 @@
 #include "drivers/ins/ins_state_assembler.hpp"
 #include "drivers/ins/ixblue_nmea.hpp"
 #include "drivers/ins/nmea_stream_parser.hpp"
+#include "drivers/ins/position_fix.hpp"
 
 namespace {
 
@@ -64,6 +67,23 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     check(reparser.rejectedSentences() == 0 && reparser.counters().garbage_bytes == 0);
     for (int64_t rejected : reassembler.counters().rejected) check(rejected == 0);
     check(reassembled == 1);
+  }
+
+  // Position fixes: whatever is accepted is a finite position on Earth with a positive sigma, and
+  // the same bytes in two pieces give the same fixes.
+  PositionFixReader fix_reader;
+  fix_reader.feed(std::string_view(reinterpret_cast<const char*>(data), size));
+  const std::vector<PositionFix> fixes = fix_reader.finish();
+  PositionFixReader fix_pieces;
+  fix_pieces.feed(std::string_view(reinterpret_cast<const char*>(data), split));
+  fix_pieces.feed(std::string_view(reinterpret_cast<const char*>(data) + split, size - split));
+  check(fix_pieces.finish().size() == fixes.size());
+  check(fix_reader.counters().fixes == fixes.size());
+  for (const PositionFix& fix : fixes) {
+    check(std::abs(fix.latitude_deg) <= 90.0 && std::abs(fix.longitude_deg) <= 180.0);
+    check(fix.sigma_north_m > 0.0 && fix.sigma_east_m > 0.0 && std::isfinite(fix.sigma_north_m) &&
+          std::isfinite(fix.sigma_east_m));
+    check(fix.seconds_of_day >= 0.0 && fix.seconds_of_day < 86401.0);
   }
   return 0;
 }

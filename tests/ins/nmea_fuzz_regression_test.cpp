@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "drivers/ins/ixblue_nmea.hpp"
+#include "drivers/ins/position_fix.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size);
 
@@ -49,6 +50,38 @@ TEST(NmeaFuzzRegression, SurvivesGeneratedMutationsOfValidBursts) {
   }
   std::mt19937 random(12345);  // fixed seed: the same mutations on every run
   const char interesting[] = {'$', '*', ',', '\r', '\n', '\0', '-', '.', '9', 'A', '\x80'};
+  for (int round = 0; round < 2000; ++round) {
+    std::string bytes = base;
+    const int edits = 1 + static_cast<int>(random() % 8);
+    for (int e = 0; e < edits && !bytes.empty(); ++e) {
+      const size_t at = random() % bytes.size();
+      switch (random() % 4) {
+        case 0: bytes[at] = static_cast<char>(random() & 0xFF); break;
+        case 1: bytes[at] = interesting[random() % sizeof(interesting)]; break;
+        case 2: bytes.erase(at, 1 + random() % 16); break;
+        case 3: bytes.insert(at, bytes.substr(random() % bytes.size(), random() % 64)); break;
+      }
+    }
+    run(bytes);
+  }
+}
+
+TEST(NmeaFuzzRegression, SurvivesGeneratedMutationsOfFixStreams) {
+  PositionFix fix;
+  fix.utime_us = 1780300800000000;
+  fix.latitude_deg = 59.35;
+  fix.longitude_deg = 18.07;
+  fix.sigma_north_m = 0.9;
+  fix.sigma_east_m = 1.1;
+  fix.quality = 1;
+  fix.hdop = 0.9;
+  std::string base;
+  for (int i = 0; i < 3; ++i) {
+    fix.utime_us += 1000000;
+    base += encodePositionFix(fix, i == 1 ? "U0" : "GP");
+  }
+  std::mt19937 random(4242);  // fixed seed: the same mutations on every run
+  const char interesting[] = {'$', '*', ',', '\r', '\n', '\0', '-', '.', '9', 'N', 'S', 'E', 'W', '\x80'};
   for (int round = 0; round < 2000; ++round) {
     std::string bytes = base;
     const int edits = 1 + static_cast<int>(random() % 8);
