@@ -129,6 +129,7 @@ std::vector<std::string> validatePoseGraphOptions(const PoseGraphOptions& o) {
   if (!(o.separation_bias_min_lateral_m >= 0.0)) problems.push_back("separation_bias_min_lateral_m must be >= 0");
   if (!(o.separation_bias_significance >= 0.0))
     problems.push_back("separation_bias_significance must be >= 0 (sigmas; 0: always significant)");
+  positive(o.fix_gate_chi2, "fix_gate_chi2");
   positive(o.variance_factor_min, "variance_factor_min");
   positive(o.variance_factor_max, "variance_factor_max");
   if (o.variance_factor_min > 1.0 || o.variance_factor_max < 1.0)
@@ -174,6 +175,7 @@ void readPoseGraphOptions(sss::core::ConfigSection& section, PoseGraphOptions& o
   section.optional("separation_bias_min_lateral_m", options.separation_bias_min_lateral_m, {inRange(0.0, 10000.0)});
   section.optional("separation_bias_apply", options.separation_bias_apply);
   section.optional("separation_bias_significance", options.separation_bias_significance, {inRange(0.0, 100.0)});
+  section.optional("fix_gate_chi2", options.fix_gate_chi2, {greaterThan(0.0)});
   section.optional("variance_factor_min", options.variance_factor_min, {inRange(1e-6, 1.0)});
   section.optional("variance_factor_max", options.variance_factor_max, {inRange(1.0, 1e6)});
   section.optional("degraded_after_s", options.degraded_after_s, {greaterThan(0.0)});
@@ -322,6 +324,81 @@ Status SlidingWindowPoseGraph::addLoopClosure(const LoopClosure& closure) {
   return Status::success();
 }
 
+Status SlidingWindowPoseGraph::addFix(const AbsoluteFix& fix) {
+  ++fix_counters_.received;
+  auto refuse = [&](const std::string& why) {
+    ++fix_counters_.refused;
+    return Status::error("fix at " + std::to_string(fix.utime_us) + " us: " + why);
+  };
+  if (!fix.position_ne_m.allFinite() || !fix.dr_position_m.allFinite() || !std::isfinite(fix.dr_distance_m))
+    return refuse("position, DR position or distance is not finite; fix dropped");
+  const Eigen::Matrix2d covariance = 0.5 * (fix.covariance_m2 + fix.covariance_m2.transpose());
+  const Eigen::LLT<Eigen::Matrix2d> llt(covariance);
+  if (!covariance.allFinite() || llt.info() != Eigen::Success || !(covariance.determinant() > 0.0))
+    return refuse("covariance is not finite and positive definite; fix dropped");
+  Fix f;
+  f.record.fix = fix;
+  f.record.fix.covariance_m2 = covariance;
+  fixes_.push_back(std::move(f));
+  return Status::success();
+}
+
+bool SlidingWindowPoseGraph::tieFix(Fix& f, int n) const {
+  const Node& node = nodes_[n];
+  f.node = n;
+  f.record.subframe_id = node.id;
+  f.p_body = node.dr.inverse() * f.record.fix.dr_position_m;
+  // The DR between the node and the fix drifts like any odometry edge of that length.
+  const double dr_variance =
+      odometryCovariance(options_, std::abs(f.record.fix.dr_distance_m - node.distance_m))(0, 0);
+  const Eigen::Matrix2d covariance = f.record.fix.covariance_m2 + dr_variance * Eigen::Matrix2d::Identity();
+  const Eigen::LLT<Eigen::Matrix2d> llt(covariance);
+  if (llt.info() != Eigen::Success) return false;
+  f.sqrt_information = llt.matrixL().solve(Eigen::Matrix2d::Identity());
+  return f.sqrt_information.allFinite();
+}
+
+void SlidingWindowPoseGraph::decideFixes(bool final) {
+  if (nodes_.empty()) return;
+  for (int index = 0; index < static_cast<int>(fixes_.size()); ++index) {
+    Fix& f = fixes_[index];
+    if (f.node < 0) {
+      // The node nearest in time, once the fix lies between two nodes (or at the end of the mission).
+      const int64_t t = f.record.fix.utime_us;
+      const auto after = std::lower_bound(nodes_.begin(), nodes_.end(), t,
+                                          [](const Node& n, int64_t time) { return n.utime_us < time; });
+      if (after == nodes_.end() && !final) continue;
+      int n = static_cast<int>(after - nodes_.begin());
+      if (after == nodes_.end() || (n > 0 && t - nodes_[n - 1].utime_us < after->utime_us - t)) --n;
+      n = std::clamp(n, 0, static_cast<int>(nodes_.size()) - 1);
+      if (!tieFix(f, n)) {
+        f.record.status = FixStatus::kRejected;  // cannot happen for a validated covariance
+        continue;
+      }
+      nodes_[n].fixes.push_back(index);
+    }
+    if (f.record.status != FixStatus::kPending) continue;
+    // Gate: innovation against the node's estimate carried to the fix, with the node's covariance.
+    const Node& node = nodes_[f.node];
+    const Eigen::Matrix3d rotation = node.estimate.rotation.toRotationMatrix();
+    const Eigen::Vector2d predicted = (node.estimate * f.p_body).head<2>();
+    const Eigen::Vector2d innovation = f.record.fix.position_ne_m - predicted;
+    Eigen::Matrix<double, 2, 6> jacobian;  // d predicted / d [dt, dr] (right perturbation)
+    Eigen::Matrix3d skew;
+    skew << 0, -f.p_body.z(), f.p_body.y(), f.p_body.z(), 0, -f.p_body.x(), -f.p_body.y(), f.p_body.x(), 0;
+    jacobian.leftCols<3>() = rotation.topRows<2>();
+    jacobian.rightCols<3>() = -(rotation * skew).topRows<2>();
+    const Eigen::Matrix2d fix_covariance = (f.sqrt_information.transpose() * f.sqrt_information).inverse();
+    const Matrix6d node_covariance = node.has_covariance ? node.covariance : Matrix6d::Zero();
+    const Eigen::Matrix2d s = jacobian * node_covariance * jacobian.transpose() + fix_covariance;
+    f.record.innovation_chi2 = innovation.dot(s.ldlt().solve(innovation));
+    const bool accepted = std::isfinite(f.record.innovation_chi2) && f.record.innovation_chi2 <= options_.fix_gate_chi2;
+    f.record.status = accepted ? FixStatus::kAccepted : FixStatus::kRejected;
+    ++(accepted ? fix_counters_.accepted : fix_counters_.rejected_gate);
+    if (accepted) newest_accepted_fix_utime_us_ = std::max(newest_accepted_fix_utime_us_, f.record.fix.utime_us);
+  }
+}
+
 void SlidingWindowPoseGraph::setStatus(Closure& c, ClosureStatus status, ClosureRejection rejection) {
   auto counter = [&](ClosureStatus s, ClosureRejection r) -> uint64_t* {
     switch (s) {
@@ -373,6 +450,8 @@ std::vector<SlidingWindowPoseGraph::Factor> SlidingWindowPoseGraph::windowFactor
       const int first_active_end = isActive(c.a) && isActive(c.b) ? std::min(c.a, c.b) : (isActive(c.a) ? c.a : c.b);
       if (first_active_end == k) factors.push_back({FactorKind::kClosure, index});
     }
+    for (int index : nodes_[k].fixes)
+      if (fixes_[index].record.status == FixStatus::kAccepted) factors.push_back({FactorKind::kFix, index});
   }
   return factors;
 }
@@ -387,6 +466,8 @@ std::vector<SlidingWindowPoseGraph::Factor> SlidingWindowPoseGraph::allFactors()
   for (int k = 1; k < n; ++k) factors.push_back({FactorKind::kOdometry, k});
   for (int index = 0; index < static_cast<int>(closures_.size()); ++index)
     if (closures_[index].record.status == ClosureStatus::kAccepted) factors.push_back({FactorKind::kClosure, index});
+  for (int index = 0; index < static_cast<int>(fixes_.size()); ++index)
+    if (fixes_[index].record.status == FixStatus::kAccepted) factors.push_back({FactorKind::kFix, index});
   return factors;
 }
 
@@ -401,6 +482,8 @@ std::vector<SlidingWindowPoseGraph::Factor> SlidingWindowPoseGraph::factorsTouch
     if (c.record.status == ClosureStatus::kAccepted && !c.record.marginalised)
       factors.push_back({FactorKind::kClosure, index});
   }
+  for (int index : nodes_[m].fixes)
+    if (fixes_[index].record.status == FixStatus::kAccepted) factors.push_back({FactorKind::kFix, index});
   return factors;
 }
 
@@ -411,6 +494,7 @@ std::vector<int> SlidingWindowPoseGraph::factorNodes(const Factor& f) const {
     case FactorKind::kOdometry: return {f.index - 1, f.index};
     case FactorKind::kClosure: return {closures_[f.index].a, closures_[f.index].b};
     case FactorKind::kPrior: return prior_.nodes;
+    case FactorKind::kFix: return {fixes_[f.index].node};
   }
   return {};
 }
@@ -463,12 +547,16 @@ ceres::CostFunction* SlidingWindowPoseGraph::makeCost(const Factor& f) const {
     }
     case FactorKind::kPrior:
       return new MarginalPriorCost(prior_.linearisation, prior_.jacobian, prior_.residual);
+    case FactorKind::kFix: {
+      const Fix& fix = fixes_[f.index];
+      return PositionFixError::create(fix.p_body, fix.record.fix.position_ne_m, fix.sqrt_information);
+    }
   }
   return nullptr;
 }
 
 ceres::LossFunction* SlidingWindowPoseGraph::makeLoss(const Factor& f) const {
-  if (f.kind != FactorKind::kClosure) return nullptr;
+  if (f.kind != FactorKind::kClosure && f.kind != FactorKind::kFix) return nullptr;
   if (options_.robust_loss == "cauchy") return new ceres::CauchyLoss(options_.robust_loss_scale);
   if (options_.robust_loss == "huber") return new ceres::HuberLoss(options_.robust_loss_scale);
   return nullptr;
@@ -992,6 +1080,7 @@ UpdateReport SlidingWindowPoseGraph::optimize() {
   UpdateReport report;
   if (nodes_.empty()) return report;
   decideClosures(report);
+  decideFixes(false);
   const std::vector<Factor> factors = windowFactors();
   refreshWindowStats(factors);
   solve(factors, options_.max_iterations, report);
@@ -1015,6 +1104,7 @@ UpdateReport SlidingWindowPoseGraph::fullSmoothing() {
   UpdateReport report;
   if (nodes_.empty()) return report;
   decideClosures(report);
+  decideFixes(true);
   // Every node is a variable: solve with the window boundary at the first node.
   const int boundary = first_active_;
   first_active_ = 0;
@@ -1101,6 +1191,17 @@ std::vector<ClosureRecord> SlidingWindowPoseGraph::closures() const {
   return out;
 }
 
+std::vector<FixRecord> SlidingWindowPoseGraph::fixes() const {
+  std::vector<FixRecord> out;
+  out.reserve(fixes_.size());
+  for (const Fix& f : fixes_) {
+    FixRecord record = f.record;
+    if (f.node >= 0) record.residual_ne_m = record.fix.position_ne_m - (nodes_[f.node].estimate * f.p_body).head<2>();
+    out.push_back(record);
+  }
+  return out;
+}
+
 Correction SlidingWindowPoseGraph::correctionAt(int64_t utime_us) const {
   Correction out;
   out.update_utime_us = update_utime_us_;
@@ -1140,10 +1241,13 @@ Correction SlidingWindowPoseGraph::correctionAt(int64_t utime_us) const {
   }
   const Matrix6d node_covariance = reference->has_covariance ? reference->covariance : 1e6 * Matrix6d::Identity();
   out.covariance = node_covariance + odometryCovariance(options_, std::abs(distance_m - reference->distance_m));
-  if (counters_.closures_accepted == 0 || newest_accepted_closure_utime_us_ < 0) {
+  // Corrected by closures or fixes; degraded when the newest of them is old.
+  const int64_t newest_closure_us = counters_.closures_accepted > 0 ? newest_accepted_closure_utime_us_ : -1;
+  const int64_t newest_us = std::max(newest_closure_us, newest_accepted_fix_utime_us_);
+  if (newest_us < 0) {
     out.status = CorrectionStatus::kDrOnly;
   } else {
-    const double age_s = 1e-6 * static_cast<double>(utime_us - newest_accepted_closure_utime_us_);
+    const double age_s = 1e-6 * static_cast<double>(utime_us - newest_us);
     out.status = age_s > options_.degraded_after_s ? CorrectionStatus::kDegraded : CorrectionStatus::kCorrected;
   }
   return out;

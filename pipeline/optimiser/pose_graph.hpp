@@ -119,6 +119,14 @@ struct PoseGraphOptions {
   double separation_bias_min_lateral_m = 10.0;
   double separation_bias_significance = 3.0;
 
+  // ---- absolute position fixes (GNSS at the surface, USBL) ------------------------------------------
+  // A fix is a horizontal position with its covariance, tied to the node nearest in time through the
+  // DR displacement between the node and the fix (whose drift over that distance adds the odometry
+  // model's covariance). Like a closure it must pass a chi-square gate of its innovation against the
+  // node's current estimate and covariance (2 dof: 13.82 = 99.9 %), so an outlying USBL fix does not
+  // pull the survey, and it enters the solve under the closures' robust loss.
+  double fix_gate_chi2 = 13.82;
+
   int variance_component_iterations = 20;
   double variance_factor_min = 0.1;
   double variance_factor_max = 100.0;
@@ -148,6 +156,36 @@ struct LoopClosure {
   int association_round = 0;  // a newer round of the same pair supersedes the older closure
   int num_inliers = 0;
   double total_cost = 0.0;
+};
+
+// An absolute horizontal position fix in the local NED world (GNSS at the surface, USBL).
+struct AbsoluteFix {
+  int64_t utime_us = 0;
+  Eigen::Vector2d position_ne_m = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d covariance_m2 = Eigen::Matrix2d::Identity();  // north/east
+  // DR position and distance travelled at the fix time, from the navigation the nodes come from: the
+  // fix is tied to its node through the DR displacement between them.
+  Eigen::Vector3d dr_position_m = Eigen::Vector3d::Zero();
+  double dr_distance_m = 0.0;
+  std::string source = "gnss";  // "gnss" or "usbl" (reported)
+};
+
+enum class FixStatus { kPending, kAccepted, kRejected };
+
+struct FixRecord {
+  AbsoluteFix fix;
+  FixStatus status = FixStatus::kPending;
+  int64_t subframe_id = -1;   // the node it is tied to; -1 until a node at or after its time exists
+  double innovation_chi2 = std::numeric_limits<double>::quiet_NaN();  // at the gate
+  // After the solve: the fix less the node's estimate carried to the fix time (north, east), m.
+  Eigen::Vector2d residual_ne_m = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+};
+
+struct FixCounters {
+  uint64_t received = 0;
+  uint64_t refused = 0;       // not finite, covariance not positive definite, no navigation
+  uint64_t accepted = 0;
+  uint64_t rejected_gate = 0;
 };
 
 enum class ClosureStatus { kPending, kAccepted, kRejected, kSuperseded };
@@ -277,6 +315,10 @@ class SlidingWindowPoseGraph {
   // closure to a marginalised node acts through that node held constant (see pose_graph.cpp); one
   // between two marginalised nodes only counts in fullSmoothing().
   Status addLoopClosure(const LoopClosure& closure);
+  // Queues an absolute fix: it waits for a node at or after its time (full smoothing ties the rest
+  // to the newest node), then the next update gates it. Refused when not finite or the covariance
+  // is not positive definite.
+  Status addFix(const AbsoluteFix& fix);
 
   // Decides pending closures, solves the window, marginalises nodes beyond window_size and
   // updates the covariances. Never throws on field data.
@@ -294,6 +336,8 @@ class SlidingWindowPoseGraph {
   std::optional<NodeState> newestNode() const;  // O(1)
   size_t numNodes() const { return nodes_.size(); }
   std::vector<ClosureRecord> closures() const;  // in arrival order
+  std::vector<FixRecord> fixes() const;         // in arrival order, with residuals at the estimate
+  const FixCounters& fixCounters() const { return fix_counters_; }
   const PoseGraphCounters& counters() const { return counters_; }
   const WindowStats& windowStats() const { return window_stats_; }
   const VarianceFactors& varianceFactors() const { return variance_factors_; }
@@ -334,6 +378,14 @@ class SlidingWindowPoseGraph {
     // of this node relative to the window it stayed tied to.
     sss::core::Matrix6d conditional_covariance = sss::core::Matrix6d::Zero();
     std::vector<int> closures;  // indices into closures_ of closures touching this node
+    std::vector<int> fixes;     // indices into fixes_ of the fixes tied to this node
+  };
+
+  struct Fix {
+    FixRecord record;
+    int node = -1;                                      // index; -1 until tied
+    Eigen::Vector3d p_body = Eigen::Vector3d::Zero();   // DR position at the fix time, node's DR frame
+    Eigen::Matrix2d sqrt_information = Eigen::Matrix2d::Identity();  // fix + DR between node and fix
   };
 
   struct Closure {
@@ -351,10 +403,10 @@ class SlidingWindowPoseGraph {
     bool empty() const { return nodes.empty(); }
   };
 
-  enum class FactorKind { kFirstNode, kInsAbsolute, kOdometry, kClosure, kPrior };
+  enum class FactorKind { kFirstNode, kInsAbsolute, kOdometry, kClosure, kPrior, kFix };
   struct Factor {
     FactorKind kind;
-    int index;  // node (first node, INS absolute; odometry: the newer node) or closure index
+    int index;  // node (first node, INS absolute; odometry: the newer node), closure or fix index
   };
 
   struct LinearisedFactor {
@@ -378,6 +430,10 @@ class SlidingWindowPoseGraph {
   bool linearise(const Factor& factor, LinearisedFactor& out) const;
 
   void decideClosures(UpdateReport& report);
+  // Ties waiting fixes to their node (all of them when final), then gates the tied, pending ones.
+  void decideFixes(bool final);
+  // Ties fix f to node n: its body-frame offset and whitening (also used by the checkpoint).
+  bool tieFix(Fix& f, int n) const;
   bool passesGate(const Closure& closure, const Eigen::MatrixXd& covariance, const std::vector<int>& slot) const;
   bool pairConsistent(const Closure& i, const Closure& j) const;
   sss::core::Matrix6d chainCovariance(int from, int to) const;
@@ -406,6 +462,9 @@ class SlidingWindowPoseGraph {
   std::vector<Node> nodes_;
   std::unordered_map<int64_t, int> index_of_;
   std::vector<Closure> closures_;
+  std::vector<Fix> fixes_;
+  FixCounters fix_counters_;
+  int64_t newest_accepted_fix_utime_us_ = -1;
   std::map<std::pair<int64_t, int64_t>, int> latest_for_pair_;  // (smaller id, larger id) -> closure
   std::map<std::pair<int, int>, bool> pcm_cache_;               // pair consistency within the horizon
   int pcm_horizon_start_ = 0;  // closures before it are decided for good

@@ -21,7 +21,8 @@ namespace {
 constexpr const char* kMagic = "sss-pose-graph-checkpoint";
 // 2 adds the variance factors; a version 1 file (before them) restores with factors of 1.
 // 3 adds the separation bias; older files restore without one (0, not applied).
-constexpr int kVersion = 3;
+// 4 adds the absolute fixes; older files restore without any.
+constexpr int kVersion = 4;
 constexpr size_t kMaxFileBytes = size_t{1} << 31;  // 2 GiB: far above any mission
 
 using checkpoint::TextReader;
@@ -109,6 +110,26 @@ std::string SlidingWindowPoseGraph::checkpointText() const {
   w.integer(b.applied ? 1 : 0);
   w.integer(b.closures);
   w.endLine();
+  w.word("fixes");
+  w.integer(static_cast<int64_t>(fixes_.size()));
+  w.integer(newest_accepted_fix_utime_us_);
+  for (uint64_t v : {fix_counters_.received, fix_counters_.refused, fix_counters_.accepted, fix_counters_.rejected_gate})
+    w.unsignedInteger(v);
+  w.endLine();
+  for (const Fix& f : fixes_) {
+    const AbsoluteFix& x = f.record.fix;
+    w.word("fix");
+    w.integer(x.utime_us);
+    w.word(x.source == "usbl" ? "usbl" : "gnss");
+    w.matrix(x.position_ne_m);
+    w.matrix(x.covariance_m2);
+    w.matrix(x.dr_position_m);
+    w.real(x.dr_distance_m);
+    w.integer(static_cast<int>(f.record.status));
+    w.integer(f.node);
+    w.real(f.record.innovation_chi2);
+    w.endLine();
+  }
   const WindowStats& s = window_stats_;
   w.word("window");
   for (int v : {s.active_nodes, s.variable_blocks, s.constant_blocks, s.residual_blocks, s.prior_nodes, s.prior_rows,
@@ -256,6 +277,40 @@ Status SlidingWindowPoseGraph::restoreCheckpointText(const std::string& text) {
     if (!std::isfinite(b.estimate_m) || !std::isfinite(b.tested_m))
       return fail("separation_bias record: the bias must be finite");
     b.applied = applied == 1;
+  }
+  if (version >= 4) {
+    int64_t num_fixes = 0;
+    FixCounters& k4 = g.fix_counters_;
+    if (!r.expect("fixes") || !r.integer(num_fixes) || !r.integer(g.newest_accepted_fix_utime_us_) ||
+        !r.unsignedInteger(k4.received) || !r.unsignedInteger(k4.refused) || !r.unsignedInteger(k4.accepted) ||
+        !r.unsignedInteger(k4.rejected_gate) || num_fixes < 0 ||
+        static_cast<uint64_t>(num_fixes) > r.remainingRecords(20))
+      return fail("bad fixes record");
+    for (int64_t i = 0; i < num_fixes; ++i) {
+      Fix f;
+      AbsoluteFix& x = f.record.fix;
+      std::string source;
+      Eigen::MatrixXd position, covariance, dr_position;
+      int status = 0, node = -1;
+      if (!r.expect("fix") || !r.integer(x.utime_us) || !r.token(source) || !r.matrix(position, 2, 1) ||
+          !r.matrix(covariance, 2, 2) || !r.matrix(dr_position, 3, 1) || !r.finite(x.dr_distance_m) ||
+          !r.boundedInt(status, 0, 2) || !r.boundedInt(node, -1, num_nodes - 1) || !r.real(f.record.innovation_chi2))
+        return fail("bad fix record " + std::to_string(i));
+      if (source != "gnss" && source != "usbl") return fail("fix record " + std::to_string(i) + ": unknown source");
+      x.source = source;
+      x.position_ne_m = position.col(0);
+      x.covariance_m2 = covariance;
+      x.dr_position_m = dr_position.col(0);
+      f.record.status = static_cast<FixStatus>(status);
+      const Eigen::LLT<Eigen::Matrix2d> llt(x.covariance_m2);
+      if (!x.position_ne_m.allFinite() || !x.dr_position_m.allFinite() || llt.info() != Eigen::Success)
+        return fail("fix record " + std::to_string(i) + " is not finite or its covariance not positive definite");
+      if (node >= 0) {
+        if (!g.tieFix(f, node)) return fail("fix record " + std::to_string(i) + " cannot be tied to its node");
+        g.nodes_[node].fixes.push_back(static_cast<int>(g.fixes_.size()));
+      }
+      g.fixes_.push_back(std::move(f));
+    }
   }
   WindowStats& s = g.window_stats_;
   if (!r.expect("window")) return fail("bad window record");

@@ -178,6 +178,30 @@ struct InsAbsoluteError {
   }
 };
 
+// An absolute horizontal position fix of a point fixed in a node's body frame (the DR position at
+// the fix time): e = W ((R p_body + t)_ne - fix_ne), W^T W = Sigma^-1 (2 x 2).
+struct PositionFixError {
+  Eigen::Vector3d p_body;
+  Eigen::Vector2d fix_ne;
+  Eigen::Matrix2d sqrt_information;
+
+  template <typename T>
+  bool operator()(const T* x, T* residual) const {
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t(x);
+    const Eigen::Map<const Eigen::Quaternion<T>> q(x + 3);
+    const Eigen::Matrix<T, 3, 1> p_world = q * p_body.cast<T>() + t;
+    Eigen::Map<Eigen::Matrix<T, 2, 1>> whitened(residual);
+    whitened = sqrt_information.cast<T>() * (p_world.template head<2>() - fix_ne.cast<T>());
+    return true;
+  }
+
+  static ceres::CostFunction* create(const Eigen::Vector3d& p_body, const Eigen::Vector2d& fix_ne,
+                                     const Eigen::Matrix2d& sqrt_information) {
+    return new ceres::AutoDiffCostFunction<PositionFixError, 2, kPoseAmbientSize>(
+        new PositionFixError{p_body, fix_ne, sqrt_information});
+  }
+};
+
 // The marginalisation prior: r = r0 + J [boxMinus(x_1, x_lin_1); ...; boxMinus(x_k, x_lin_k)],
 // a Gaussian on the tangent spaces at the linearisation points (Schur complement, see pose_graph.cpp).
 class MarginalPriorCost final : public ceres::CostFunction {

@@ -1,0 +1,240 @@
+// Absolute position fixes in the pose graph (SlidingWindowPoseGraph::addFix): GNSS at the start and
+// the end of a drifting lawnmower, USBL with outliers, a fix between nodes, checkpoints and refusals.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <random>
+
+#include "pipeline/optimiser/pose_graph.hpp"
+#include "pipeline/optimiser/synthetic_mission.hpp"
+#include "tests/optimiser/pose_graph_test_helpers.hpp"
+
+namespace sss::optimiser {
+namespace {
+
+using namespace test_helpers;
+
+// A fix of node i's true position with noise of sigma_m per axis, tied through its DR.
+AbsoluteFix fixAt(const synthetic::Node& node, double sigma_m, std::mt19937_64& random, const char* source = "gnss") {
+  std::normal_distribution<double> gauss(0.0, sigma_m);
+  AbsoluteFix fix;
+  fix.utime_us = node.utime_us;
+  fix.position_ne_m = node.truth.translation.head<2>() + Eigen::Vector2d(gauss(random), gauss(random));
+  fix.covariance_m2 = sigma_m * sigma_m * Eigen::Matrix2d::Identity();
+  fix.dr_position_m = node.dr.translation;
+  fix.dr_distance_m = node.distance_m;
+  fix.source = source;
+  return fix;
+}
+
+double error(const SlidingWindowPoseGraph& graph, const synthetic::Mission& mission, size_t node) {
+  return (graph.nodes()[node].T_world_body.translation - mission.nodes[node].truth.translation).head<2>().norm();
+}
+
+// Feeds the mission node by node with its closures (when asked) and the fixes due at each node.
+void feedWithFixes(SlidingWindowPoseGraph& graph, const synthetic::Mission& mission, bool closures,
+                   const std::vector<std::pair<size_t, AbsoluteFix>>& fixes) {
+  for (size_t i = 0; i < mission.nodes.size(); ++i) {
+    const synthetic::Node& n = mission.nodes[i];
+    ASSERT_TRUE(graph.addNode(n.subframe_id, n.utime_us, n.dr, n.distance_m).ok);
+    for (const synthetic::Closure& c : mission.closures) {
+      if (closures && c.newer_node == static_cast<int>(i)) {
+        ASSERT_TRUE(graph.addLoopClosure(c.closure).ok);
+      }
+    }
+    for (const auto& [node, fix] : fixes) {
+      if (node == i) {
+        ASSERT_TRUE(graph.addFix(fix).ok);
+      }
+    }
+    ASSERT_TRUE(graph.optimize().ok);
+  }
+  ASSERT_TRUE(graph.fullSmoothing().ok);
+}
+
+// GNSS (1 m) at the dive and at the surfacing: the end, where DR drifted furthest, comes back to
+// within the fix's accuracy, and over the seeds the survey is better than with closures alone (on
+// one mission the fixes' own noise may outweigh what they add to a start already known exactly).
+TEST(PositionFixGraph, GnssAtStartAndEndBoundsTheDrift) {
+  double sum_closures = 0.0, sum_fixes = 0.0;
+  for (uint64_t seed = 1; seed <= 4; ++seed) {
+    const synthetic::Mission mission = synthetic::makeLawnmowerMission(missionOptions(seed));
+    const size_t last = mission.nodes.size() - 1;
+    std::mt19937_64 random(seed * 77);
+    const std::vector<std::pair<size_t, AbsoluteFix>> fixes = {{0, fixAt(mission.nodes[0], 1.0, random)},
+                                                               {last, fixAt(mission.nodes[last], 1.0, random)}};
+    SlidingWindowPoseGraph closures_only(graphOptions());
+    feedWithFixes(closures_only, mission, true, {});
+    SlidingWindowPoseGraph with_fixes(graphOptions());
+    feedWithFixes(with_fixes, mission, true, fixes);
+    SlidingWindowPoseGraph fixes_only(graphOptions());
+    feedWithFixes(fixes_only, mission, false, fixes);
+
+    const double ate_dr = synthetic::translationRmse(synthetic::drPoses(mission), mission.nodes);
+    const double ate_closures = synthetic::translationRmse(estimates(closures_only), mission.nodes);
+    const double ate_fixes = synthetic::translationRmse(estimates(with_fixes), mission.nodes);
+    const double ate_dr_fixed = synthetic::translationRmse(estimates(fixes_only), mission.nodes);
+    std::printf("seed %llu: ATE DR %.2f, DR + fixes %.2f, closures %.2f, closures + fixes %.2f m; end %.2f -> %.2f m\n",
+                static_cast<unsigned long long>(seed), ate_dr, ate_dr_fixed, ate_closures, ate_fixes,
+                (mission.nodes[last].dr.translation - mission.nodes[last].truth.translation).head<2>().norm(),
+                error(with_fixes, mission, last));
+    EXPECT_EQ(with_fixes.fixCounters().accepted, 2u);
+    EXPECT_LT(error(with_fixes, mission, last), 3.0);  // 1 m per axis: 3 sigma of the 2-D error
+    sum_closures += ate_closures;
+    sum_fixes += ate_fixes;
+    EXPECT_LT(ate_dr_fixed, 0.4 * ate_dr);
+    for (const FixRecord& r : with_fixes.fixes()) {
+      EXPECT_EQ(r.status, FixStatus::kAccepted);
+      EXPECT_LT(r.residual_ne_m.norm(), 3.0);
+    }
+    EXPECT_EQ(with_fixes.correctionAt(mission.nodes[last].utime_us).status, CorrectionStatus::kCorrected);
+    EXPECT_EQ(fixes_only.correctionAt(mission.nodes[last].utime_us).status, CorrectionStatus::kCorrected);
+  }
+  EXPECT_LT(sum_fixes, sum_closures);
+}
+
+// USBL (1 m) at every node with one in five 15-40 m off: the gate refuses every outlier, keeps
+// nearly every good fix, and the estimate follows the good ones.
+TEST(PositionFixGraph, UsblOutliersAreRejectedByTheGate) {
+  for (uint64_t seed = 1; seed <= 4; ++seed) {
+    const synthetic::Mission mission = synthetic::makeLawnmowerMission(missionOptions(seed));
+    std::mt19937_64 random(seed * 991);
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    std::vector<std::pair<size_t, AbsoluteFix>> fixes;
+    std::vector<bool> outlier;
+    for (size_t i = 0; i < mission.nodes.size(); ++i) {
+      AbsoluteFix fix = fixAt(mission.nodes[i], 1.0, random, "usbl");
+      const bool bad = i % 5 == 2;
+      if (bad) {
+        const double distance_m = 15.0 + 25.0 * uniform(random), angle = 2.0 * M_PI * uniform(random);
+        fix.position_ne_m += distance_m * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+      }
+      fixes.push_back({i, fix});
+      outlier.push_back(bad);
+    }
+    SlidingWindowPoseGraph graph(graphOptions());
+    feedWithFixes(graph, mission, true, fixes);
+    const std::vector<FixRecord> records = graph.fixes();
+    ASSERT_EQ(records.size(), fixes.size());
+    int good_accepted = 0, good = 0;
+    for (size_t i = 0; i < records.size(); ++i) {
+      if (outlier[i]) {
+        EXPECT_EQ(records[i].status, FixStatus::kRejected) << "outlier " << i << " chi2 " << records[i].innovation_chi2;
+      } else {
+        ++good;
+        good_accepted += records[i].status == FixStatus::kAccepted;
+      }
+    }
+    const double ate = synthetic::translationRmse(estimates(graph), mission.nodes);
+    std::printf("seed %llu: USBL good fixes accepted %d of %d, outliers rejected %llu; ATE %.2f m\n",
+                static_cast<unsigned long long>(seed), good_accepted, good,
+                static_cast<unsigned long long>(graph.fixCounters().rejected_gate), ate);
+    EXPECT_GE(good_accepted, good - 1);
+    EXPECT_LT(ate, 1.0);  // sixteen 1 m fixes and the closures
+  }
+}
+
+// A fix half way between two nodes ties to the nearer one through DR and pulls the survey to it.
+TEST(PositionFixGraph, FixBetweenNodesTiesToTheNearestThroughDr) {
+  const synthetic::Mission mission = synthetic::makeLawnmowerMission(missionOptions(3));
+  const size_t last = mission.nodes.size() - 1;
+  const synthetic::Node& a = mission.nodes[last - 1];
+  const synthetic::Node& b = mission.nodes[last];
+  AbsoluteFix fix;
+  fix.utime_us = a.utime_us + (b.utime_us - a.utime_us) * 7 / 10;  // nearer b
+  fix.position_ne_m = (0.3 * a.truth.translation + 0.7 * b.truth.translation).head<2>();
+  fix.covariance_m2 = 0.25 * Eigen::Matrix2d::Identity();
+  fix.dr_position_m = 0.3 * a.dr.translation + 0.7 * b.dr.translation;  // same line: straight
+  fix.dr_distance_m = 0.3 * a.distance_m + 0.7 * b.distance_m;
+  SlidingWindowPoseGraph graph(graphOptions());
+  feedWithFixes(graph, mission, false, {{last - 1, fix}});
+  const std::vector<FixRecord> records = graph.fixes();
+  ASSERT_EQ(records.size(), 1u);
+  EXPECT_EQ(records[0].subframe_id, b.subframe_id);
+  EXPECT_EQ(records[0].status, FixStatus::kAccepted);
+  EXPECT_LT(records[0].residual_ne_m.norm(), 0.5);
+  EXPECT_LT(error(graph, mission, last), 1.0);
+}
+
+// The fixes and their decisions survive a checkpoint; the restored graph goes on identically.
+TEST(PositionFixGraph, CheckpointCarriesTheFixes) {
+  const synthetic::Mission mission = synthetic::makeLawnmowerMission(missionOptions(2));
+  std::mt19937_64 random(5);
+  SlidingWindowPoseGraph graph(graphOptions());
+  const size_t half = mission.nodes.size() / 2;
+  for (size_t i = 0; i < half; ++i) {
+    const synthetic::Node& n = mission.nodes[i];
+    ASSERT_TRUE(graph.addNode(n.subframe_id, n.utime_us, n.dr, n.distance_m).ok);
+    ASSERT_TRUE(graph.addFix(fixAt(n, 1.0, random, i % 2 ? "usbl" : "gnss")).ok);
+    ASSERT_TRUE(graph.optimize().ok);
+  }
+  AbsoluteFix waiting = fixAt(mission.nodes[half], 1.0, random);  // no node at its time yet
+  ASSERT_TRUE(graph.addFix(waiting).ok);
+  const std::string path = (std::filesystem::temp_directory_path() / "position_fix_graph_checkpoint.txt").string();
+  ASSERT_TRUE(graph.saveCheckpoint(path).ok);
+  SlidingWindowPoseGraph restored(graphOptions());
+  ASSERT_TRUE(restored.loadCheckpoint(path).ok);
+  std::filesystem::remove(path);
+  ASSERT_EQ(restored.fixes().size(), graph.fixes().size());
+  EXPECT_EQ(restored.fixCounters().accepted, graph.fixCounters().accepted);
+  for (size_t i = 0; i < graph.fixes().size(); ++i) {
+    EXPECT_EQ(restored.fixes()[i].status, graph.fixes()[i].status);
+    EXPECT_EQ(restored.fixes()[i].subframe_id, graph.fixes()[i].subframe_id);
+    EXPECT_EQ(restored.fixes()[i].fix.source, graph.fixes()[i].fix.source);
+  }
+  EXPECT_EQ(restored.fixes().back().subframe_id, -1);
+
+  // Version 3 (before fixes) restores without any.
+  SlidingWindowPoseGraph no_fixes(graphOptions());
+  {
+    SlidingWindowPoseGraph plain(graphOptions());
+    for (size_t i = 0; i < half; ++i) {
+      const synthetic::Node& n = mission.nodes[i];
+      ASSERT_TRUE(plain.addNode(n.subframe_id, n.utime_us, n.dr, n.distance_m).ok);
+      ASSERT_TRUE(plain.optimize().ok);
+    }
+    std::string version_3 = plain.checkpointText();
+    const std::string header = "sss-pose-graph-checkpoint 4";
+    ASSERT_EQ(version_3.rfind(header, 0), 0u);
+    version_3.replace(0, header.size(), "sss-pose-graph-checkpoint 3");
+    const size_t record = version_3.find("\nfixes ");
+    ASSERT_NE(record, std::string::npos);
+    version_3.erase(record, version_3.find('\n', record + 1) - record);
+    const Status status = no_fixes.restoreCheckpointText(version_3);
+    ASSERT_TRUE(status.ok) << status.message;
+    EXPECT_TRUE(no_fixes.fixes().empty());
+    EXPECT_EQ(no_fixes.nodes().size(), half);
+  }
+  for (SlidingWindowPoseGraph* g : {&graph, &restored}) {
+    for (size_t i = half; i < mission.nodes.size(); ++i) {
+      const synthetic::Node& n = mission.nodes[i];
+      ASSERT_TRUE(g->addNode(n.subframe_id, n.utime_us, n.dr, n.distance_m).ok);
+      ASSERT_TRUE(g->optimize().ok);
+    }
+    ASSERT_TRUE(g->fullSmoothing().ok);
+  }
+  const auto a = estimates(graph), b = estimates(restored);
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].translation, b[i].translation) << i;
+}
+
+TEST(PositionFixGraph, BadFixesAreRefusedWithTheReason) {
+  SlidingWindowPoseGraph graph(graphOptions());
+  AbsoluteFix fix;
+  fix.position_ne_m.x() = std::nan("");
+  Status status = graph.addFix(fix);
+  EXPECT_FALSE(status.ok);
+  EXPECT_NE(status.message.find("not finite"), std::string::npos) << status.message;
+  fix = AbsoluteFix();
+  fix.covariance_m2 << 1.0, 2.0, 2.0, 1.0;  // indefinite
+  status = graph.addFix(fix);
+  EXPECT_FALSE(status.ok);
+  EXPECT_NE(status.message.find("positive definite"), std::string::npos) << status.message;
+  EXPECT_EQ(graph.fixCounters().refused, 2u);
+  EXPECT_EQ(graph.fixCounters().received, 2u);
+  EXPECT_TRUE(graph.fixes().empty());
+}
+
+}  // namespace
+}  // namespace sss::optimiser
