@@ -173,6 +173,13 @@ Status OptimiserEngine::addLoopClosure(const sss::matcher::LoopClosure& closure)
   return addToGraph(closure);
 }
 
+Status OptimiserEngine::addFix(AbsoluteFix fix) {
+  fix.dr_distance_m += odometer_offset_m_;
+  const Status added = graph_.addFix(fix);
+  if (added.ok) new_input_ = true;
+  return added;
+}
+
 Status OptimiserEngine::addToGraph(const sss::matcher::LoopClosure& closure) {
   LoopClosure edge;
   edge.subframe_id_a = closure.subframe_id_a;

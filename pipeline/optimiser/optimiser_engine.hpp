@@ -88,6 +88,10 @@ class OptimiserEngine {
   // A closure from the matcher. One naming a subframe not seen yet waits (bounded) for it.
   Status addLoopClosure(const sss::matcher::LoopClosure& closure);
 
+  // An absolute position fix (GNSS, USBL) with the DR position and distance at its time, in the
+  // navigation's own distance (the odometer offset is added here, as for subframes).
+  Status addFix(AbsoluteFix fix);
+
   // Decides pending closures and solves the window (see SlidingWindowPoseGraph::optimize).
   UpdateReport update();
   // End of mission: full smoothing over all nodes.

@@ -785,4 +785,120 @@ TEST_F(OfflineRunnerTest, TruncatedSonarFileIsProcessedUpToTheCut) {
   EXPECT_LT(result.summary.pings, 700u);
 }
 
+// A survey flown as real ones are: GNSS at the surface before the dive and after the last line,
+// USBL every 30 s from a ship (10 % lost, 5 % outliers 10-50 m off), and a DR that drifts
+// (drift x3). Fixes bound the drift (DR + fixes beats DR), SLAM with the fixes beats both, no
+// outlier is accepted, the same fixes without dates give the same run, and USBL fixes taken for
+// GNSS (gnss: prefix) are ignored under water with a finding that says so.
+TEST_F(OfflineRunnerTest, GnssAndUsblFixesBoundTheDriftAndNoOutlierIsAccepted) {
+  const std::string command = std::string(SSS_SIM_PATH) + " --out " + root_ + "/fixes_mission --lines 3" +
+                              " --line-length-m 200 --line-spacing-m 50 --seed 5 --drift-scale 3 --gnss-fixes start-end" +
+                              " --usbl-period-s 30 > " + root_ + "/fixes_sim.log 2>&1";
+  ASSERT_EQ(std::system(command.c_str()), 0) << "sss-sim failed, see " << root_ << "/fixes_sim.log";
+  const std::string mission = root_ + "/fixes_mission";
+  auto r = request("fixes_run");
+  r.sonar_path = mission + "/sonar.jsf";
+  r.ins_path = mission + "/ins.nmea";
+  r.fix_paths = {mission + "/fixes.nmea"};
+  r.write_mosaics = false;
+  const auto result = sss::offline::runOffline(r);
+  ASSERT_TRUE(result.ok) << result.error;
+  const sss::offline::FixSummary& f = result.summary.fixes;
+  EXPECT_EQ(f.files, 1u);
+  EXPECT_GE(f.gnss, 6u);   // 20 s at the surface at either end, one every 5 s
+  EXPECT_GE(f.usbl, 10u);  // ~25 of 30 s over a ~15 min dive
+  EXPECT_EQ(f.read, f.gnss + f.usbl);
+  EXPECT_EQ(f.below_surface, 0u);
+  EXPECT_EQ(f.outside_navigation, 0u);
+  EXPECT_EQ(f.fed, f.read);
+  EXPECT_EQ(f.accepted + f.rejected_gate, f.fed);
+  EXPECT_TRUE(fs::is_regular_file(r.out_dir + "/fixes.csv"));
+  ASSERT_TRUE(fs::is_regular_file(r.out_dir + "/dead_reckoning_fixed.tum"));
+
+  // No accepted fix lies more than 5 m from the truth (the outliers are 10-50 m off).
+  const auto truth = sss::eval::readTum(mission + "/ground_truth.tum");
+  ASSERT_TRUE(truth.ok);
+  const auto dr = sss::eval::readTum(r.out_dir + "/dead_reckoning.tum");
+  ASSERT_TRUE(dr.ok && !dr.poses.empty());
+  // The run's frame is the INS's first position; the truth's the mission origin: the offset between
+  // them is the first DR pose's (DR starts at the truth).
+  const Eigen::Vector2d frame_offset = (dr.poses.front().T_world_body.translation - truth.poses.front().T_world_body.translation).head<2>();
+  std::istringstream csv(readFile(r.out_dir + "/fixes.csv"));
+  std::string line;
+  int accepted_checked = 0, outliers_rejected = 0;
+  while (std::getline(csv, line)) {
+    if (line.empty() || line[0] == '#' || line.rfind("utime_us", 0) == 0) continue;
+    std::vector<std::string> fields;
+    std::stringstream split(line);
+    for (std::string field; std::getline(split, field, ',');) fields.push_back(field);
+    ASSERT_GE(fields.size(), 11u) << line;
+    const int64_t utime = std::stoll(fields[0]);
+    const auto nearest = std::min_element(truth.poses.begin(), truth.poses.end(), [&](const auto& a, const auto& b) {
+      return std::llabs(a.utime_us - utime) < std::llabs(b.utime_us - utime);
+    });
+    const Eigen::Vector2d fix(std::stod(fields[2]), std::stod(fields[3]));
+    const double error_m = (fix - frame_offset - nearest->T_world_body.translation.head<2>()).norm();
+    if (fields[6] == "accepted") {
+      EXPECT_LT(error_m, 5.0) << "accepted fix " << line;
+      ++accepted_checked;
+    } else if (error_m > 9.0) {
+      ++outliers_rejected;
+    }
+  }
+  EXPECT_EQ(accepted_checked, static_cast<int>(f.accepted));
+
+  const double ate_dr = horizontalAte(r.out_dir + "/dead_reckoning.tum", "fixes_mission");
+  const double ate_fixed = horizontalAte(r.out_dir + "/dead_reckoning_fixed.tum", "fixes_mission");
+  const double ate_slam = horizontalAte(r.out_dir + "/slam.tum", "fixes_mission");
+  std::printf("fixes: %llu GNSS + %llu USBL, %llu accepted, %llu rejected (%d far outliers); ATE DR %.3f, DR + fixes %.3f, "
+              "SLAM + fixes %.3f m\n",
+              static_cast<unsigned long long>(f.gnss), static_cast<unsigned long long>(f.usbl),
+              static_cast<unsigned long long>(f.accepted), static_cast<unsigned long long>(f.rejected_gate),
+              outliers_rejected, ate_dr, ate_fixed, ate_slam);
+  EXPECT_LT(ate_fixed, 0.7 * ate_dr);
+  EXPECT_LT(ate_slam, ate_fixed);
+
+  // The same fixes without ZDA: dated from the navigation's day, the same run.
+  {
+    std::istringstream in(readFile(mission + "/fixes.nmea"));
+    std::ofstream out(root_ + "/undated.nmea");
+    for (std::string sentence; std::getline(in, sentence);)
+      if (sentence.find("ZDA") == std::string::npos) out << sentence << "\n";
+  }
+  auto undated = r;
+  undated.out_dir = root_ + "/fixes_undated";
+  undated.fix_paths = {root_ + "/undated.nmea"};
+  const auto undated_result = sss::offline::runOffline(undated);
+  ASSERT_TRUE(undated_result.ok) << undated_result.error;
+  EXPECT_EQ(undated_result.summary.fixes.accepted, f.accepted);
+  EXPECT_EQ(readFile(undated.out_dir + "/slam.tum"), readFile(r.out_dir + "/slam.tum"));
+
+  // USBL taken for GNSS: every one under water, ignored, and the finding names the cause.
+  {
+    std::istringstream in(readFile(mission + "/fixes.nmea"));
+    std::ofstream out(root_ + "/usbl_only.nmea");
+    for (std::string sentence; std::getline(in, sentence);)
+      if (sentence.rfind("$II", 0) == 0) out << sentence << "\n";
+  }
+  auto as_gnss = r;
+  as_gnss.out_dir = root_ + "/fixes_as_gnss";
+  as_gnss.fix_paths = {"gnss:" + root_ + "/usbl_only.nmea"};
+  const auto as_gnss_result = sss::offline::runOffline(as_gnss);
+  ASSERT_TRUE(as_gnss_result.ok) << as_gnss_result.error;
+  EXPECT_EQ(as_gnss_result.summary.fixes.below_surface, as_gnss_result.summary.fixes.read);
+  EXPECT_EQ(as_gnss_result.summary.fixes.fed, 0u);
+  bool named = false;
+  for (const std::string& finding : as_gnss_result.summary.findings)
+    named = named || finding.find("gnss_max_depth_m") != std::string::npos;
+  EXPECT_TRUE(named) << "a finding must say why the GNSS fixes were ignored";
+
+  // A fix file that does not exist is bad input, named.
+  auto missing = r;
+  missing.out_dir = root_ + "/fixes_missing";
+  missing.fix_paths = {root_ + "/no_such_fixes.nmea"};
+  const auto missing_result = sss::offline::runOffline(missing);
+  EXPECT_EQ(missing_result.exit_code, 2);
+  EXPECT_NE(missing_result.error.find("no_such_fixes.nmea"), std::string::npos) << missing_result.error;
+}
+
 }  // namespace

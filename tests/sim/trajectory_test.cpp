@@ -213,5 +213,56 @@ TEST(Trajectory, CrossPatternIsContinuousWithPerpendicularLinesAcrossTheBlock) {
   }
 }
 
+// Surfacing for GNSS fixes: a lead-in at the surface and a dive before the first line, the mirror
+// after the last; "lines" also comes up half way through each turn. The survey lines themselves are
+// flown at altitude as without surfacing, and the velocity follows the dive and the climb.
+TEST(Trajectory, SurfacesForGnssFixesOutsideTheSurveyLines) {
+  const Seabed bed = flatBed();
+  TrajectoryOptions plain;
+  plain.lines = 3;
+  plain.line_length_m = 200.0;
+  plain.line_spacing_m = 60.0;
+  const Trajectory without(plain, &bed);
+  for (const char* mode : {"start", "start-end", "lines"}) {
+    SCOPED_TRACE(mode);
+    TrajectoryOptions options = plain;
+    options.surface = mode;
+    const Trajectory trajectory(options, &bed);
+    const double lead_m = options.surface_hold_m + options.surface_ramp_m;
+    const bool at_end = std::string(mode) != "start";
+    EXPECT_NEAR(trajectory.lengthM(), without.lengthM() + (at_end ? 2.0 : 1.0) * lead_m, 1e-6);
+    EXPECT_NEAR(trajectory.sample(0.0).T_world_body.translation.z(), options.surface_depth_m, 1e-9);
+    EXPECT_NEAR(trajectory.sample(10.0).T_world_body.translation.z(), options.surface_depth_m, 1e-9);  // 20 m held
+    if (at_end) {
+      EXPECT_NEAR(trajectory.sample(trajectory.durationS()).T_world_body.translation.z(), options.surface_depth_m, 1e-9);
+    }
+    // Survey lines at altitude, where they were.
+    for (double d = 5.0; d < 200.0; d += 20.0) {
+      const TrajectorySample on_line = trajectory.sample((lead_m + d) / options.speed_m_s);
+      const TrajectorySample reference = without.sample(d / plain.speed_m_s);
+      EXPECT_EQ(on_line.line_index, 0);
+      EXPECT_NEAR(on_line.altitude_m, 18.0, 0.31) << d;
+      EXPECT_LT((on_line.T_world_body.translation - reference.T_world_body.translation).head<2>().norm(), 1e-6) << d;
+    }
+    // The dive: smooth, and the velocity is the motion of the pose.
+    for (double t = 1.0; t < lead_m / options.speed_m_s; t += 3.1) {
+      const TrajectorySample a = trajectory.sample(t), b = trajectory.sample(t + 0.1), c = trajectory.sample(t + 0.05);
+      const Eigen::Vector3d finite = (b.T_world_body.translation - a.T_world_body.translation) / 0.1;
+      EXPECT_LT((c.velocity_world_m_s - finite).norm(), 0.01) << t;
+    }
+    // "lines": at the surface half way through the first turn.
+    const double turn_middle_m = lead_m + 200.0 + 0.5 * M_PI * 30.0;
+    const double turn_depth = trajectory.sample(turn_middle_m / options.speed_m_s).T_world_body.translation.z();
+    if (std::string(mode) == "lines") {
+      EXPECT_NEAR(turn_depth, options.surface_depth_m, 1e-9);
+    } else {
+      EXPECT_GT(turn_depth, 20.0);
+    }
+  }
+  TrajectoryOptions bad = plain;
+  bad.surface = "sometimes";
+  EXPECT_THROW(Trajectory(bad, &bed), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace sss::sim

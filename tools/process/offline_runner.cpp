@@ -14,6 +14,7 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -25,6 +26,7 @@
 #include "drivers/ins/ins_bridge.hpp"
 #include "drivers/ins/nav_message.hpp"
 #include "drivers/ins/nmea_gga.hpp"
+#include "drivers/ins/position_fix.hpp"
 #include "drivers/xtf/xtf_reader.hpp"
 #include "pipeline/core/config.hpp"
 #include "pipeline/core/geodesy.hpp"
@@ -71,6 +73,12 @@ struct Options {
   sss::matcher::MatcherEngineOptions matcher;
   sss::optimiser::OptimiserEngineOptions optimiser;
   sss::subframe::PictureOptions pictures;
+  // Section `fixes`: how fix files are read, and the depth above which a GNSS fix is real (the
+  // antenna is out of the water only at the surface; below, a receiver reports stale or no fixes).
+  sss::ins::FixReaderOptions fix_reader;
+  double gnss_max_depth_m = 1.0;
+  // A fix this far outside the navigation's time span has no DR position to tie it to.
+  double fix_max_extrapolation_s = 2.0;
 };
 
 // The library keys of each process's section; keys only a live process uses (ports, channels)
@@ -92,6 +100,19 @@ bool readOptions(const std::string& path, Options& options, std::string& error) 
     sss::matcher::readMatcherEngineOptions(matcher, options.matcher);
     ConfigSection optimiser = config.section("optimiser");
     sss::optimiser::readOptimiserEngineOptions(optimiser, options.optimiser);
+    {
+      ConfigSection fixes = config.section("fixes");
+      fixes.optional("gnss_max_depth_m", options.gnss_max_depth_m, {atLeast(0.0)});
+      fixes.optional("max_extrapolation_s", options.fix_max_extrapolation_s, {atLeast(0.0)});
+      fixes.optional("gnss_sigma_per_hdop_m", options.fix_reader.gnss_sigma_per_hdop_m, {greaterThan(0.0)});
+      fixes.optional("dgnss_sigma_per_hdop_m", options.fix_reader.dgnss_sigma_per_hdop_m, {greaterThan(0.0)});
+      fixes.optional("rtk_fixed_sigma_per_hdop_m", options.fix_reader.rtk_fixed_sigma_per_hdop_m, {greaterThan(0.0)});
+      fixes.optional("rtk_float_sigma_per_hdop_m", options.fix_reader.rtk_float_sigma_per_hdop_m, {greaterThan(0.0)});
+      fixes.optional("missing_hdop", options.fix_reader.missing_hdop, {greaterThan(0.0)});
+      fixes.optional("usbl_default_sigma_m", options.fix_reader.usbl_default_sigma_m, {greaterThan(0.0)});
+      fixes.optional("min_sigma_m", options.fix_reader.min_sigma_m, {greaterThan(0.0)});
+      fixes.rejectUnknownKeys();
+    }
     if (!config.ok()) {
       error = "invalid configuration " + path + ": " + config.problemReport();
       return false;
@@ -500,6 +521,54 @@ std::vector<std::string> explainRun(const OfflineSummary& s, const Options& opti
   return findings;
 }
 
+// One line each for fixes that were given but not used, naming the cause and the fix.
+std::vector<std::string> explainFixes(const FixSummary& f, const Options& options) {
+  std::vector<std::string> findings;
+  if (f.files == 0) return findings;
+  char text[640];
+  if (f.read == 0) {
+    std::snprintf(text, sizeof text,
+                  "the %llu fix file(s) hold no usable fix (GGA sentences with a fix; %llu sentences skipped%s%s)",
+                  static_cast<unsigned long long>(f.files), static_cast<unsigned long long>(f.sentences_skipped),
+                  f.first_problem.empty() ? "" : ", first: ", f.first_problem.c_str());
+    findings.push_back(text);
+    return findings;
+  }
+  if (f.no_frame > 0) {
+    std::snprintf(text, sizeof text,
+                  "%llu fixes not used: the mission frame is the sonar file's projected grid without a CRS, so "
+                  "latitude/longitude fixes cannot be placed in it; give the INS file (--ins) or configure "
+                  "mission.origin_latitude_deg/origin_longitude_deg",
+                  static_cast<unsigned long long>(f.no_frame));
+    findings.push_back(text);
+  }
+  if (f.outside_navigation > 0) {
+    std::snprintf(text, sizeof text,
+                  "%llu of %llu fixes fall outside the navigation's time span (more than %.1f s before it starts or "
+                  "after it ends): check that the fix file belongs to this mission and its dates (files without "
+                  "ZDA/RMC are dated from the navigation's first day)",
+                  static_cast<unsigned long long>(f.outside_navigation), static_cast<unsigned long long>(f.read),
+                  options.fix_max_extrapolation_s);
+    findings.push_back(text);
+  }
+  if (f.below_surface > 0 && f.below_surface == f.gnss) {
+    std::snprintf(text, sizeof text,
+                  "all %llu GNSS fixes came while the vehicle was deeper than fixes.gnss_max_depth_m (%.1f m) and were "
+                  "ignored (a receiver under water reports stale positions); if they are the ship's USBL, name the file "
+                  "usbl:PATH",
+                  static_cast<unsigned long long>(f.below_surface), options.gnss_max_depth_m);
+    findings.push_back(text);
+  }
+  if (f.fed > 0 && f.accepted == 0) {
+    std::snprintf(text, sizeof text,
+                  "none of the %llu fixes given to the optimiser was accepted (%llu rejected by the gate against "
+                  "dead reckoning; see fixes.csv): fixes and navigation disagree, check the fixes' datum and time",
+                  static_cast<unsigned long long>(f.fed), static_cast<unsigned long long>(f.rejected_gate));
+    findings.push_back(text);
+  }
+  return findings;
+}
+
 // ---- outputs -----------------------------------------------------------------------------------
 
 const char* statusName(sss::optimiser::ClosureStatus status) {
@@ -642,6 +711,22 @@ bool writeSummaryJson(const std::string& path, const OfflineRequest& request, co
   json.key("applied").value(s.separation_bias.applied);
   json.key("closures").value(static_cast<uint64_t>(s.separation_bias.closures));
   json.endObject();
+  json.key("fixes").beginObject();  // absolute fixes (--fixes): what was read and what became of it
+  json.key("files").value(s.fixes.files);
+  json.key("read").value(s.fixes.read);
+  json.key("gnss").value(s.fixes.gnss);
+  json.key("usbl").value(s.fixes.usbl);
+  json.key("sentences_skipped").value(s.fixes.sentences_skipped);
+  json.key("first_problem").value(s.fixes.first_problem);
+  json.key("below_surface").value(s.fixes.below_surface);
+  json.key("outside_navigation").value(s.fixes.outside_navigation);
+  json.key("no_geographic_frame").value(s.fixes.no_frame);
+  json.key("fed").value(s.fixes.fed);
+  json.key("accepted").value(s.fixes.accepted);
+  json.key("rejected_gate").value(s.fixes.rejected_gate);
+  json.key("refused").value(s.fixes.refused);
+  json.key("rms_residual_m").value(s.fixes.rms_residual_m, 4);
+  json.endObject();
   json.key("lines").beginObject();
   json.key("survey_lines").value(s.survey_lines);
   json.key("turn_pings").value(s.buffer.builder.turn_pings);
@@ -733,6 +818,15 @@ class Runner {
     if (nav.origin && !origin_) origin_ = nav.origin;  // the frame every output is written in
     buffer_.addNav(nav, subframes_);
     handleSubframes();
+    if (nav.position_valid && (nav_history_.empty() || nav.utime_us > nav_history_.back().utime_us)) {
+      nav_history_.push_back({nav.utime_us, nav.position_ned_m, nav.distance_travelled_m});
+    }
+    feedFixes(nav.utime_us, false);
+  }
+
+  // The fixes of the request's files, in file order (dated against the navigation later).
+  void setFixes(std::vector<sss::ins::PositionFix> fixes) {
+    pending_fixes_.assign(fixes.begin(), fixes.end());
   }
   void addPing(PingInput ping) {
     ++summary_.pings;
@@ -745,6 +839,7 @@ class Runner {
   void finish() {
     buffer_.finish(subframes_);
     handleSubframes();
+    feedFixes(std::numeric_limits<int64_t>::max(), true);
     const double start = wallSeconds();
     optimiser_.finish();
     summary_.optimiser_s += wallSeconds() - start;
@@ -776,6 +871,7 @@ class Runner {
   }
 
   bool writeOutputs(std::string& error);
+  bool writeFixOutputs(const std::string& dir, std::string& error);
   bool writeAltitudeCsv(const std::string& path, std::string& error) const;
   OfflineSummary& summary() { return summary_; }
   const std::optional<sss::core::MissionOrigin>& origin() const { return origin_; }
@@ -873,6 +969,75 @@ class Runner {
     return true;
   }
 
+  // Fixes up to up_to_us (all when final) into the optimiser, each tied to the DR position at its
+  // time; GNSS only while at the surface. The navigation history is kept only as far back as the
+  // oldest fix still to come needs it.
+  void feedFixes(int64_t up_to_us, bool final) {
+    if (pending_fixes_.empty() || nav_history_.empty()) {
+      if (final) summary_.fixes.outside_navigation += pending_fixes_.size();
+      if (final) pending_fixes_.clear();
+      return;
+    }
+    if (!fixes_dated_) {
+      std::vector<sss::ins::PositionFix> fixes(pending_fixes_.begin(), pending_fixes_.end());
+      sss::ins::resolveFixDates(fixes, nav_history_.front().utime_us);
+      std::stable_sort(fixes.begin(), fixes.end(), [](const auto& a, const auto& b) { return a.utime_us < b.utime_us; });
+      pending_fixes_.assign(fixes.begin(), fixes.end());
+      fixes_dated_ = true;
+    }
+    const int64_t tolerance_us = static_cast<int64_t>(options_.fix_max_extrapolation_s * 1e6);
+    while (!pending_fixes_.empty() && (final || pending_fixes_.front().utime_us <= up_to_us)) {
+      const sss::ins::PositionFix fix = pending_fixes_.front();
+      pending_fixes_.pop_front();
+      tieFix(fix, tolerance_us);
+    }
+    // Keep the samples the next fix may fall between (and always the newest two).
+    const int64_t keep_from_us = pending_fixes_.empty() ? nav_history_.back().utime_us : pending_fixes_.front().utime_us;
+    while (nav_history_.size() > 2 && nav_history_[1].utime_us <= keep_from_us) nav_history_.pop_front();
+  }
+
+  void tieFix(const sss::ins::PositionFix& fix, int64_t tolerance_us) {
+    sss::offline::FixSummary& s = summary_.fixes;
+    if (!origin_) {
+      ++s.no_frame;
+      return;
+    }
+    const NavPoint& first = nav_history_.front();
+    const NavPoint& last = nav_history_.back();
+    if (fix.utime_us < first.utime_us - tolerance_us || fix.utime_us > last.utime_us + tolerance_us) {
+      ++s.outside_navigation;
+      return;
+    }
+    // The DR position and distance at the fix time: linear between the bracketing samples.
+    NavPoint at = fix.utime_us <= first.utime_us ? first : last;
+    for (size_t i = 1; i < nav_history_.size(); ++i) {
+      const NavPoint& a = nav_history_[i - 1];
+      const NavPoint& b = nav_history_[i];
+      if (fix.utime_us < a.utime_us || fix.utime_us > b.utime_us) continue;
+      const double alpha = static_cast<double>(fix.utime_us - a.utime_us) / static_cast<double>(b.utime_us - a.utime_us);
+      at.position_ned_m = a.position_ned_m + alpha * (b.position_ned_m - a.position_ned_m);
+      at.distance_m = a.distance_m + alpha * (b.distance_m - a.distance_m);
+      break;
+    }
+    if (fix.source == sss::ins::FixSource::kGnss && at.position_ned_m.z() > options_.gnss_max_depth_m) {
+      ++s.below_surface;
+      return;
+    }
+    if (!plane_) plane_.emplace(origin_->latitude_deg, origin_->longitude_deg);
+    sss::optimiser::AbsoluteFix input;
+    input.utime_us = fix.utime_us;
+    input.position_ne_m = plane_->toNed({fix.latitude_deg, fix.longitude_deg, 0.0}).head<2>();
+    input.covariance_m2 = Eigen::Vector2d(fix.sigma_north_m * fix.sigma_north_m, fix.sigma_east_m * fix.sigma_east_m).asDiagonal();
+    input.dr_position_m = at.position_ned_m;
+    input.dr_distance_m = at.distance_m;
+    input.source = sss::ins::fixSourceName(fix.source);
+    if (optimiser_.addFix(input).ok) {
+      ++s.fed;
+    } else {
+      ++s.refused;
+    }
+  }
+
   void update() {
     const double start = wallSeconds();
     optimiser_.update();
@@ -904,6 +1069,16 @@ class Runner {
   std::vector<sss::subframe::Subframe> mosaic_subframes_;
   std::vector<std::pair<int, sss::core::Pose>> centres_;  // line id and DR centre pose of every subframe
   std::vector<sss::optimiser::StampedPose> dr_per_ping_;
+  // Fixes: those still to come (time order once dated), and the navigation they are tied through.
+  struct NavPoint {
+    int64_t utime_us = 0;
+    Eigen::Vector3d position_ned_m = Eigen::Vector3d::Zero();
+    double distance_m = 0.0;
+  };
+  std::deque<sss::ins::PositionFix> pending_fixes_;
+  bool fixes_dated_ = false;
+  std::deque<NavPoint> nav_history_;
+  std::optional<sss::core::LocalTangentPlane> plane_;
   struct PingAltitude {
     int64_t utime_us;
     double altitude_m;
@@ -921,6 +1096,60 @@ class Runner {
   double start_s_ = wallSeconds();
   double last_progress_s_ = 0.0;
 };
+
+// With fixes: fixes.csv (every fix the optimiser saw, its decision and residual) and
+// dead_reckoning_fixed.tum, the best answer without side-scan: the same nodes, odometry and fixes in
+// a graph without closures (what an aided-INS smoother with the same fixes gives).
+bool Runner::writeFixOutputs(const std::string& dir, std::string& error) {
+  const sss::optimiser::SlidingWindowPoseGraph& graph = optimiser_.graph();
+  const std::vector<sss::optimiser::FixRecord> records = graph.fixes();
+  sss::offline::FixSummary& s = summary_.fixes;
+  s.accepted = graph.fixCounters().accepted;
+  s.rejected_gate = graph.fixCounters().rejected_gate;
+  if (records.empty()) return true;
+  double sum_squared = 0.0;
+  for (const auto& r : records)
+    if (r.status == sss::optimiser::FixStatus::kAccepted) sum_squared += r.residual_ne_m.squaredNorm();
+  s.rms_residual_m = s.accepted > 0 ? std::sqrt(sum_squared / static_cast<double>(s.accepted)) : 0.0;
+
+  const std::string csv_path = dir + "/fixes.csv";
+  std::FILE* f = std::fopen(csv_path.c_str(), "w");
+  if (!f) {
+    error = "cannot write " + csv_path;
+    return false;
+  }
+  std::fprintf(f, "# absolute fixes given to the optimiser (local NED of the mission origin); residual = fix - SLAM "
+                  "estimate at the fix time; chi2 = innovation at the gate (2 dof)\n"
+                  "utime_us,source,north_m,east_m,sigma_north_m,sigma_east_m,status,innovation_chi2,subframe_id,"
+                  "residual_north_m,residual_east_m\n");
+  for (const auto& r : records) {
+    const char* status = r.status == sss::optimiser::FixStatus::kAccepted   ? "accepted"
+                         : r.status == sss::optimiser::FixStatus::kRejected ? "rejected_gate"
+                                                                              : "pending";
+    std::fprintf(f, "%lld,%s,%.3f,%.3f,%.3f,%.3f,%s,%.3f,%lld,%.3f,%.3f\n", static_cast<long long>(r.fix.utime_us),
+                 r.fix.source.c_str(), r.fix.position_ne_m.x(), r.fix.position_ne_m.y(),
+                 std::sqrt(r.fix.covariance_m2(0, 0)), std::sqrt(r.fix.covariance_m2(1, 1)), status, r.innovation_chi2,
+                 static_cast<long long>(r.subframe_id), r.residual_ne_m.x(), r.residual_ne_m.y());
+  }
+  if (std::fclose(f) != 0) {
+    error = "cannot write " + csv_path;
+    return false;
+  }
+
+  sss::optimiser::SlidingWindowPoseGraph fixed(options_.optimiser.graph);
+  for (const sss::optimiser::NodeState& n : graph.nodes()) {
+    fixed.addNode(n.subframe_id, n.utime_us, n.T_world_body_dr, n.distance_travelled_m);
+  }
+  for (const auto& r : records) fixed.addFix(r.fix);
+  fixed.fullSmoothing();
+  std::vector<sss::optimiser::StampedPose> poses;
+  poses.reserve(dr_per_ping_.size());
+  for (const auto& p : dr_per_ping_) poses.push_back({p.utime_us, fixed.correctionAt(p.utime_us).T_corrected_dr * p.T_world_body});
+  return sss::optimiser::writeTum(dir + "/dead_reckoning_fixed.tum", poses,
+                                  "sss-process: dead reckoning with the same fixes, no side-scan (graph without "
+                                  "closures) at every ping" + frame_comment_,
+                                  error, origin_);
+}
 
 // altitude.csv: the altitude every ping was processed with and where it came from.
 bool Runner::writeAltitudeCsv(const std::string& path, std::string& error) const {
@@ -958,6 +1187,7 @@ bool Runner::writeOutputs(std::string& error) {
                                 error, origin_)) {
     return false;
   }
+  if (!writeFixOutputs(dir, error)) return false;
   if (!writeClosuresCsv(dir + "/loop_closures.csv", optimiser_, error)) return false;
   if (!writeAltitudeCsv(dir + "/altitude.csv", error)) return false;
   if (!match_writer_.close(error)) return false;
@@ -1040,7 +1270,30 @@ OfflineResult runOffline(const OfflineRequest& request) {
     return result;
   }
 
+  std::vector<sss::ins::PositionFix> fixes;
+  FixSummary fix_summary;
+  for (const std::string& spec : request.fix_paths) {
+    std::vector<sss::ins::PositionFix> read;
+    sss::ins::FixReaderCounters counters;
+    std::string problem;
+    if (!sss::ins::readPositionFixFile(spec, options.fix_reader, read, counters, problem, result.error)) return result;
+    ++fix_summary.files;
+    fix_summary.read += read.size();
+    fix_summary.sentences_skipped += counters.rejected_sentences + counters.malformed + counters.no_fix;
+    if (fix_summary.first_problem.empty() && !problem.empty()) fix_summary.first_problem = spec + ": " + problem;
+    for (const auto& fix : read) ++(fix.source == sss::ins::FixSource::kGnss ? fix_summary.gnss : fix_summary.usbl);
+    if (request.progress) {
+      std::fprintf(request.progress, "sss-process: %zu fixes from %s (%llu GNSS, %llu USBL so far)%s%s\n", read.size(),
+                   spec.c_str(), static_cast<unsigned long long>(fix_summary.gnss),
+                   static_cast<unsigned long long>(fix_summary.usbl), problem.empty() ? "" : "; skipped: ",
+                   problem.c_str());
+    }
+    fixes.insert(fixes.end(), read.begin(), read.end());
+  }
+
   Runner runner(request, options);
+  runner.summary().fixes = fix_summary;
+  runner.setFixes(std::move(fixes));
   if (request.write_matches && !runner.openMatchWriter(result.error)) {
     result.exit_code = 1;
     return result;
@@ -1237,6 +1490,7 @@ OfflineResult runOffline(const OfflineRequest& request) {
   summary.real_time_factor = summary.wall_s > 0.0 ? summary.mission_s / summary.wall_s : 0.0;
   summary.peak_rss_mib = peakRssMib();
   summary.findings = explainRun(summary, options);
+  for (const std::string& finding : explainFixes(summary.fixes, options)) summary.findings.push_back(finding);
   result.summary = summary;
   if (!writeSummaryJson(request.out_dir + "/summary.json", request, summary, result.error)) return result;
   if (summary.pings_with_pose == 0 || summary.subframes == 0) {

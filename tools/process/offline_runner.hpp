@@ -27,6 +27,9 @@ struct OfflineRequest {
   std::string config_path;   // deployment YAML (sections mission, sonar_driver, ins_bridge,
                              // subframe_buffer, matcher, optimiser); empty: defaults
   std::string out_dir;
+  // Absolute position fixes: NMEA files (GGA + GST + ZDA/RMC), each PATH, gnss:PATH or usbl:PATH
+  // (drivers/ins/position_fix.hpp). GNSS fixes count only while the vehicle is at the surface.
+  std::vector<std::string> fix_paths;
   // Non-empty (sonar file input): also write the SSS_PING and SSS_NAV messages fed to the chain
   // into this LCM log, for lcm-logplayer into the live chain or a later --lcm-log run. Messages
   // made from the sonar's embedded navigation are not in it (give --ins for a complete log).
@@ -43,6 +46,23 @@ struct OfflineRequest {
   uint64_t false_closure_seed = 1;
   std::FILE* progress = nullptr;  // progress lines every progress_period_s of wall time; null: quiet
   double progress_period_s = 2.0;
+};
+
+// What became of the fixes of OfflineRequest::fix_paths.
+struct FixSummary {
+  uint64_t files = 0;
+  uint64_t read = 0;               // fixes in the files
+  uint64_t gnss = 0, usbl = 0;
+  uint64_t sentences_skipped = 0;  // corrupt or malformed sentences, and GGA without a fix
+  std::string first_problem;       // of the skipped sentences
+  uint64_t below_surface = 0;      // GNSS while the vehicle was deeper than fixes.gnss_max_depth_m
+  uint64_t outside_navigation = 0; // before the navigation starts or after it ends
+  uint64_t no_frame = 0;           // the frame has no latitude/longitude (projected XTF)
+  uint64_t fed = 0;                // given to the optimiser
+  uint64_t accepted = 0;
+  uint64_t rejected_gate = 0;
+  uint64_t refused = 0;            // by the optimiser (non-finite, bad covariance)
+  double rms_residual_m = 0.0;     // of the accepted fixes at the final estimate (horizontal)
 };
 
 struct OfflineSummary {
@@ -68,6 +88,7 @@ struct OfflineSummary {
   // smoothing (1 when optimiser.graph.variance_component_iterations is 0).
   sss::optimiser::VarianceFactors variance_factors;
   sss::optimiser::SeparationBias separation_bias;
+  FixSummary fixes;
   uint64_t seabed_points = 0;
   uint64_t input_faults = 0;       // corrupt records, bad messages, dropped pings
   // Where the pings went: the fusion's drops by cause and altitude sources, the line builder's.

@@ -1,5 +1,5 @@
 // sss-process: post-processes a survey offline with the live chain's libraries, deterministically.
-//   sss-process --sonar FILE.jsf|FILE.xtf [--ins FILE.nmea] [--config FILE] --out DIR
+//   sss-process --sonar FILE.jsf|FILE.xtf [--ins FILE.nmea] [--fixes FILE]... [--config FILE] --out DIR
 //   sss-process --lcm-log FILE [--config FILE] --out DIR
 // Without --ins the navigation in the sonar file's ping headers is used. Exit 0 ok (with a warning
 // per stage that yielded nothing), 1 an output could not be written, 2 bad input, 3 nothing could
@@ -14,10 +14,15 @@
 namespace {
 void usage(std::FILE* out) {
   std::fprintf(out,
-               "usage: sss-process --sonar FILE.jsf|FILE.xtf [--ins FILE.nmea] [--config FILE] --out DIR [--quiet]\n"
+               "usage: sss-process --sonar FILE.jsf|FILE.xtf [--ins FILE.nmea] [--fixes FILE]... [--config FILE] --out DIR\n"
+               "                   [--quiet]\n"
                "                   [--write-matches] [--inject-false-closures FRACTION [--inject-seed N]]\n"
                "       sss-process --lcm-log FILE [--ping-channel C] [--nav-channel C] [--config FILE] --out DIR\n"
                "                   [--no-mosaics] [--quiet]\n"
+               "  --fixes [gnss:|usbl:]FILE  absolute position fixes, NMEA GGA (+ GST sigmas, ZDA/RMC dates); repeatable.\n"
+               "                         GNSS counts only at the surface; the talker says GNSS (GP, GN, ...) or USBL\n"
+               "                         (any other) unless the prefix does. Adds fixes.csv and dead_reckoning_fixed.tum\n"
+               "                         (the same fixes without side-scan)\n"
                "  --record-lcm-log FILE  also write the SSS_PING and SSS_NAV messages fed to the chain to an LCM log\n"
                "  --write-matches        also write matches.csv: every dense match, subframe row and recall probe of\n"
                "                         every pair the matcher tried (for sss-eval --matches FILE --mission DIR)\n"
@@ -52,6 +57,11 @@ int main(int argc, char** argv) {
     else if (arg == "--ping-channel") ok = value(request.ping_channel);
     else if (arg == "--nav-channel") ok = value(request.nav_channel);
     else if (arg == "--record-lcm-log") ok = value(request.record_lcm_log_path);
+    else if (arg == "--fixes") {
+      std::string spec;
+      ok = value(spec);
+      if (ok) request.fix_paths.push_back(spec);
+    }
     else if (arg == "--no-mosaics") request.write_mosaics = false;
     else if (arg == "--write-matches") request.write_matches = true;
     else if (arg == "--inject-false-closures" || arg == "--inject-seed") {

@@ -6,6 +6,7 @@
 
 #include "drivers/edgetech/jsf_format.hpp"
 #include "drivers/ins/ixblue_nmea.hpp"
+#include "drivers/ins/position_fix.hpp"
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -17,6 +18,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
 
 namespace sss::sim {
@@ -104,6 +106,9 @@ void readSimOptions(sss::core::ConfigSection section, SimOptions& o) {
   vehicle.optional("altitude_variation_m", t.altitude_variation_m, {inRange(0.0, 50.0)});
   vehicle.optional("altitude_variation_length_m", t.altitude_variation_length_m, {inRange(10.0, 10000.0)});
   vehicle.optional("max_turn_bank_rad", t.max_turn_bank_rad, {inRange(0.0, 0.5)});
+  vehicle.optional("surface_hold_m", t.surface_hold_m, {inRange(0.0, 10000.0)});
+  vehicle.optional("surface_ramp_m", t.surface_ramp_m, {inRange(1.0, 10000.0)});
+  vehicle.optional("surface_depth_m", t.surface_depth_m, {inRange(0.0, 10.0)});
   vehicle.rejectUnknownKeys();
 
   sss::core::ConfigSection dr = subsection(section, "dead_reckoning");
@@ -150,6 +155,21 @@ void readSimOptions(sss::core::ConfigSection section, SimOptions& o) {
   sonar.optional("ground_step_m", n.ground_step_m, {inRange(0.005, 1.0)});
   sonar.optional("output_scale", n.output_scale, {greaterThan(0.0)});
   sonar.rejectUnknownKeys();
+
+  sss::core::ConfigSection fixes = subsection(section, "fixes");
+  SimFixOptions& f = o.fixes;
+  fixes.optional("gnss", f.gnss, {sss::core::oneOf({"none", "start", "start-end", "lines"})});
+  fixes.optional("gnss_sigma_m", f.gnss_sigma_m, {inRange(0.01, 100.0)});
+  fixes.optional("gnss_period_s", f.gnss_period_s, {inRange(0.1, 600.0)});
+  fixes.optional("gnss_max_depth_m", f.gnss_max_depth_m, {inRange(0.0, 10.0)});
+  fixes.optional("usbl_period_s", f.usbl_period_s, {inRange(0.0, 3600.0)});
+  fixes.optional("usbl_sigma_fraction", f.usbl_sigma_fraction, {inRange(0.0, 0.1)});
+  fixes.optional("usbl_sigma_floor_m", f.usbl_sigma_floor_m, {inRange(0.01, 100.0)});
+  fixes.optional("usbl_dropout_fraction", f.usbl_dropout_fraction, {inRange(0.0, 1.0)});
+  fixes.optional("usbl_outlier_fraction", f.usbl_outlier_fraction, {inRange(0.0, 1.0)});
+  fixes.optional("usbl_outlier_min_m", f.usbl_outlier_min_m, {inRange(0.0, 10000.0)});
+  fixes.optional("usbl_outlier_max_m", f.usbl_outlier_max_m, {inRange(0.0, 10000.0)});
+  fixes.rejectUnknownKeys();
   section.rejectUnknownKeys();
 }
 
@@ -176,6 +196,13 @@ std::vector<std::string> validateSimOptions(const SimOptions& o) {
     add("dead_reckoning.heading_bias_min_rad", o.dead_reckoning.heading_bias_min_rad, "exceeds the max");
   if (o.dead_reckoning.heading_deviation_min_rad > o.dead_reckoning.heading_deviation_max_rad)
     add("dead_reckoning.heading_deviation_min_rad", o.dead_reckoning.heading_deviation_min_rad, "exceeds the max");
+  if (o.fixes.gnss != "none" && o.fixes.gnss != "start" && o.fixes.gnss != "start-end" && o.fixes.gnss != "lines")
+    problems.push_back("sim.fixes.gnss: " + o.fixes.gnss + " is not none, start, start-end or lines");
+  if (o.fixes.usbl_period_s < 0.0) add("fixes.usbl_period_s", o.fixes.usbl_period_s, "must be >= 0 (0: no USBL)");
+  if (o.fixes.usbl_outlier_min_m > o.fixes.usbl_outlier_max_m)
+    add("fixes.usbl_outlier_min_m", o.fixes.usbl_outlier_min_m, "exceeds usbl_outlier_max_m");
+  if (o.fixes.gnss != "none" && o.trajectory.surface_depth_m > o.fixes.gnss_max_depth_m)
+    add("vehicle.surface_depth_m", o.trajectory.surface_depth_m, "is deeper than fixes.gnss_max_depth_m: no GNSS fix");
   if (o.seabed.boulder_min_radius_m > o.seabed.boulder_max_radius_m)
     add("seabed.boulder_min_radius_m", o.seabed.boulder_min_radius_m, "exceeds boulder_max_radius_m");
   if (o.trajectory.pattern != "lawnmower" && o.trajectory.pattern != "loop" && o.trajectory.pattern != "cross")
@@ -242,7 +269,9 @@ std::string simOptionsYaml(const SimOptions& o) {
       << "yaw_period_s" << YAML::Value << t.yaw_period_s << YAML::Key << "altitude_wobble_m" << YAML::Value
       << t.altitude_wobble_m << YAML::Key << "max_turn_bank_rad" << YAML::Value << t.max_turn_bank_rad << YAML::Key
       << "altitude_variation_m" << YAML::Value << t.altitude_variation_m << YAML::Key << "altitude_variation_length_m"
-      << YAML::Value << t.altitude_variation_length_m;
+      << YAML::Value << t.altitude_variation_length_m << YAML::Key << "surface_hold_m" << YAML::Value << t.surface_hold_m
+      << YAML::Key << "surface_ramp_m" << YAML::Value << t.surface_ramp_m << YAML::Key << "surface_depth_m" << YAML::Value
+      << t.surface_depth_m;
   out << YAML::EndMap;
   const DeadReckoningOptions& d = o.dead_reckoning;
   out << YAML::Key << "dead_reckoning" << YAML::Value << YAML::BeginMap;
@@ -276,6 +305,17 @@ std::string simOptionsYaml(const SimOptions& o) {
       << YAML::Key << "gain_step_sigma_db" << YAML::Value << n.gain_step_sigma_db << YAML::Key << "jsf_subsystem"
       << YAML::Value << n.jsf_subsystem << YAML::Key << "volume_backscatter" << YAML::Value << n.volume_backscatter;
   out << YAML::EndMap;
+  const SimFixOptions& f = o.fixes;
+  out << YAML::Key << "fixes" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "gnss" << YAML::Value << f.gnss << YAML::Key << "gnss_sigma_m" << YAML::Value << f.gnss_sigma_m
+      << YAML::Key << "gnss_period_s" << YAML::Value << f.gnss_period_s << YAML::Key << "gnss_max_depth_m" << YAML::Value
+      << f.gnss_max_depth_m << YAML::Key << "usbl_period_s" << YAML::Value << f.usbl_period_s << YAML::Key
+      << "usbl_sigma_fraction" << YAML::Value << f.usbl_sigma_fraction << YAML::Key << "usbl_sigma_floor_m" << YAML::Value
+      << f.usbl_sigma_floor_m << YAML::Key << "usbl_dropout_fraction" << YAML::Value << f.usbl_dropout_fraction
+      << YAML::Key << "usbl_outlier_fraction" << YAML::Value << f.usbl_outlier_fraction << YAML::Key
+      << "usbl_outlier_min_m" << YAML::Value << f.usbl_outlier_min_m << YAML::Key << "usbl_outlier_max_m" << YAML::Value
+      << f.usbl_outlier_max_m;
+  out << YAML::EndMap;
   out << YAML::EndMap;
   return out.c_str();
 }
@@ -289,6 +329,8 @@ Mission::Mission(const SimOptions& options)
   options_.trajectory.seed = mixSeed(seed, 2);
   options_.dead_reckoning.seed = mixSeed(seed, 3);
   options_.sonar.seed = mixSeed(seed, 4);
+  // The vehicle surfaces where its GNSS fixes are to be taken.
+  options_.trajectory.surface = options_.fixes.gnss;
   if (options_.auto_seabed_extent) {
     // The seabed covers the path plus the swath and a margin on every side.
     const Eigen::Vector4d extent = Trajectory::planExtent(options_.trajectory);
@@ -364,6 +406,64 @@ std::vector<uint8_t> Mission::encodePingJsf(size_t ping, const PingSamples& samp
     bytes.insert(bytes.end(), message.begin(), message.end());
   }
   return bytes;
+}
+
+std::string fixesNmea(const Mission& mission) {
+  const SimFixOptions& f = mission.options().fixes;
+  struct Timed {
+    double time_s;
+    std::string text;
+  };
+  std::vector<Timed> sentences;
+  std::mt19937_64 rng(mixSeed(static_cast<uint64_t>(mission.options().seed), 5));
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  const sss::core::LocalTangentPlane& plane = mission.tangentPlane();
+  auto fixAt = [&](double time_s, const Eigen::Vector2d& position_ne_m, double sigma_m, int satellites) {
+    sss::ins::PositionFix fix;
+    fix.utime_us = mission.options().start_utime_us + static_cast<int64_t>(std::llround(time_s * 1e6));
+    const sss::core::GeodeticPosition geo = plane.toGeodetic(Eigen::Vector3d(position_ne_m.x(), position_ne_m.y(), 0.0));
+    fix.latitude_deg = geo.latitude_deg;
+    fix.longitude_deg = geo.longitude_deg;
+    fix.sigma_north_m = fix.sigma_east_m = sigma_m;
+    fix.quality = 1;
+    fix.satellites = satellites;
+    fix.hdop = 0.9;
+    return fix;
+  };
+  const double duration_s = mission.durationS();
+  if (f.gnss != "none") {
+    for (double t = 0.0; t <= duration_s; t += f.gnss_period_s) {
+      const TrajectorySample truth = mission.trajectory().sample(t);
+      if (truth.T_world_body.translation.z() > f.gnss_max_depth_m) continue;
+      const Eigen::Vector2d noise(gauss(rng), gauss(rng));
+      const Eigen::Vector2d measured = truth.T_world_body.translation.head<2>() + f.gnss_sigma_m * noise;
+      sentences.push_back({t, sss::ins::encodePositionFix(fixAt(t, measured, f.gnss_sigma_m, 10), "GP")});
+    }
+  }
+  if (f.usbl_period_s > 0.0) {
+    // The ship holds station at the surface over the middle of the survey.
+    const Eigen::Vector4d extent = Trajectory::planExtent(mission.trajectory().options());
+    const Eigen::Vector3d ship(0.5 * (extent[0] + extent[2]), 0.5 * (extent[1] + extent[3]), 0.0);
+    for (double t = f.usbl_period_s; t <= duration_s; t += f.usbl_period_s) {
+      const TrajectorySample truth = mission.trajectory().sample(t);
+      const bool dropped = uniform(rng) < f.usbl_dropout_fraction;
+      const bool outlier = uniform(rng) < f.usbl_outlier_fraction;
+      const Eigen::Vector2d noise(gauss(rng), gauss(rng));
+      const double outlier_m = f.usbl_outlier_min_m + (f.usbl_outlier_max_m - f.usbl_outlier_min_m) * uniform(rng);
+      const double outlier_angle = 2.0 * M_PI * uniform(rng);
+      if (dropped || truth.T_world_body.translation.z() < 2.0) continue;  // no reply; or at the surface
+      const double slant_m = (truth.T_world_body.translation - ship).norm();
+      const double sigma_m = f.usbl_sigma_floor_m + f.usbl_sigma_fraction * slant_m;
+      Eigen::Vector2d measured = truth.T_world_body.translation.head<2>() + sigma_m * noise;
+      if (outlier) measured += outlier_m * Eigen::Vector2d(std::cos(outlier_angle), std::sin(outlier_angle));
+      sentences.push_back({t, sss::ins::encodePositionFix(fixAt(t, measured, sigma_m, 0), "II")});
+    }
+  }
+  std::stable_sort(sentences.begin(), sentences.end(), [](const Timed& a, const Timed& b) { return a.time_s < b.time_s; });
+  std::string out;
+  for (const Timed& s : sentences) out += s.text;
+  return out;
 }
 
 std::string insNmeaStream(const Mission& mission) {
@@ -555,6 +655,10 @@ bool writeMission(const Mission& mission, const std::string& out_dir, MissionRep
   // INS stream: iXblue NMEA ($PIXSE family) at the DR rate.
   if (!writeText(dir + "/ins.nmea", insNmeaStream(mission), error)) return false;
   report.files.push_back("ins.nmea");
+  if (options.fixes.gnss != "none" || options.fixes.usbl_period_s > 0.0) {
+    if (!writeText(dir + "/fixes.nmea", fixesNmea(mission), error)) return false;
+    report.files.push_back("fixes.nmea");
+  }
 
   // Pings: rendered in parallel chunks, written in order.
   const int bins = options.waterfall_bins_per_side;

@@ -16,6 +16,22 @@
 
 namespace sss::sim {
 
+// Absolute fixes written to fixes.nmea (GGA + GST + ZDA): GNSS while the vehicle is at the surface,
+// USBL from a ship holding station over the middle of the survey.
+struct SimFixOptions {
+  std::string gnss = "none";        // none, start, start-end, lines: when the vehicle surfaces for them
+  double gnss_sigma_m = 1.5;        // per axis, white (the GST says so)
+  double gnss_period_s = 5.0;       // one fix every period while at the surface
+  double gnss_max_depth_m = 0.5;    // the antenna is out of the water above this depth
+  double usbl_period_s = 0.0;       // 0: no USBL
+  double usbl_sigma_fraction = 0.002;  // of the slant range, per axis
+  double usbl_sigma_floor_m = 0.5;     // the ship's own GNSS and attitude
+  double usbl_dropout_fraction = 0.1;  // fixes lost (no reply, bad geometry)
+  double usbl_outlier_fraction = 0.05; // multipath: a fix far off with the usual sigma
+  double usbl_outlier_min_m = 10.0;
+  double usbl_outlier_max_m = 50.0;
+};
+
 struct SimOptions {
   int64_t seed = 1;                         // one seed for everything; modules derive their own
   std::string family = "default";           // the seabed family drawn by --randomise (a label)
@@ -34,6 +50,7 @@ struct SimOptions {
   TrajectoryOptions trajectory;
   DeadReckoningOptions dead_reckoning;
   SonarOptions sonar;
+  SimFixOptions fixes;
 };
 
 // Reads the `sim` section's keys into options (defaults stay where a key is absent); problems go
@@ -95,5 +112,9 @@ bool writeMission(const Mission& mission, const std::string& out_dir, MissionRep
 
 // The INS stream: iXblue $PIXSE NMEA bursts of the DR navigation at the DR rate.
 std::string insNmeaStream(const Mission& mission);
+
+// The absolute fixes of SimFixOptions (GNSS talker GP, USBL talker II), in time order; empty when
+// the mission has none.
+std::string fixesNmea(const Mission& mission);
 
 }  // namespace sss::sim

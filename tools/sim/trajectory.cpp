@@ -80,7 +80,12 @@ std::vector<PathSegment> turnStraightTurn(const Eigen::Vector2d& from, double fr
 
 }  // namespace
 
+static void appendCrossLines(const TrajectoryOptions& options, std::vector<PathSegment>& segments, double& distance);
+
 std::vector<PathSegment> planSurvey(const TrajectoryOptions& options) {
+  if (options.surface != "none" && options.surface != "start" && options.surface != "start-end" &&
+      options.surface != "lines")
+    throw std::invalid_argument("planSurvey: surface must be none, start, start-end or lines, not " + options.surface);
   if (options.lines < 1) throw std::invalid_argument("planSurvey: lines must be >= 1");
   const double h0 = options.line_heading_deg * kPi / 180.0;
   const Eigen::Vector2d along = headingVector(h0);
@@ -137,8 +142,45 @@ std::vector<PathSegment> planSurvey(const TrajectoryOptions& options) {
     segments.push_back(turn);
     distance += turn.length_m;
   }
-  if (options.pattern != "cross") return segments;
+  if (options.pattern == "cross") appendCrossLines(options, segments, distance);
+  if (options.surface == "none") return segments;
+  // Lead-in (and lead-out) at the surface and the ramp to depth, straight along the first (last) line.
+  const double lead_m = options.surface_hold_m + options.surface_ramp_m;
+  PathSegment lead_in;
+  lead_in.is_line = true;
+  lead_in.line_index = -1;
+  lead_in.length_m = lead_m;
+  lead_in.start_heading_rad = segments.front().start_heading_rad;
+  lead_in.start = segments.front().start - headingVector(lead_in.start_heading_rad) * lead_m;
+  for (PathSegment& segment : segments) segment.start_distance_m += lead_m;
+  segments.insert(segments.begin(), lead_in);
+  if (options.surface == "start-end" || options.surface == "lines") {
+    const PathSegment& last = segments.back();
+    PathSegment lead_out;
+    lead_out.is_line = true;
+    lead_out.line_index = -1;
+    lead_out.length_m = lead_m;
+    lead_out.start_distance_m = last.start_distance_m + last.length_m;
+    if (last.is_line) {
+      lead_out.start_heading_rad = last.start_heading_rad;
+      lead_out.start = last.start + headingVector(last.start_heading_rad) * last.length_m;
+    } else {
+      const double r = last.turn_radius_m;
+      const Eigen::Vector2d centre = last.start + last.turn_sign * r * starboardVector(last.start_heading_rad);
+      lead_out.start_heading_rad = last.start_heading_rad + last.turn_sign * last.length_m / r;
+      lead_out.start = centre - last.turn_sign * r * starboardVector(lead_out.start_heading_rad);
+    }
+    segments.push_back(lead_out);
+  }
+  return segments;
+}
 
+static void appendCrossLines(const TrajectoryOptions& options, std::vector<PathSegment>& segments, double& distance) {
+  const double h0 = options.line_heading_deg * kPi / 180.0;
+  const Eigen::Vector2d along = headingVector(h0);
+  const Eigen::Vector2d lateral = starboardVector(h0);
+  const double s = options.line_spacing_m;
+  const double length = options.line_length_m;
   // Crossing lines: perpendicular to the lawnmower at 1/(K+1) ... K/(K+1) of its length, one
   // spacing beyond the outer lines on either side; the first from the side and end where the
   // lawnmower finished, then alternating.
@@ -169,7 +211,6 @@ std::vector<PathSegment> planSurvey(const TrajectoryOptions& options) {
     segments.push_back(line);
     distance += line.length_m;
   }
-  return segments;
 }
 
 Eigen::Vector4d Trajectory::planExtent(const TrajectoryOptions& options) {
@@ -206,6 +247,32 @@ Trajectory::Trajectory(const TrajectoryOptions& options, const Seabed* seabed)
   phase_pitch_ = phase(rng);
   phase_yaw_ = phase(rng);
   phase_altitude_ = phase(rng);
+  if (options.surface != "none") {
+    surface_windows_.push_back({-1e12, options.surface_hold_m, options.surface_ramp_m});
+    if (options.surface == "start-end" || options.surface == "lines")
+      surface_windows_.push_back({total_length_m_ - options.surface_hold_m, 1e12, options.surface_ramp_m});
+    if (options.surface == "lines") {
+      // Half way through each turn between two lawnmower lines, ramps shortened to fit the turn.
+      for (const PathSegment& segment : segments_) {
+        if (segment.is_line) continue;
+        const double middle = segment.start_distance_m + 0.5 * segment.length_m;
+        const double half_hold = std::min(0.5 * options.surface_hold_m, 0.25 * segment.length_m);
+        const double ramp = std::max(1.0, std::min(options.surface_ramp_m, 0.5 * segment.length_m - half_hold));
+        surface_windows_.push_back({middle - half_hold, middle + half_hold, ramp});
+      }
+    }
+  }
+}
+
+double Trajectory::submergedWeight(double distance_m) const {
+  double weight = 1.0;
+  for (const SurfaceWindow& w : surface_windows_) {
+    const double outside = std::max({w.from_m - distance_m, distance_m - w.to_m, 0.0});
+    const double x = std::clamp(outside / w.ramp_m, 0.0, 1.0);
+    // Smootherstep: neither pitch nor vertical acceleration jumps where the ramp starts and ends.
+    weight = std::min(weight, x * x * x * (x * (6.0 * x - 15.0) + 10.0));
+  }
+  return weight;
 }
 
 void Trajectory::planarState(double distance_m, Eigen::Vector2d& position, double& heading_rad, double& curvature,
@@ -248,7 +315,8 @@ TrajectorySample Trajectory::sample(double time_s) const {
       depth_m -= options_.altitude_variation_m *
                  fractalNoise2d(mixSeed(options_.seed, 2002), path_m / options_.altitude_variation_length_m, 0.5, 2);
     }
-    return depth_m;
+    if (surface_windows_.empty()) return depth_m;
+    return options_.surface_depth_m + submergedWeight(path_m) * (depth_m - options_.surface_depth_m);
   };
   const double depth = depthAt(planar, distance, t);
   // Slope of the flown depth along track gives the mean pitch (bow up when climbing).
@@ -270,7 +338,8 @@ TrajectorySample Trajectory::sample(double time_s) const {
                                         Eigen::Vector3d(planar.x(), planar.y(), depth));
   const Eigen::Vector2d velocity_planar = headingVector(path_heading) * options_.speed_m_s;
   // Vertical speed: terrain following along the path plus the altitude wobble's own rate.
-  const double wobble_rate = options_.altitude_wobble_m * (2.0 * kPi / 31.0) * std::cos(2.0 * kPi * t / 31.0 + phase_altitude_);
+  const double wobble_rate = submergedWeight(distance) * options_.altitude_wobble_m * (2.0 * kPi / 31.0) *
+                             std::cos(2.0 * kPi * t / 31.0 + phase_altitude_);
   sample.velocity_world_m_s =
       Eigen::Vector3d(velocity_planar.x(), velocity_planar.y(), dz_ds * options_.speed_m_s + wobble_rate);
   sample.altitude_m = seabed_->depthM(planar.x(), planar.y()) - depth;

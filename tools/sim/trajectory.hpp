@@ -37,6 +37,14 @@ struct TrajectoryOptions {
   double altitude_variation_m = 0.0;
   double altitude_variation_length_m = 300.0;
   double max_turn_bank_rad = 0.08;     // roll into turns
+  // Surfacing for GNSS fixes (set from the mission's fix options): "none"; "start": a lead-in at the
+  // surface before the first line, then the dive; "start-end": also a climb and a lead-out at the
+  // surface after the last line; "lines": also up to the surface half way through every turn
+  // between lawnmower lines. The lead-in and lead-out run straight along the first and last lines.
+  std::string surface = "none";
+  double surface_hold_m = 40.0;   // path at the surface (20 s at 2 m/s)
+  double surface_ramp_m = 80.0;   // path to dive from the surface to the flying depth, or to climb
+  double surface_depth_m = 0.3;   // the hull awash: the GNSS antenna on its mast is out of the water
   uint64_t seed = 1;
 };
 
@@ -76,7 +84,15 @@ class Trajectory {
  private:
   void planarState(double distance_m, Eigen::Vector2d& position, double& heading_rad, double& curvature, int& line) const;
 
+  // Where the vehicle is at the surface: [from, to] of path distance, and the ramp to the flying depth
+  // on either side. submergedWeight() is 0 inside, 1 a ramp away, smooth in between.
+  struct SurfaceWindow {
+    double from_m, to_m, ramp_m;
+  };
+  double submergedWeight(double distance_m) const;
+
   TrajectoryOptions options_;
+  std::vector<SurfaceWindow> surface_windows_;
   const Seabed* seabed_;
   std::vector<PathSegment> segments_;
   double total_length_m_ = 0.0;
