@@ -28,6 +28,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -46,6 +47,16 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
+// Zero-mean priors on the calibration block: x ./ sigma.
+struct CalibrationPriorError {
+  Eigen::Vector4d inverse_sigma;
+  template <typename T>
+  bool operator()(const T* x, T* residual) const {
+    for (int i = 0; i < 4; ++i) residual[i] = x[i] * T(inverse_sigma(i));
+    return true;
+  }
+};
+
 // A Gaussian prior on a scalar parameter: (x - mean) / sigma.
 struct ScalarPriorError {
   double mean, inverse_sigma;
@@ -55,6 +66,63 @@ struct ScalarPriorError {
     return true;
   }
 };
+
+// The heading moments D_c = integral of (cos psi - cos psi_a) dp and D_s (sin) of the DR path between
+// two nodes (CalibratedOdometryError). Only the end poses and the distance flown are known, so the
+// path is taken as straight - arc - straight (a turn between lines): three unknowns (the two straight
+// lengths and the radius) from the displacement and the distance, a linear system. Where that has no
+// solution the moments are the trapezoid of the ends. Along a straight line both are zero.
+void pathMoments(const Pose& a, const Pose& b, double distance_m, Eigen::Vector2d& moment_cos,
+                 Eigen::Vector2d& moment_sin) {
+  moment_cos.setZero();
+  moment_sin.setZero();
+  const double heading_a = sss::core::eulerFromQuaternion(a.rotation).heading_rad;
+  const double heading_b = sss::core::eulerFromQuaternion(b.rotation).heading_rad;
+  const Eigen::Vector2d displacement = (b.translation - a.translation).head<2>();
+  const double turn = sss::core::wrapAngle(heading_b - heading_a);
+  if (std::abs(turn) < 0.01) return;  // straight: (cos psi - cos psi_a) ~ 0 all along
+  const auto unit = [](double psi) { return Eigen::Vector2d(std::cos(psi), std::sin(psi)); };
+  constexpr int kSteps = 64;
+  // Either turning direction for a near U-turn (wrapAngle cannot tell), the shorter one first.
+  for (const double sign : {turn > 0.0 ? 1.0 : -1.0, turn > 0.0 ? -1.0 : 1.0}) {
+    const double angle = sign * turn > 0.0 ? std::abs(turn) : 2.0 * M_PI - std::abs(turn);
+    if (angle > M_PI + 0.3) continue;  // not a plausible single turn
+    // Chord of a unit-radius arc, and the arc's moments per unit radius (midpoint rule).
+    Eigen::Vector2d chord = Eigen::Vector2d::Zero(), arc_cos = Eigen::Vector2d::Zero(), arc_sin = Eigen::Vector2d::Zero();
+    for (int k = 0; k < kSteps; ++k) {
+      const double psi = heading_a + sign * angle * (k + 0.5) / kSteps;
+      const Eigen::Vector2d step = unit(psi) * angle / kSteps;
+      chord += step;
+      arc_cos += (std::cos(psi) - std::cos(heading_a)) * step;
+      arc_sin += (std::sin(psi) - std::sin(heading_a)) * step;
+    }
+    Eigen::Matrix3d system;
+    system << unit(heading_a), unit(heading_b), chord, 1.0, 1.0, angle;
+    const Eigen::Vector3d lengths = system.colPivHouseholderQr().solve(Eigen::Vector3d(displacement.x(), displacement.y(), distance_m));
+    if (!lengths.allFinite() || lengths.minCoeff() < -0.05 * std::max(distance_m, 1.0)) continue;
+    const double radius = std::max(lengths(2), 0.0), after = std::max(lengths(1), 0.0);
+    moment_cos = radius * arc_cos + after * (std::cos(heading_b) - std::cos(heading_a)) * unit(heading_b);
+    moment_sin = radius * arc_sin + after * (std::sin(heading_b) - std::sin(heading_a)) * unit(heading_b);
+    return;
+  }
+  moment_cos = 0.5 * (std::cos(heading_b) - std::cos(heading_a)) * displacement;
+  moment_sin = 0.5 * (std::sin(heading_b) - std::sin(heading_a)) * displacement;
+}
+
+// Whitening of the first node's anchor.
+Matrix6d firstNodeSqrtInformation(const PoseGraphOptions& o) {
+  Vector6d inverse_sigma;
+  const double m = 1.0 / o.first_node_sigma_m, r = 1.0 / o.first_node_sigma_rad;
+  inverse_sigma << m, m, m, r, r, r;
+  return inverse_sigma.asDiagonal();
+}
+
+// 1 / sigma of the INS absolute factor's depth, roll, pitch and heading (0: not used).
+Eigen::Vector4d insAbsoluteWeights(const PoseGraphOptions& o) {
+  auto weight = [](double sigma) { return sigma > 0.0 ? 1.0 / sigma : 0.0; };
+  return Eigen::Vector4d(weight(o.absolute_depth_sigma_m), weight(o.absolute_roll_pitch_sigma_rad),
+                         weight(o.absolute_roll_pitch_sigma_rad), weight(o.absolute_heading_sigma_rad));
+}
 
 double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
@@ -130,6 +198,12 @@ std::vector<std::string> validatePoseGraphOptions(const PoseGraphOptions& o) {
   if (!(o.separation_bias_significance >= 0.0))
     problems.push_back("separation_bias_significance must be >= 0 (sigmas; 0: always significant)");
   positive(o.fix_gate_chi2, "fix_gate_chi2");
+  if (o.calibration != "auto" && o.calibration != "always" && o.calibration != "never")
+    problems.push_back("calibration must be one of auto, always, never (got '" + o.calibration + "')");
+  positive(o.calibration_scale_sigma, "calibration_scale_sigma");
+  nonNegative(o.calibrated_odometry_drift_fraction, "calibrated_odometry_drift_fraction");
+  positive(o.calibration_heading_bias_sigma_rad, "calibration_heading_bias_sigma_rad");
+  positive(o.calibration_heading_deviation_sigma_rad, "calibration_heading_deviation_sigma_rad");
   positive(o.variance_factor_min, "variance_factor_min");
   positive(o.variance_factor_max, "variance_factor_max");
   if (o.variance_factor_min > 1.0 || o.variance_factor_max < 1.0)
@@ -176,6 +250,12 @@ void readPoseGraphOptions(sss::core::ConfigSection& section, PoseGraphOptions& o
   section.optional("separation_bias_apply", options.separation_bias_apply);
   section.optional("separation_bias_significance", options.separation_bias_significance, {inRange(0.0, 100.0)});
   section.optional("fix_gate_chi2", options.fix_gate_chi2, {greaterThan(0.0)});
+  section.optional("calibration", options.calibration, {sss::core::oneOf({"auto", "always", "never"})});
+  section.optional("calibration_scale_sigma", options.calibration_scale_sigma, {inRange(1e-6, 0.5)});
+  section.optional("calibrated_odometry_drift_fraction", options.calibrated_odometry_drift_fraction, {inRange(0.0, 1.0)});
+  section.optional("calibration_heading_bias_sigma_rad", options.calibration_heading_bias_sigma_rad, {inRange(1e-6, 0.5)});
+  section.optional("calibration_heading_deviation_sigma_rad", options.calibration_heading_deviation_sigma_rad,
+                   {inRange(1e-6, 0.5)});
   section.optional("variance_factor_min", options.variance_factor_min, {inRange(1e-6, 1.0)});
   section.optional("variance_factor_max", options.variance_factor_max, {inRange(1.0, 1e6)});
   section.optional("degraded_after_s", options.degraded_after_s, {greaterThan(0.0)});
@@ -218,6 +298,7 @@ void SlidingWindowPoseGraph::setupDerived(Node& node, const Node* previous) cons
     return;
   }
   node.odometry = sss::core::between(previous->dr, node.dr);
+  pathMoments(previous->dr, node.dr, node.distance_m - previous->distance_m, node.moment_cos, node.moment_sin);
   const Matrix6d sigma = odometryCovariance(options_, node.distance_m - previous->distance_m);
   sqrtInformation(sigma, node.odometry_sqrt_information);  // diagonal and positive: cannot fail
   const Matrix6d ad = adjoint(node.dr);
@@ -517,21 +598,23 @@ Matrix6d SlidingWindowPoseGraph::closureSqrtInformation(const Closure& c) const 
 
 ceres::CostFunction* SlidingWindowPoseGraph::makeCost(const Factor& f) const {
   switch (f.kind) {
-    case FactorKind::kFirstNode: {
-      Vector6d inverse_sigma;
-      const double m = 1.0 / options_.first_node_sigma_m, r = 1.0 / options_.first_node_sigma_rad;
-      inverse_sigma << m, m, m, r, r, r;
-      return PosePriorError::create(nodes_[0].dr, inverse_sigma.asDiagonal());
-    }
+    case FactorKind::kFirstNode:
+      return PosePriorError::create(firstNodePrior(), firstNodeSqrtInformation(options_));
     case FactorKind::kInsAbsolute: {
-      auto weight = [](double sigma) { return sigma > 0.0 ? 1.0 / sigma : 0.0; };
-      const Eigen::Vector4d w(weight(options_.absolute_depth_sigma_m), weight(options_.absolute_roll_pitch_sigma_rad),
-                              weight(options_.absolute_roll_pitch_sigma_rad), weight(options_.absolute_heading_sigma_rad));
+      const Eigen::Vector4d w = insAbsoluteWeights(options_);
+      if (calibration_.estimated) {
+        const Pose& dr = nodes_[f.index].dr;
+        return CalibratedInsAbsoluteError::createHeld(
+            dr, w, sss::core::eulerFromQuaternion(dr.rotation).heading_rad,
+            Eigen::Vector3d(calibration_.heading_bias_rad, calibration_.heading_cos_rad, calibration_.heading_sin_rad));
+      }
       return InsAbsoluteError::create(nodes_[f.index].dr, w);
     }
-    case FactorKind::kOdometry:
-      return RelativePoseError::create(nodes_[f.index].odometry, nodes_[f.index].odometry_sqrt_information /
-                                                                     std::sqrt(variance_factors_.odometry));
+    case FactorKind::kOdometry: {
+      const Matrix6d sqrt_information = odometrySqrtInformation(f.index, calibration_.estimated);
+      if (calibration_.estimated) return CalibratedOdometryError::createHeld(calibratedOdometry(f.index));
+      return RelativePoseError::create(nodes_[f.index].odometry, sqrt_information);
+    }
     case FactorKind::kClosure: {
       const Closure& c = closures_[f.index];
       Matrix6d sqrt_information = closureSqrtInformation(c);
@@ -795,8 +878,44 @@ Eigen::Vector3d SlidingWindowPoseGraph::separationDirection(const Closure& c) co
   return Eigen::Vector3d(0.0, lateral_m > 0.0 ? 1.0 : -1.0, 0.0);
 }
 
+Matrix6d SlidingWindowPoseGraph::odometrySqrtInformation(int k, bool calibrated) const {
+  const Node& node = nodes_[k];
+  if (!calibrated || k == 0) return node.odometry_sqrt_information / std::sqrt(variance_factors_.odometry);
+  PoseGraphOptions model = options_;
+  model.odometry_drift_fraction = options_.calibrated_odometry_drift_fraction;
+  Matrix6d sqrt_information;
+  sqrtInformation(odometryCovariance(model, node.distance_m - nodes_[k - 1].distance_m), sqrt_information);
+  return sqrt_information / std::sqrt(variance_factors_.odometry);
+}
+
+CalibratedOdometryError SlidingWindowPoseGraph::calibratedOdometry(int k) const {
+  const Node& node = nodes_[k];
+  CalibratedOdometryError error;
+  error.measured = node.odometry;
+  error.sqrt_information = odometrySqrtInformation(k, true);
+  error.moment_cos = node.moment_cos;
+  error.moment_sin = node.moment_sin;
+  error.heading_a_rad = sss::core::eulerFromQuaternion(nodes_[k - 1].dr.rotation).heading_rad;
+  error.heading_b_rad = sss::core::eulerFromQuaternion(node.dr.rotation).heading_rad;
+  error.held = Eigen::Vector3d(calibration_.dvl_scale, calibration_.heading_cos_rad, calibration_.heading_sin_rad);
+  return error;
+}
+
+Pose SlidingWindowPoseGraph::firstNodePrior() const {
+  Pose prior = nodes_[0].dr;
+  if (calibration_.estimated) {
+    const double e = calibration_.headingErrorRad(sss::core::eulerFromQuaternion(prior.rotation).heading_rad);
+    prior.rotation = (Eigen::Quaterniond(Eigen::AngleAxisd(-e, Eigen::Vector3d::UnitZ())) * prior.rotation).normalized();
+  }
+  return prior;
+}
+
+bool SlidingWindowPoseGraph::calibrationWanted() const {
+  return options_.calibration == "always" || (options_.calibration == "auto" && fix_counters_.accepted > 0);
+}
+
 bool SlidingWindowPoseGraph::solve(const std::vector<Factor>& factors, int max_iterations, UpdateReport& report,
-                                   bool estimate_separation_bias) {
+                                   bool estimate_separation_bias, bool estimate_calibration) {
   PoseManifold manifold;  // outlives the problem, which does not own it
   ceres::Problem::Options problem_options;
   problem_options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -819,9 +938,27 @@ bool SlidingWindowPoseGraph::solve(const std::vector<Factor>& factors, int max_i
   // prior of separation_bias_sigma_m holds it where DR cannot tell.
   double separation_bias_m = separation_bias_.estimate_m;
   int biased_closures = 0;
+  // The DR calibration as a variable: odometry and INS factors take it as a block, zero-mean priors
+  // hold what nothing observes.
+  std::array<double, kCalibrationSize> calibration = {calibration_.dvl_scale, calibration_.heading_bias_rad,
+                                                      calibration_.heading_cos_rad, calibration_.heading_sin_rad};
   for (const Factor& f : factors) {
     std::vector<double*> blocks;
     for (int n : factorNodes(f)) blocks.push_back(parameters[slot_of[n]].data());
+    if (estimate_calibration && (f.kind == FactorKind::kOdometry || f.kind == FactorKind::kInsAbsolute ||
+                                 f.kind == FactorKind::kFirstNode)) {
+      blocks.push_back(calibration.data());
+      const Node& node = nodes_[f.index];
+      const double dr_heading_rad = sss::core::eulerFromQuaternion(node.dr.rotation).heading_rad;
+      ceres::CostFunction* cost =
+          f.kind == FactorKind::kOdometry
+              ? CalibratedOdometryError::createEstimated(calibratedOdometry(f.index))
+          : f.kind == FactorKind::kInsAbsolute
+              ? CalibratedInsAbsoluteError::createEstimated(node.dr, insAbsoluteWeights(options_), dr_heading_rad)
+              : CalibratedPosePriorError::create(node.dr, firstNodeSqrtInformation(options_), dr_heading_rad);
+      problem.AddResidualBlock(cost, nullptr, blocks);
+      continue;
+    }
     // Full smoothing: every node is a variable, so the closure's own weight is the whole of it.
     if (estimate_separation_bias && f.kind == FactorKind::kClosure) {
       const Closure& c = closures_[f.index];
@@ -841,6 +978,16 @@ bool SlidingWindowPoseGraph::solve(const std::vector<Factor>& factors, int max_i
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<ScalarPriorError, 1, 1>(
                                  new ScalarPriorError{0.0, 1.0 / options_.separation_bias_sigma_m}),
                              nullptr, &separation_bias_m);
+  }
+  const bool calibrating = estimate_calibration && problem.HasParameterBlock(calibration.data());
+  if (calibrating) {
+    const double sigmas[kCalibrationSize] = {options_.calibration_scale_sigma, options_.calibration_heading_bias_sigma_rad,
+                                             options_.calibration_heading_deviation_sigma_rad,
+                                             options_.calibration_heading_deviation_sigma_rad};
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<CalibrationPriorError, kCalibrationSize, kCalibrationSize>(
+                                 new CalibrationPriorError{Eigen::Vector4d(1.0 / sigmas[0], 1.0 / sigmas[1],
+                                                                           1.0 / sigmas[2], 1.0 / sigmas[3])}),
+                             nullptr, calibration.data());
   }
 
   ceres::Solver::Options solver_options;
@@ -880,6 +1027,21 @@ bool SlidingWindowPoseGraph::solve(const std::vector<Factor>& factors, int max_i
     separation_bias_.closures = biased_closures;
     separation_bias_.tested_m = 0.0;
     separation_bias_.sigma_m = std::numeric_limits<double>::quiet_NaN();
+  }
+  if (calibrating && std::all_of(calibration.begin(), calibration.end(), [](double v) { return std::isfinite(v); })) {
+    calibration_.estimated = true;
+    calibration_.dvl_scale = calibration[0];
+    calibration_.heading_bias_rad = calibration[1];
+    calibration_.heading_cos_rad = calibration[2];
+    calibration_.heading_sin_rad = calibration[3];
+    ceres::Covariance::Options covariance_options;
+    covariance_options.algorithm_type = ceres::SPARSE_QR;
+    ceres::Covariance covariance(covariance_options);
+    const std::vector<std::pair<const double*, const double*>> blocks = {{calibration.data(), calibration.data()}};
+    Eigen::Matrix<double, 4, 4, Eigen::RowMajor> c = Eigen::Matrix<double, 4, 4, Eigen::RowMajor>::Constant(
+        std::numeric_limits<double>::quiet_NaN());
+    if (covariance.Compute(blocks, &problem)) covariance.GetCovarianceBlock(calibration.data(), calibration.data(), c.data());
+    for (int i = 0; i < 4; ++i) calibration_.sigma(i) = c(i, i) >= 0.0 ? std::sqrt(c(i, i)) : std::numeric_limits<double>::quiet_NaN();
   }
   if (estimate_separation_bias && biased_closures > 0 && std::isfinite(separation_bias_m)) {
     separation_bias_.estimate_m = separation_bias_.tested_m = separation_bias_m;
@@ -941,7 +1103,7 @@ void SlidingWindowPoseGraph::reweighFromResiduals(const std::vector<Factor>& fac
     ++variance_factors_.iterations;
     if (settled) return;
     UpdateReport again;
-    if (!solve(factors, options_.full_smoothing_max_iterations, again, separation_bias_.applied)) {
+    if (!solve(factors, options_.full_smoothing_max_iterations, again, separation_bias_.applied, calibrating_)) {
       variance_factors_ = before;  // the estimate stays the last good one, and so do its weights
       return;
     }
@@ -1110,6 +1272,9 @@ UpdateReport SlidingWindowPoseGraph::fullSmoothing() {
   first_active_ = 0;
   const std::vector<Factor> factors = allFactors();
   bool ok = true;
+  const bool calibrate = calibrationWanted();
+  calibrating_ = calibrate;
+  const DrCalibration calibration_start = calibration_;
   if (options_.separation_bias_sigma_m > 0.0) {
     // The separation bias as a variable. Kept only when significant and asked for; otherwise the
     // graph is solved again from where it was, without it (its estimate stays as a diagnostic).
@@ -1117,7 +1282,7 @@ UpdateReport SlidingWindowPoseGraph::fullSmoothing() {
     start.reserve(nodes_.size());
     for (const Node& n : nodes_) start.push_back(n.estimate);
     UpdateReport measured;
-    const bool estimated = solve(factors, options_.full_smoothing_max_iterations, measured, true);
+    const bool estimated = solve(factors, options_.full_smoothing_max_iterations, measured, true, calibrate);
     report.iterations += measured.iterations;
     report.solve_s += measured.solve_s;
     // sigma_m is NaN when no opposite-side closure was accepted or the covariance failed.
@@ -1127,14 +1292,16 @@ UpdateReport SlidingWindowPoseGraph::fullSmoothing() {
     if (!separation_bias_.applied) {
       for (size_t i = 0; i < nodes_.size(); ++i) nodes_[i].estimate = start[i];
       separation_bias_.estimate_m = 0.0;
-      ok = solve(factors, options_.full_smoothing_max_iterations, report);
+      calibration_ = calibration_start;
+      ok = solve(factors, options_.full_smoothing_max_iterations, report, false, calibrate);
     } else {
       ok = estimated;
     }
   } else {
-    ok = solve(factors, options_.full_smoothing_max_iterations, report);
+    ok = solve(factors, options_.full_smoothing_max_iterations, report, false, calibrate);
   }
   if (ok) reweighFromResiduals(factors, report);
+  calibrating_ = false;
   if (ok) {
     // Re-derive the window's prior at the smoothed estimate, eliminating the old nodes in order.
     prior_ = Prior();

@@ -4,6 +4,7 @@
 // corrections for any time and checkpoints. Pure C++ over Ceres: no LCM, DDS or systemd.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <map>
@@ -24,6 +25,8 @@ class LossFunction;
 }  // namespace ceres
 
 namespace sss::optimiser {
+
+struct CalibratedOdometryError;  // pose_manifold.hpp
 
 struct PoseGraphOptions {
   // ---- sliding window ----------------------------------------------------------------------------
@@ -126,6 +129,22 @@ struct PoseGraphOptions {
   // node's current estimate and covariance (2 dof: 13.82 = 99.9 %), so an outlying USBL fix does not
   // pull the survey, and it enters the solve under the closures' robust loss.
   double fix_gate_chi2 = 13.82;
+
+  // ---- calibration of the DR sensors -----------------------------------------------------------------
+  // DVL scale factor s (DR's horizontal odometry is (1 + s) times the distance flown) and the INS
+  // heading error e(psi) = b + a_c cos(psi) + a_s sin(psi): a constant bias, and the error of one
+  // cycle per revolution (gyrocompass steaming and alignment residuals) that does not cancel on the
+  // reversed lines of a lawnmower. Most of a plain lawnmower's DR error is these, and no side-scan
+  // closure sees them, but absolute fixes do. Estimated at full smoothing with zero-mean priors of
+  // these sigmas, then held by the window: "auto" when fixes were accepted, "always", or "never".
+  std::string calibration = "auto";
+  double calibration_scale_sigma = 0.005;
+  double calibration_heading_bias_sigma_rad = 0.005;
+  double calibration_heading_deviation_sigma_rad = 0.005;
+  // odometry_drift_fraction models the scale and heading errors as independent per edge; once they
+  // are estimated, what is left drifts by this (slowly varying gyro bias, scale changing with the
+  // seabed): otherwise every edge's slack absorbs what the calibration should explain.
+  double calibrated_odometry_drift_fraction = 0.001;
 
   int variance_component_iterations = 20;
   double variance_factor_min = 0.1;
@@ -285,6 +304,20 @@ struct SeparationBias {
   int closures = 0;         // accepted opposite-side closures at the last estimate
 };
 
+// The DR sensor calibration (PoseGraphOptions::calibration) as last estimated.
+struct DrCalibration {
+  bool estimated = false;          // the odometry and INS factors use it (held between smoothings)
+  double dvl_scale = 0.0;          // s: DR distance = (1 + s) x true
+  double heading_bias_rad = 0.0;   // b
+  double heading_cos_rad = 0.0;    // a_c: e(psi) = b + a_c cos(psi) + a_s sin(psi)
+  double heading_sin_rad = 0.0;    // a_s
+  // 1-sigma of each, from the solve's covariance; NaN before an estimate.
+  Eigen::Vector4d sigma = Eigen::Vector4d::Constant(std::numeric_limits<double>::quiet_NaN());
+  double headingErrorRad(double heading_rad) const {
+    return heading_bias_rad + heading_cos_rad * std::cos(heading_rad) + heading_sin_rad * std::sin(heading_rad);
+  }
+};
+
 enum class CorrectionStatus { kDrOnly, kCorrected, kDegraded };
 
 // corrected = T_corrected_dr * T_world_body_dr for the same time (world-frame correction).
@@ -342,6 +375,7 @@ class SlidingWindowPoseGraph {
   const WindowStats& windowStats() const { return window_stats_; }
   const VarianceFactors& varianceFactors() const { return variance_factors_; }
   const SeparationBias& separationBias() const { return separation_bias_; }
+  const DrCalibration& calibration() const { return calibration_; }
   const PoseGraphOptions& options() const { return options_; }
   Correction correctionAt(int64_t utime_us) const;
 
@@ -369,6 +403,9 @@ class SlidingWindowPoseGraph {
     // Odometry from the previous node (identity for the first).
     sss::core::Pose odometry;
     sss::core::Matrix6d odometry_sqrt_information = sss::core::Matrix6d::Identity();
+    // The DR path's heading moments since the previous node (CalibratedOdometryError), north/east.
+    Eigen::Vector2d moment_cos = Eigen::Vector2d::Zero();
+    Eigen::Vector2d moment_sin = Eigen::Vector2d::Zero();
     // Sum over the chain edges e < this node of Ad(dr_{e+1}) Sigma_e Ad(dr_{e+1})^T: the DR chain
     // covariance between any two nodes in O(1) (see chainCovariance()).
     sss::core::Matrix6d chain_prefix = sss::core::Matrix6d::Zero();
@@ -438,8 +475,18 @@ class SlidingWindowPoseGraph {
   bool pairConsistent(const Closure& i, const Closure& j) const;
   sss::core::Matrix6d chainCovariance(int from, int to) const;
   // estimate_separation_bias: the separation bias is a variable of this solve (full smoothing).
+  // estimate_calibration: the DR calibration is a variable too (full smoothing).
   bool solve(const std::vector<Factor>& factors, int max_iterations, UpdateReport& report,
-             bool estimate_separation_bias = false);
+             bool estimate_separation_bias = false, bool estimate_calibration = false);
+  // Whether full smoothing estimates the calibration (PoseGraphOptions::calibration).
+  bool calibrationWanted() const;
+  // Whitening of node k's odometry edge: the configured model, or with the calibration in use
+  // (calibrated_odometry_drift_fraction); divided by the odometry variance factor.
+  sss::core::Matrix6d odometrySqrtInformation(int k, bool calibrated) const;
+  // Node k's odometry edge under the calibration model, holding the last estimate.
+  CalibratedOdometryError calibratedOdometry(int k) const;
+  // The first node's anchor: its DR pose, with the calibrated heading error removed when in use.
+  sss::core::Pose firstNodePrior() const;
   // Unit direction (in A's body frame) along which the separation bias moves the closure's
   // measured B, or zero when the closure is not between opposite-side lines.
   Eigen::Vector3d separationDirection(const Closure& closure) const;
@@ -474,6 +521,8 @@ class SlidingWindowPoseGraph {
   WindowStats window_stats_;
   VarianceFactors variance_factors_;
   SeparationBias separation_bias_;
+  DrCalibration calibration_;
+  bool calibrating_ = false;  // within fullSmoothing(): the calibration is a variable of every solve
   int64_t update_utime_us_ = 0;
   // Newest node time of an accepted closure that left the PCM horizon (its decision is final).
   int64_t frozen_newest_accepted_utime_us_ = -1;

@@ -22,7 +22,8 @@ constexpr const char* kMagic = "sss-pose-graph-checkpoint";
 // 2 adds the variance factors; a version 1 file (before them) restores with factors of 1.
 // 3 adds the separation bias; older files restore without one (0, not applied).
 // 4 adds the absolute fixes; older files restore without any.
-constexpr int kVersion = 4;
+// 5 adds the DR calibration; older files restore without one (not estimated).
+constexpr int kVersion = 5;
 constexpr size_t kMaxFileBytes = size_t{1} << 31;  // 2 GiB: far above any mission
 
 using checkpoint::TextReader;
@@ -130,6 +131,12 @@ std::string SlidingWindowPoseGraph::checkpointText() const {
     w.real(f.record.innovation_chi2);
     w.endLine();
   }
+  const DrCalibration& c = calibration_;
+  w.word("calibration");
+  w.integer(c.estimated ? 1 : 0);
+  for (double v : {c.dvl_scale, c.heading_bias_rad, c.heading_cos_rad, c.heading_sin_rad}) w.real(v);
+  for (int i = 0; i < 4; ++i) w.real(c.sigma(i));
+  w.endLine();
   const WindowStats& s = window_stats_;
   w.word("window");
   for (int v : {s.active_nodes, s.variable_blocks, s.constant_blocks, s.residual_blocks, s.prior_nodes, s.prior_rows,
@@ -311,6 +318,16 @@ Status SlidingWindowPoseGraph::restoreCheckpointText(const std::string& text) {
       }
       g.fixes_.push_back(std::move(f));
     }
+  }
+  if (version >= 5) {
+    DrCalibration& c = g.calibration_;
+    int estimated = 0;
+    if (!r.expect("calibration") || !r.boundedInt(estimated, 0, 1) || !r.finite(c.dvl_scale) ||
+        !r.finite(c.heading_bias_rad) || !r.finite(c.heading_cos_rad) || !r.finite(c.heading_sin_rad) ||
+        !r.real(c.sigma(0)) || !r.real(c.sigma(1)) || !r.real(c.sigma(2)) || !r.real(c.sigma(3)))
+      return fail("bad calibration record");
+    if (!(c.dvl_scale > -0.5)) return fail("calibration record: the DVL scale must be > -0.5");
+    c.estimated = estimated == 1;
   }
   WindowStats& s = g.window_stats_;
   if (!r.expect("window")) return fail("bad window record");

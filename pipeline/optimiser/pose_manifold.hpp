@@ -132,6 +132,68 @@ struct BiasedRelativePoseError {
   }
 };
 
+// The DR sensor calibration of the pose graph, one parameter block [s, b, a_c, a_s]: DVL scale factor
+// s (DR's horizontal distance is (1 + s) times the true one) and the INS heading error
+// e(psi) = b + a_c cos(psi) + a_s sin(psi) (the heading DR used minus the true heading).
+constexpr int kCalibrationSize = 4;
+
+// DR odometry predicted from the true poses with the calibration [s, b, a_c, a_s]. DR integrates
+// (1 + s) times the distance along a heading off by e(psi), and its node attitudes are off by e too:
+//   rotation:    R_dr_a^T R_dr_b = R_a^T Rz(e_b - e_a) R_b
+//   translation: R_dr_a^T dp_dr ~= (1 + s) R_a^T [dp + J (a_c D_c + a_s D_s)]   (horizontal)
+// with J the quarter turn in the north-east plane and D_c, D_s the DR path's moments between the
+// nodes, D_c = integral of (cos psi - cos psi_a) dp (zero along a straight line; a turn between lines
+// gives them, see PathMoments in pose_graph.cpp). A constant bias b cancels: it rotates both ends.
+// The calibration is held (first form, the last estimate) or a parameter block (second).
+struct CalibratedOdometryError {
+  sss::core::Pose measured;
+  sss::core::Matrix6d sqrt_information;
+  Eigen::Vector2d moment_cos = Eigen::Vector2d::Zero();  // D_c, world north/east
+  Eigen::Vector2d moment_sin = Eigen::Vector2d::Zero();  // D_s
+  double heading_a_rad = 0.0;                             // DR headings of the two nodes
+  double heading_b_rad = 0.0;
+  Eigen::Vector3d held = Eigen::Vector3d::Zero();         // s, a_c, a_s
+
+  template <typename T>
+  bool evaluate(const T* x_a, const T* x_b, const T& scale, const T& a_c, const T& a_s, T* residual) const {
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t_a(x_a), t_b(x_b);
+    const Eigen::Map<const Eigen::Quaternion<T>> q_a(x_a + 3), q_b(x_b + 3);
+    const Eigen::Quaternion<T> q_a_inverse = q_a.conjugate();
+    // The heading error's sideways displacement of the DR path, world frame.
+    const Eigen::Matrix<T, 2, 1> moment = a_c * moment_cos.cast<T>() + a_s * moment_sin.cast<T>();
+    const Eigen::Matrix<T, 3, 1> sideways(-moment.y(), moment.x(), T(0));
+    const Eigen::Matrix<T, 3, 1> t_ab = q_a_inverse * (t_b - t_a + sideways);
+    const T delta_e = a_c * T(std::cos(heading_b_rad) - std::cos(heading_a_rad)) +
+                      a_s * T(std::sin(heading_b_rad) - std::sin(heading_a_rad));
+    const Eigen::Quaternion<T> q_delta_e(ceres::cos(delta_e / T(2)), T(0), T(0), ceres::sin(delta_e / T(2)));
+    const Eigen::Quaternion<T> q_ab = q_a_inverse * q_delta_e * q_b;
+    Eigen::Matrix<T, 3, 1> t_measured = measured.translation.cast<T>();
+    t_measured.x() /= T(1) + scale;
+    t_measured.y() /= T(1) + scale;
+    const Eigen::Matrix<T, 6, 1> e = detail::boxMinus<T>(t_ab, q_ab, t_measured, measured.rotation.cast<T>());
+    Eigen::Map<Eigen::Matrix<T, 6, 1>> whitened(residual);
+    whitened = sqrt_information.cast<T>() * e;
+    return true;
+  }
+  template <typename T>
+  bool operator()(const T* x_a, const T* x_b, T* residual) const {
+    return evaluate(x_a, x_b, T(held(0)), T(held(1)), T(held(2)), residual);
+  }
+  template <typename T>
+  bool operator()(const T* x_a, const T* x_b, const T* calibration, T* residual) const {
+    return evaluate(x_a, x_b, calibration[0], calibration[2], calibration[3], residual);
+  }
+
+  static ceres::CostFunction* createHeld(const CalibratedOdometryError& error) {
+    return new ceres::AutoDiffCostFunction<CalibratedOdometryError, 6, kPoseAmbientSize, kPoseAmbientSize>(
+        new CalibratedOdometryError(error));
+  }
+  static ceres::CostFunction* createEstimated(const CalibratedOdometryError& error) {
+    return new ceres::AutoDiffCostFunction<CalibratedOdometryError, 6, kPoseAmbientSize, kPoseAmbientSize,
+                                           kCalibrationSize>(new CalibratedOdometryError(error));
+  }
+};
+
 // Error of an absolute pose prior: e = boxMinus(T, prior), whitened.
 struct PosePriorError {
   sss::core::Pose prior;
@@ -199,6 +261,75 @@ struct PositionFixError {
                                      const Eigen::Matrix2d& sqrt_information) {
     return new ceres::AutoDiffCostFunction<PositionFixError, 2, kPoseAmbientSize>(
         new PositionFixError{p_body, fix_ne, sqrt_information});
+  }
+};
+
+// InsAbsoluteError with the heading error model removed from the INS attitude: the INS says
+// R_dr = Rz(e) R_true (heading about the world's down axis), so the residual rotation is
+// Log(R_dr^T Rz(e) R). The calibration is held (first form) or a parameter block (second).
+struct CalibratedInsAbsoluteError {
+  sss::core::Pose dr;
+  Eigen::Vector4d weight;
+  double dr_heading_rad = 0.0;
+  Eigen::Vector3d held = Eigen::Vector3d::Zero();  // b, a_c, a_s
+
+  template <typename T>
+  bool evaluate(const T* x, const T& b, const T& a_c, const T& a_s, T* residual) const {
+    const Eigen::Map<const Eigen::Quaternion<T>> q(x + 3);
+    residual[0] = T(weight(0)) * (x[2] - T(dr.translation.z()));
+    const T e = b + a_c * T(std::cos(dr_heading_rad)) + a_s * T(std::sin(dr_heading_rad));
+    const Eigen::Quaternion<T> q_e(ceres::cos(e / T(2)), T(0), T(0), ceres::sin(e / T(2)));
+    const Eigen::Matrix<T, 3, 1> rotation_error =
+        detail::logQuaternion<T>(dr.rotation.conjugate().cast<T>() * q_e * Eigen::Quaternion<T>(q));
+    for (int i = 0; i < 3; ++i) residual[1 + i] = T(weight(1 + i)) * rotation_error(i);
+    return true;
+  }
+  template <typename T>
+  bool operator()(const T* x, T* residual) const {
+    return evaluate(x, T(held(0)), T(held(1)), T(held(2)), residual);
+  }
+  template <typename T>
+  bool operator()(const T* x, const T* calibration, T* residual) const {
+    return evaluate(x, calibration[1], calibration[2], calibration[3], residual);
+  }
+
+  static ceres::CostFunction* createHeld(const sss::core::Pose& dr, const Eigen::Vector4d& weight, double dr_heading_rad,
+                                         const Eigen::Vector3d& heading_error) {
+    return new ceres::AutoDiffCostFunction<CalibratedInsAbsoluteError, 4, kPoseAmbientSize>(
+        new CalibratedInsAbsoluteError{dr, weight, dr_heading_rad, heading_error});
+  }
+  static ceres::CostFunction* createEstimated(const sss::core::Pose& dr, const Eigen::Vector4d& weight,
+                                              double dr_heading_rad) {
+    return new ceres::AutoDiffCostFunction<CalibratedInsAbsoluteError, 4, kPoseAmbientSize, kCalibrationSize>(
+        new CalibratedInsAbsoluteError{dr, weight, dr_heading_rad, Eigen::Vector3d::Zero()});
+  }
+};
+
+// The first node's anchor (PosePriorError) with the INS heading error removed from the DR attitude,
+// the calibration a parameter block: e = boxMinus(T, (t_dr, Rz(-e(psi)) R_dr)).
+struct CalibratedPosePriorError {
+  sss::core::Pose prior;
+  sss::core::Matrix6d sqrt_information;
+  double dr_heading_rad = 0.0;
+
+  template <typename T>
+  bool operator()(const T* x, const T* calibration, T* residual) const {
+    const Eigen::Map<const Eigen::Matrix<T, 3, 1>> t(x);
+    const Eigen::Map<const Eigen::Quaternion<T>> q(x + 3);
+    const T e = calibration[1] + calibration[2] * T(std::cos(dr_heading_rad)) + calibration[3] * T(std::sin(dr_heading_rad));
+    const Eigen::Quaternion<T> q_minus_e(ceres::cos(e / T(2)), T(0), T(0), -ceres::sin(e / T(2)));
+    const Eigen::Quaternion<T> prior_rotation = q_minus_e * prior.rotation.cast<T>();
+    const Eigen::Matrix<T, 6, 1> error = detail::boxMinus<T>(Eigen::Matrix<T, 3, 1>(t), Eigen::Quaternion<T>(q),
+                                                             prior.translation.cast<T>(), prior_rotation);
+    Eigen::Map<Eigen::Matrix<T, 6, 1>> whitened(residual);
+    whitened = sqrt_information.cast<T>() * error;
+    return true;
+  }
+
+  static ceres::CostFunction* create(const sss::core::Pose& prior, const sss::core::Matrix6d& sqrt_information,
+                                     double dr_heading_rad) {
+    return new ceres::AutoDiffCostFunction<CalibratedPosePriorError, 6, kPoseAmbientSize, kCalibrationSize>(
+        new CalibratedPosePriorError{prior, sqrt_information, dr_heading_rad});
   }
 };
 

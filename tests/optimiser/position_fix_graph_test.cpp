@@ -186,7 +186,7 @@ TEST(PositionFixGraph, CheckpointCarriesTheFixes) {
   }
   EXPECT_EQ(restored.fixes().back().subframe_id, -1);
 
-  // Version 3 (before fixes) restores without any.
+  // Version 3 (before fixes and calibration) restores without either.
   SlidingWindowPoseGraph no_fixes(graphOptions());
   {
     SlidingWindowPoseGraph plain(graphOptions());
@@ -196,12 +196,14 @@ TEST(PositionFixGraph, CheckpointCarriesTheFixes) {
       ASSERT_TRUE(plain.optimize().ok);
     }
     std::string version_3 = plain.checkpointText();
-    const std::string header = "sss-pose-graph-checkpoint 4";
+    const std::string header = "sss-pose-graph-checkpoint 5";
     ASSERT_EQ(version_3.rfind(header, 0), 0u);
     version_3.replace(0, header.size(), "sss-pose-graph-checkpoint 3");
-    const size_t record = version_3.find("\nfixes ");
-    ASSERT_NE(record, std::string::npos);
-    version_3.erase(record, version_3.find('\n', record + 1) - record);
+    for (const char* newer : {"\nfixes ", "\ncalibration "}) {
+      const size_t record = version_3.find(newer);
+      ASSERT_NE(record, std::string::npos) << newer;
+      version_3.erase(record, version_3.find('\n', record + 1) - record);
+    }
     const Status status = no_fixes.restoreCheckpointText(version_3);
     ASSERT_TRUE(status.ok) << status.message;
     EXPECT_TRUE(no_fixes.fixes().empty());

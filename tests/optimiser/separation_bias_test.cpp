@@ -172,17 +172,20 @@ TEST(SeparationBias, SurvivesACheckpointAndOlderCheckpointsRestoreWithout) {
   EXPECT_TRUE(restored.separationBias().applied);
   EXPECT_TRUE(restored.separationBias().significant);
 
-  // The same state as version 2 wrote it: no separation_bias record (nor version 4's fixes record).
+  // The same state as version 2 wrote it: no separation_bias record (nor version 4's fixes record
+  // and version 5's calibration record).
   std::string version_2 = text;
-  const std::string header = "sss-pose-graph-checkpoint 4";
+  const std::string header = "sss-pose-graph-checkpoint 5";
   ASSERT_EQ(version_2.rfind(header, 0), 0u) << version_2.substr(0, 40);
   version_2.replace(0, header.size(), "sss-pose-graph-checkpoint 2");
   const size_t record = version_2.find("\nseparation_bias ");
   ASSERT_NE(record, std::string::npos);
   version_2.erase(record, version_2.find('\n', record + 1) - record);
-  const size_t fixes_record = version_2.find("\nfixes ");
-  ASSERT_NE(fixes_record, std::string::npos);
-  version_2.erase(fixes_record, version_2.find('\n', fixes_record + 1) - fixes_record);
+  for (const char* newer : {"\nfixes ", "\ncalibration "}) {
+    const size_t newer_record = version_2.find(newer);
+    ASSERT_NE(newer_record, std::string::npos) << newer;
+    version_2.erase(newer_record, version_2.find('\n', newer_record + 1) - newer_record);
+  }
   SlidingWindowPoseGraph older(options);
   const Status status = older.restoreCheckpointText(version_2);
   ASSERT_TRUE(status.ok) << status.message;

@@ -727,6 +727,17 @@ bool writeSummaryJson(const std::string& path, const OfflineRequest& request, co
   json.key("refused").value(s.fixes.refused);
   json.key("rms_residual_m").value(s.fixes.rms_residual_m, 4);
   json.endObject();
+  json.key("calibration").beginObject();  // DVL scale and INS heading error, when fixes observed them
+  json.key("estimated").value(s.calibration.estimated);
+  json.key("dvl_scale").value(s.calibration.dvl_scale, 6);
+  json.key("dvl_scale_sigma").value(s.calibration.sigma(0), 6);
+  json.key("heading_bias_rad").value(s.calibration.heading_bias_rad, 6);
+  json.key("heading_bias_sigma_rad").value(s.calibration.sigma(1), 6);
+  json.key("heading_cos_rad").value(s.calibration.heading_cos_rad, 6);
+  json.key("heading_cos_sigma_rad").value(s.calibration.sigma(2), 6);
+  json.key("heading_sin_rad").value(s.calibration.heading_sin_rad, 6);
+  json.key("heading_sin_sigma_rad").value(s.calibration.sigma(3), 6);
+  json.endObject();
   json.key("lines").beginObject();
   json.key("survey_lines").value(s.survey_lines);
   json.key("turn_pings").value(s.buffer.builder.turn_pings);
@@ -1199,6 +1210,7 @@ bool Runner::writeOutputs(std::string& error) {
   summary_.closures_superseded = counters.closures_superseded;
   summary_.variance_factors = optimiser_.graph().varianceFactors();
   summary_.separation_bias = optimiser_.graph().separationBias();
+  summary_.calibration = optimiser_.graph().calibration();
 
   // Bathymetry: SLAM poses (the product) and DR poses (the baseline the map error is compared to).
   const auto& bathymetry = options_.optimiser.bathymetry;

@@ -89,6 +89,8 @@ struct OfflineSummary {
   sss::optimiser::VarianceFactors variance_factors;
   sss::optimiser::SeparationBias separation_bias;
   FixSummary fixes;
+  // The DR calibration the final smoothing estimated (estimated: false when nothing observed it).
+  sss::optimiser::DrCalibration calibration;
   uint64_t seabed_points = 0;
   uint64_t input_faults = 0;       // corrupt records, bad messages, dropped pings
   // Where the pings went: the fusion's drops by cause and altitude sources, the line builder's.

@@ -1,0 +1,144 @@
+// DR sensor calibration in the pose graph (PoseGraphOptions::calibration): DVL scale factor and the
+// INS heading error b + a_c cos(psi) + a_s sin(psi), estimated at full smoothing once fixes are
+// accepted. The synthetic lawnmower's DR has a known scale error and a steaming error b cos(psi).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "pipeline/optimiser/pose_graph.hpp"
+#include "pipeline/optimiser/synthetic_mission.hpp"
+#include "tests/optimiser/pose_graph_test_helpers.hpp"
+
+namespace sss::optimiser {
+namespace {
+
+using namespace test_helpers;
+
+AbsoluteFix fixAt(const synthetic::Node& node, double sigma_m, std::mt19937_64& random) {
+  std::normal_distribution<double> gauss(0.0, sigma_m);
+  AbsoluteFix fix;
+  fix.utime_us = node.utime_us;
+  fix.position_ne_m = node.truth.translation.head<2>() + Eigen::Vector2d(gauss(random), gauss(random));
+  fix.covariance_m2 = sigma_m * sigma_m * Eigen::Matrix2d::Identity();
+  fix.dr_position_m = node.dr.translation;
+  fix.dr_distance_m = node.distance_m;
+  fix.source = "usbl";
+  return fix;
+}
+
+// Every node's closures and a USBL fix (1 m) at every other node, then full smoothing.
+SlidingWindowPoseGraph solved(const synthetic::Mission& mission, const PoseGraphOptions& options, bool fixes,
+                              uint64_t seed) {
+  std::mt19937_64 random(seed);
+  SlidingWindowPoseGraph graph(options);
+  for (size_t i = 0; i < mission.nodes.size(); ++i) {
+    const synthetic::Node& n = mission.nodes[i];
+    EXPECT_TRUE(graph.addNode(n.subframe_id, n.utime_us, n.dr, n.distance_m).ok);
+    for (const synthetic::Closure& c : mission.closures) {
+      if (c.newer_node == static_cast<int>(i)) {
+        EXPECT_TRUE(graph.addLoopClosure(c.closure).ok);
+      }
+    }
+    if (fixes && i % 2 == 0) {
+      EXPECT_TRUE(graph.addFix(fixAt(n, 1.0, random)).ok);
+    }
+    EXPECT_TRUE(graph.optimize().ok);
+  }
+  EXPECT_TRUE(graph.fullSmoothing().ok);
+  return graph;
+}
+
+// A 2 % scale error and a 0.5 deg steaming error, no other heading error: both are found within
+// 2 sigma, the constant bias and a_s (zero in truth) too, and the ATE improves on fixes alone.
+TEST(DrCalibration, ScaleAndSteamingErrorAreRecoveredFromFixes) {
+  for (uint64_t seed = 1; seed <= 4; ++seed) {
+    synthetic::MissionOptions o = missionOptions(seed);
+    o.velocity_scale_error = 0.02;
+    o.heading_bias_rad = 0.0087;  // 0.5 deg: + heading north, - heading south
+    o.heading_noise_sigma_rad = 0.0;
+    const synthetic::Mission mission = synthetic::makeLawnmowerMission(o);
+    PoseGraphOptions never = graphOptions();
+    never.calibration = "never";
+    const SlidingWindowPoseGraph fixes_only = solved(mission, never, true, seed);
+    const SlidingWindowPoseGraph calibrated = solved(mission, graphOptions(), true, seed);
+    const DrCalibration& c = calibrated.calibration();
+    ASSERT_TRUE(c.estimated);
+    EXPECT_FALSE(fixes_only.calibration().estimated);
+    const double ate_fixes = synthetic::translationRmse(estimates(fixes_only), mission.nodes);
+    const double ate_calibrated = synthetic::translationRmse(estimates(calibrated), mission.nodes);
+    std::printf("seed %llu: scale %.5f +- %.5f (0.02), b %.5f +- %.5f (0), a_c %.5f +- %.5f (0.0087), a_s %.5f +- %.5f "
+                "(0); ATE fixes %.3f, fixes + calibration %.3f m\n",
+                static_cast<unsigned long long>(seed), c.dvl_scale, c.sigma(0), c.heading_bias_rad, c.sigma(1),
+                c.heading_cos_rad, c.sigma(2), c.heading_sin_rad, c.sigma(3), ate_fixes, ate_calibrated);
+    EXPECT_LT(std::abs(c.dvl_scale - 0.02), 2.0 * c.sigma(0));
+    EXPECT_LT(std::abs(c.heading_bias_rad), 2.0 * c.sigma(1));
+    EXPECT_LT(std::abs(c.heading_cos_rad - 0.0087), 2.0 * c.sigma(2));
+    EXPECT_LT(std::abs(c.heading_sin_rad), 2.0 * c.sigma(3));
+    // Ten 1 m fixes 200 m apart observe the scale to ~1.4 m / 200 m / sqrt(8): well below its prior.
+    EXPECT_LT(c.sigma(0), 0.6 * never.calibration_scale_sigma) << "fixes observe the scale";
+    EXPECT_LT(c.sigma(2), 0.3 * never.calibration_heading_deviation_sigma_rad) << "and the steaming error";
+    EXPECT_LT(ate_calibrated, ate_fixes);
+  }
+}
+
+// Without fixes "auto" leaves the graph as it was (bit-identical), and "always" keeps the sigma of
+// what closures cannot see at its prior.
+TEST(DrCalibration, WithoutFixesNothingChangesAndUnobservedSigmasStayAtThePrior) {
+  const synthetic::Mission mission = synthetic::makeLawnmowerMission(missionOptions(2));
+  PoseGraphOptions never = graphOptions();
+  never.calibration = "never";
+  const SlidingWindowPoseGraph plain = solved(mission, never, false, 2);
+  const SlidingWindowPoseGraph automatic = solved(mission, graphOptions(), false, 2);
+  EXPECT_FALSE(automatic.calibration().estimated);
+  EXPECT_TRUE(std::isnan(automatic.calibration().sigma(0)));
+  const auto a = estimates(plain), b = estimates(automatic);
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].translation, b[i].translation) << i;
+    EXPECT_EQ(a[i].rotation.coeffs(), b[i].rotation.coeffs()) << i;
+  }
+  PoseGraphOptions always = graphOptions();
+  always.calibration = "always";
+  const SlidingWindowPoseGraph closures_only = solved(mission, always, false, 2);
+  const DrCalibration& c = closures_only.calibration();
+  ASSERT_TRUE(c.estimated);
+  std::printf("closures only: sigma scale %.5f, b %.5f, a_c %.5f, a_s %.5f (priors %.4f)\n", c.sigma(0), c.sigma(1),
+              c.sigma(2), c.sigma(3), always.calibration_scale_sigma);
+  // A constant heading bias rotates the survey about its start: nothing relative sees it.
+  EXPECT_GT(c.sigma(1), 0.9 * always.calibration_heading_bias_sigma_rad);
+}
+
+// The calibration survives a checkpoint, and a restored graph goes on exactly as the original.
+TEST(DrCalibration, SurvivesACheckpoint) {
+  synthetic::MissionOptions o = missionOptions(3);
+  o.velocity_scale_error = 0.01;
+  const synthetic::Mission mission = synthetic::makeLawnmowerMission(o);
+  SlidingWindowPoseGraph graph = solved(mission, graphOptions(), true, 3);
+  ASSERT_TRUE(graph.calibration().estimated);
+  SlidingWindowPoseGraph restored(graphOptions());
+  const Status status = restored.restoreCheckpointText(graph.checkpointText());
+  ASSERT_TRUE(status.ok) << status.message;
+  EXPECT_TRUE(restored.calibration().estimated);
+  EXPECT_EQ(restored.calibration().dvl_scale, graph.calibration().dvl_scale);
+  EXPECT_EQ(restored.calibration().heading_cos_rad, graph.calibration().heading_cos_rad);
+  EXPECT_EQ(restored.calibration().sigma, graph.calibration().sigma);
+  ASSERT_TRUE(graph.optimize().ok);
+  ASSERT_TRUE(restored.optimize().ok);
+  const auto a = estimates(graph), b = estimates(restored);
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].translation, b[i].translation) << i;
+}
+
+TEST(DrCalibration, BadOptionsAreNamed) {
+  PoseGraphOptions options;
+  options.calibration = "sometimes";
+  options.calibration_scale_sigma = 0.0;
+  const std::vector<std::string> problems = validatePoseGraphOptions(options);
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_NE(problems[0].find("calibration must be one of auto, always, never"), std::string::npos) << problems[0];
+  EXPECT_NE(problems[1].find("calibration_scale_sigma"), std::string::npos) << problems[1];
+}
+
+}  // namespace
+}  // namespace sss::optimiser
