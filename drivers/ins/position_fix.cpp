@@ -73,11 +73,37 @@ std::optional<FixSource> parseFixSourceName(std::string_view name) {
 
 struct PositionFixReader::Impl {
   NmeaStreamParser framing;
-  std::vector<PositionFix> fixes;
-  std::map<int64_t, std::pair<double, double>> gst_sigma;  // epoch -> (north, east) sigma
+  std::vector<PositionFix> released;     // complete: not waiting for a GST any more
+  std::optional<PositionFix> pending;    // the newest GGA, until its GST or the next fix
+  std::optional<std::pair<int64_t, std::pair<double, double>>> last_gst;  // epoch, (north, east) sigma
   std::optional<int64_t> date_days;  // of the newest ZDA/RMC
   double date_seconds_of_day = 0.0;
 };
+
+namespace {
+// A GST's sigma on the fix of its epoch.
+void applyGst(PositionFix& fix, const std::pair<double, double>& sigma) {
+  fix.sigma_north_m = sigma.first;
+  fix.sigma_east_m = sigma.second;
+  fix.sigma_from_gst = true;
+}
+}  // namespace
+
+void PositionFixReader::release() {
+  if (!impl_->pending) return;
+  PositionFix& fix = *impl_->pending;
+  fix.sigma_north_m = std::max(fix.sigma_north_m, options_.min_sigma_m);
+  fix.sigma_east_m = std::max(fix.sigma_east_m, options_.min_sigma_m);
+  if (fix.sigma_from_gst) ++counters_.gst;
+  impl_->released.push_back(fix);
+  impl_->pending.reset();
+}
+
+std::vector<PositionFix> PositionFixReader::take() {
+  std::vector<PositionFix> out;
+  out.swap(impl_->released);
+  return out;
+}
 
 PositionFixReader::PositionFixReader(const FixReaderOptions& options, std::optional<FixSource> forced_source)
     : options_(options), forced_source_(forced_source), impl_(new Impl) {}
@@ -93,6 +119,7 @@ void PositionFixReader::feed(std::string_view bytes) {
   std::vector<std::string> sentences;
   impl_->framing.feed(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size(), sentences);
   for (const std::string& s : sentences) addSentence(s);
+  counters_.rejected_sentences = static_cast<uint64_t>(impl_->framing.rejectedSentences());
 }
 
 void PositionFixReader::addSentence(const std::string& body) {
@@ -148,7 +175,10 @@ void PositionFixReader::addSentence(const std::string& body) {
       fix.utime_us = static_cast<int64_t>(std::llround((static_cast<double>(day) * kSecondsPerDay + fix.seconds_of_day) * 1e6));
       fix.dated = true;
     }
-    impl_->fixes.push_back(fix);
+    // The GST of this epoch may have come just before it; otherwise it may follow.
+    if (impl_->last_gst && impl_->last_gst->first == epochKey(fix.seconds_of_day)) applyGst(fix, impl_->last_gst->second);
+    release();
+    impl_->pending = fix;
     ++counters_.fixes;
   } else if (type == "GST") {
     // GST,time,rms,semi-major,semi-minor,orientation,sigma_lat,sigma_lon,sigma_alt
@@ -158,7 +188,11 @@ void PositionFixReader::addSentence(const std::string& body) {
       malformed("GST");
       return;
     }
-    impl_->gst_sigma[epochKey(seconds)] = {sigma_lat, sigma_lon};
+    impl_->last_gst = std::make_pair(epochKey(seconds), std::make_pair(sigma_lat, sigma_lon));
+    if (impl_->pending && epochKey(impl_->pending->seconds_of_day) == epochKey(seconds)) {
+      applyGst(*impl_->pending, impl_->last_gst->second);
+      release();
+    }
   } else if (type == "ZDA" || type == "RMC") {
     // ZDA,time,dd,mm,yyyy,...   RMC,time,status,lat,N,lon,E,sog,cog,ddmmyy,...
     double seconds = 0.0;
@@ -199,21 +233,8 @@ std::vector<PositionFix> PositionFixReader::finish() {
         break;
       }
   }
-  for (PositionFix& fix : impl_->fixes) {
-    const auto gst = impl_->gst_sigma.find(epochKey(fix.seconds_of_day));
-    if (gst == impl_->gst_sigma.end()) continue;
-    fix.sigma_north_m = gst->second.first;
-    fix.sigma_east_m = gst->second.second;
-    fix.sigma_from_gst = true;
-    ++counters_.gst;
-  }
-  for (PositionFix& fix : impl_->fixes) {
-    fix.sigma_north_m = std::max(fix.sigma_north_m, options_.min_sigma_m);
-    fix.sigma_east_m = std::max(fix.sigma_east_m, options_.min_sigma_m);
-  }
-  std::vector<PositionFix> out;
-  out.swap(impl_->fixes);
-  return out;
+  release();
+  return take();
 }
 
 bool readPositionFixFile(const std::string& spec, const FixReaderOptions& options, std::vector<PositionFix>& fixes,

@@ -1,7 +1,7 @@
 // Absolute position fixes from NMEA 0183 files or streams: GNSS (a receiver on the vehicle's mast,
 // valid only at the surface) and USBL (the ship's acoustic positioning, relayed by the modem or
 // logged on the ship). A fix is a GGA sentence; its accuracy comes from the GST sentence of the same
-// time when there is one (latitude and longitude 1-sigma in metres), else from the GGA's HDOP and
+// time when there is one, sent just before or after it (latitude and longitude 1-sigma in metres), else from the GGA's HDOP and
 // fix quality (GNSS) or a configured sigma (USBL). The date comes from ZDA or RMC sentences; a file
 // without them has times of day only, resolved against the mission's time (resolveFixDates).
 // Talkers GP, GN, GL, GA, GB, GI, GQ and BD are satellite systems: GNSS; any other talker (a USBL
@@ -70,8 +70,10 @@ class PositionFixReader {
   PositionFixReader& operator=(const PositionFixReader&) = delete;
 
   void feed(std::string_view bytes);
-  // End of input: completes the last sentence and returns every fix read (in input order), with its
-  // GST sigma when one of the same time came before or after it.
+  // The fixes complete so far (in input order), each with the sigma of a GST of its epoch sent just
+  // before or just after it; the newest waits for its GST until the next fix or finish().
+  std::vector<PositionFix> take();
+  // End of input: completes the last sentence and returns the fixes not taken yet.
   std::vector<PositionFix> finish();
 
   const FixReaderCounters& counters() const { return counters_; }
@@ -81,6 +83,7 @@ class PositionFixReader {
  private:
   struct Impl;
   void addSentence(const std::string& body);
+  void release();  // the pending fix is complete
   void problem(const std::string& text);
 
   FixReaderOptions options_;

@@ -26,6 +26,7 @@
 #include "drivers/ins/ins_bridge.hpp"
 #include "drivers/ins/nav_message.hpp"
 #include "drivers/ins/nmea_gga.hpp"
+#include "drivers/ins/fix_aligner.hpp"
 #include "drivers/ins/position_fix.hpp"
 #include "drivers/xtf/xtf_reader.hpp"
 #include "pipeline/core/config.hpp"
@@ -76,9 +77,7 @@ struct Options {
   // Section `fixes`: how fix files are read, and the depth above which a GNSS fix is real (the
   // antenna is out of the water only at the surface; below, a receiver reports stale or no fixes).
   sss::ins::FixReaderOptions fix_reader;
-  double gnss_max_depth_m = 1.0;
-  // A fix this far outside the navigation's time span has no DR position to tie it to.
-  double fix_max_extrapolation_s = 2.0;
+  sss::ins::FixAlignerOptions fix_aligner;
 };
 
 // The library keys of each process's section; keys only a live process uses (ports, channels)
@@ -102,8 +101,8 @@ bool readOptions(const std::string& path, Options& options, std::string& error) 
     sss::optimiser::readOptimiserEngineOptions(optimiser, options.optimiser);
     {
       ConfigSection fixes = config.section("fixes");
-      fixes.optional("gnss_max_depth_m", options.gnss_max_depth_m, {atLeast(0.0)});
-      fixes.optional("max_extrapolation_s", options.fix_max_extrapolation_s, {atLeast(0.0)});
+      fixes.optional("gnss_max_depth_m", options.fix_aligner.gnss_max_depth_m, {atLeast(0.0)});
+      fixes.optional("max_extrapolation_s", options.fix_aligner.max_extrapolation_s, {atLeast(0.0)});
       fixes.optional("gnss_sigma_per_hdop_m", options.fix_reader.gnss_sigma_per_hdop_m, {greaterThan(0.0)});
       fixes.optional("dgnss_sigma_per_hdop_m", options.fix_reader.dgnss_sigma_per_hdop_m, {greaterThan(0.0)});
       fixes.optional("rtk_fixed_sigma_per_hdop_m", options.fix_reader.rtk_fixed_sigma_per_hdop_m, {greaterThan(0.0)});
@@ -548,7 +547,7 @@ std::vector<std::string> explainFixes(const FixSummary& f, const Options& option
                   "after it ends): check that the fix file belongs to this mission and its dates (files without "
                   "ZDA/RMC are dated from the navigation's first day)",
                   static_cast<unsigned long long>(f.outside_navigation), static_cast<unsigned long long>(f.read),
-                  options.fix_max_extrapolation_s);
+                  options.fix_aligner.max_extrapolation_s);
     findings.push_back(text);
   }
   if (f.below_surface > 0 && f.below_surface == f.gnss) {
@@ -556,7 +555,7 @@ std::vector<std::string> explainFixes(const FixSummary& f, const Options& option
                   "all %llu GNSS fixes came while the vehicle was deeper than fixes.gnss_max_depth_m (%.1f m) and were "
                   "ignored (a receiver under water reports stale positions); if they are the ship's USBL, name the file "
                   "usbl:PATH",
-                  static_cast<unsigned long long>(f.below_surface), options.gnss_max_depth_m);
+                  static_cast<unsigned long long>(f.below_surface), options.fix_aligner.gnss_max_depth_m);
     findings.push_back(text);
   }
   if (f.fed > 0 && f.accepted == 0) {
@@ -815,7 +814,8 @@ class Runner {
         options_(options),
         buffer_(options.buffer),
         matcher_(options.matcher),
-        optimiser_(options.optimiser) {
+        optimiser_(options.optimiser),
+        fix_aligner_(options.fix_aligner) {
     buffer_.setFusedPingObserver([this](const sss::subframe::FusedPing& fused) {
       dr_per_ping_.push_back({fused.ping.utime_us, fused.T_world_body});
       altitude_per_ping_.push_back({fused.ping.utime_us, fused.altitude_m, fused.altitude_source, fused.bottom_track_quality});
@@ -829,15 +829,13 @@ class Runner {
     if (nav.origin && !origin_) origin_ = nav.origin;  // the frame every output is written in
     buffer_.addNav(nav, subframes_);
     handleSubframes();
-    if (nav.position_valid && (nav_history_.empty() || nav.utime_us > nav_history_.back().utime_us)) {
-      nav_history_.push_back({nav.utime_us, nav.position_ned_m, nav.distance_travelled_m});
-    }
-    feedFixes(nav.utime_us, false);
+    if (nav.position_valid) fix_aligner_.addNav(nav.utime_us, nav.position_ned_m, nav.distance_travelled_m, nav.origin);
+    feedFixes(false);
   }
 
   // The fixes of the request's files, in file order (dated against the navigation later).
-  void setFixes(std::vector<sss::ins::PositionFix> fixes) {
-    pending_fixes_.assign(fixes.begin(), fixes.end());
+  void setFixes(const std::vector<sss::ins::PositionFix>& fixes) {
+    for (const auto& fix : fixes) fix_aligner_.addFix(fix);
   }
   void addPing(PingInput ping) {
     ++summary_.pings;
@@ -850,7 +848,7 @@ class Runner {
   void finish() {
     buffer_.finish(subframes_);
     handleSubframes();
-    feedFixes(std::numeric_limits<int64_t>::max(), true);
+    feedFixes(true);
     const double start = wallSeconds();
     optimiser_.finish();
     summary_.optimiser_s += wallSeconds() - start;
@@ -980,73 +978,22 @@ class Runner {
     return true;
   }
 
-  // Fixes up to up_to_us (all when final) into the optimiser, each tied to the DR position at its
-  // time; GNSS only while at the surface. The navigation history is kept only as far back as the
-  // oldest fix still to come needs it.
-  void feedFixes(int64_t up_to_us, bool final) {
-    if (pending_fixes_.empty() || nav_history_.empty()) {
-      if (final) summary_.fixes.outside_navigation += pending_fixes_.size();
-      if (final) pending_fixes_.clear();
-      return;
+  // The fixes the navigation has passed (all when final) into the optimiser.
+  void feedFixes(bool final) {
+    for (const sss::ins::AlignedFix& aligned : fix_aligner_.take(final)) {
+      sss::optimiser::AbsoluteFix input;
+      input.utime_us = aligned.fix.utime_us;
+      input.position_ne_m = aligned.position_ne_m;
+      input.covariance_m2 = aligned.covariance_m2;
+      input.dr_position_m = aligned.dr_position_m;
+      input.dr_distance_m = aligned.dr_distance_m;
+      input.source = sss::ins::fixSourceName(aligned.fix.source);
+      ++(optimiser_.addFix(input).ok ? summary_.fixes.fed : summary_.fixes.refused);
     }
-    if (!fixes_dated_) {
-      std::vector<sss::ins::PositionFix> fixes(pending_fixes_.begin(), pending_fixes_.end());
-      sss::ins::resolveFixDates(fixes, nav_history_.front().utime_us);
-      std::stable_sort(fixes.begin(), fixes.end(), [](const auto& a, const auto& b) { return a.utime_us < b.utime_us; });
-      pending_fixes_.assign(fixes.begin(), fixes.end());
-      fixes_dated_ = true;
-    }
-    const int64_t tolerance_us = static_cast<int64_t>(options_.fix_max_extrapolation_s * 1e6);
-    while (!pending_fixes_.empty() && (final || pending_fixes_.front().utime_us <= up_to_us)) {
-      const sss::ins::PositionFix fix = pending_fixes_.front();
-      pending_fixes_.pop_front();
-      tieFix(fix, tolerance_us);
-    }
-    // Keep the samples the next fix may fall between (and always the newest two).
-    const int64_t keep_from_us = pending_fixes_.empty() ? nav_history_.back().utime_us : pending_fixes_.front().utime_us;
-    while (nav_history_.size() > 2 && nav_history_[1].utime_us <= keep_from_us) nav_history_.pop_front();
-  }
-
-  void tieFix(const sss::ins::PositionFix& fix, int64_t tolerance_us) {
-    sss::offline::FixSummary& s = summary_.fixes;
-    if (!origin_) {
-      ++s.no_frame;
-      return;
-    }
-    const NavPoint& first = nav_history_.front();
-    const NavPoint& last = nav_history_.back();
-    if (fix.utime_us < first.utime_us - tolerance_us || fix.utime_us > last.utime_us + tolerance_us) {
-      ++s.outside_navigation;
-      return;
-    }
-    // The DR position and distance at the fix time: linear between the bracketing samples.
-    NavPoint at = fix.utime_us <= first.utime_us ? first : last;
-    for (size_t i = 1; i < nav_history_.size(); ++i) {
-      const NavPoint& a = nav_history_[i - 1];
-      const NavPoint& b = nav_history_[i];
-      if (fix.utime_us < a.utime_us || fix.utime_us > b.utime_us) continue;
-      const double alpha = static_cast<double>(fix.utime_us - a.utime_us) / static_cast<double>(b.utime_us - a.utime_us);
-      at.position_ned_m = a.position_ned_m + alpha * (b.position_ned_m - a.position_ned_m);
-      at.distance_m = a.distance_m + alpha * (b.distance_m - a.distance_m);
-      break;
-    }
-    if (fix.source == sss::ins::FixSource::kGnss && at.position_ned_m.z() > options_.gnss_max_depth_m) {
-      ++s.below_surface;
-      return;
-    }
-    if (!plane_) plane_.emplace(origin_->latitude_deg, origin_->longitude_deg);
-    sss::optimiser::AbsoluteFix input;
-    input.utime_us = fix.utime_us;
-    input.position_ne_m = plane_->toNed({fix.latitude_deg, fix.longitude_deg, 0.0}).head<2>();
-    input.covariance_m2 = Eigen::Vector2d(fix.sigma_north_m * fix.sigma_north_m, fix.sigma_east_m * fix.sigma_east_m).asDiagonal();
-    input.dr_position_m = at.position_ned_m;
-    input.dr_distance_m = at.distance_m;
-    input.source = sss::ins::fixSourceName(fix.source);
-    if (optimiser_.addFix(input).ok) {
-      ++s.fed;
-    } else {
-      ++s.refused;
-    }
+    const sss::ins::FixAlignerCounters& c = fix_aligner_.counters();
+    summary_.fixes.below_surface = c.below_surface;
+    summary_.fixes.outside_navigation = c.outside_navigation;
+    summary_.fixes.no_frame = c.no_frame;
   }
 
   void update() {
@@ -1080,16 +1027,7 @@ class Runner {
   std::vector<sss::subframe::Subframe> mosaic_subframes_;
   std::vector<std::pair<int, sss::core::Pose>> centres_;  // line id and DR centre pose of every subframe
   std::vector<sss::optimiser::StampedPose> dr_per_ping_;
-  // Fixes: those still to come (time order once dated), and the navigation they are tied through.
-  struct NavPoint {
-    int64_t utime_us = 0;
-    Eigen::Vector3d position_ned_m = Eigen::Vector3d::Zero();
-    double distance_m = 0.0;
-  };
-  std::deque<sss::ins::PositionFix> pending_fixes_;
-  bool fixes_dated_ = false;
-  std::deque<NavPoint> nav_history_;
-  std::optional<sss::core::LocalTangentPlane> plane_;
+  sss::ins::FixAligner fix_aligner_;  // the request's fixes, tied to the navigation as it comes
   struct PingAltitude {
     int64_t utime_us;
     double altitude_m;
