@@ -1,5 +1,8 @@
 // sss-ins-bridge: iXblue NMEA from UDP, TCP, a serial port or a file -> SSS_NAV on LCM, with
-// staleness in the message flags and in SSS_STATUS. Translation only; the logic is in InsBridge.
+// staleness in the message flags and in SSS_STATUS; and, when fix_udp_port is set, absolute position
+// fixes (GNSS at the surface, USBL relayed by the modem: NMEA GGA + GST + ZDA on their own UDP port)
+// -> SSS_FIX, placed in the mission frame with the DR state at their time. Translation only; the
+// logic is in InsBridge, PositionFixReader and FixAligner.
 //   sss-ins-bridge [--config FILE] [--file ins.nmea [--speed X]] [--lcm-url URL]
 #include <arpa/inet.h>
 #include <fcntl.h>
@@ -15,7 +18,10 @@
 #include <fstream>
 #include <string>
 
+#include "drivers/ins/fix_aligner.hpp"
+#include "drivers/ins/fix_message.hpp"
 #include "drivers/ins/ins_bridge.hpp"
+#include "drivers/ins/position_fix.hpp"
 #include "drivers/ins/nav_message.hpp"
 #include "pipeline/core/mission_origin.hpp"
 #include "pipeline/core/state_file.hpp"
@@ -41,6 +47,12 @@ struct NodeOptions {
   std::string file;
   double replay_speed = 1.0;
   std::string nav_channel = "SSS_NAV";
+  // Absolute fixes on their own UDP port (0: none): not mixed into the INS stream, whose assembler
+  // would take a GNSS ZDA for its own epoch's time.
+  int fix_udp_port = 0;
+  std::string fix_channel = "SSS_FIX";
+  sss::ins::FixReaderOptions fix_reader;
+  sss::ins::FixAlignerOptions fix_aligner;
   // The odometer survives restarts here. Empty: $STATE_DIRECTORY (systemd StateDirectory=), else
   // none (a restarted bridge counts distance travelled from 0 again).
   std::string state_directory;
@@ -95,16 +107,16 @@ speed_t baudConstant(int baud) {
   }
 }
 
-int openUdp(const NodeOptions& options, std::string& error) {
+int openUdp(const std::string& bind_address, int port, std::string& error) {
   const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
   const int one = 1;
   ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof(one));
   sockaddr_in address{};
   address.sin_family = AF_INET;
-  address.sin_port = htons(static_cast<uint16_t>(options.udp_port));
-  ::inet_pton(AF_INET, options.bind_address.c_str(), &address.sin_addr);
+  address.sin_port = htons(static_cast<uint16_t>(port));
+  ::inet_pton(AF_INET, bind_address.c_str(), &address.sin_addr);
   if (::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0) {
-    error = "cannot bind UDP " + options.bind_address + ":" + std::to_string(options.udp_port) + ": " + std::strerror(errno);
+    error = "cannot bind UDP " + bind_address + ":" + std::to_string(port) + ": " + std::strerror(errno);
     ::close(fd);
     return -1;
   }
@@ -178,6 +190,11 @@ int main(int argc, char** argv) {
     if (!file_given) section.optional("file", options.file);
     if (!speed_given) section.optional("replay_speed", options.replay_speed, {inRange(0.0, 1000.0)});
     section.optional("nav_channel", options.nav_channel, {nonEmpty()});
+    section.optional("fix_udp_port", options.fix_udp_port, {inRange(0, 65535)});
+    section.optional("fix_channel", options.fix_channel, {nonEmpty()});
+    section.optional("fix_gnss_max_depth_m", options.fix_aligner.gnss_max_depth_m, {atLeast(0.0)});
+    section.optional("fix_max_latency_s", options.fix_aligner.max_latency_s, {inRange(1.0, 3600.0)});
+    section.optional("fix_usbl_default_sigma_m", options.fix_reader.usbl_default_sigma_m, {greaterThan(0.0)});
     section.optional("state_directory", options.state_directory);
     section.rejectUnknownKeys();
     config_problems = config.problemReport();
@@ -238,12 +255,27 @@ int main(int argc, char** argv) {
   };
   loop.addTimer(1.0, saveOdometerIfMoved);
 
+  // Fixes: read from their port, tied to the navigation as it passes their time.
+  sss::ins::PositionFixReader fix_reader(options.fix_reader);
+  sss::ins::FixAligner fix_aligner(options.fix_aligner);
+  uint64_t fixes_published = 0;
+  bool fix_problem_reported = false;
+  auto publishFixes = [&](int64_t since_us) {
+    if (!bridge.origin()) return;
+    for (const sss::ins::AlignedFix& fix : fix_aligner.take()) {
+      loop.bus().publish(options.fix_channel, sss::ins::toFixMessage(fix, *bridge.origin()), since_us);
+      ++fixes_published;
+    }
+  };
   auto publishAll = [&](int64_t since_us) {
     announceOrigin();
     for (const auto& sample : samples) {
       loop.bus().publish(options.nav_channel, sss::ins::toNavMessage(sample), since_us);
+      if ((sample.ins.validity & sss::ins::kValidPosition) && sample.origin)
+        fix_aligner.addNav(sample.ins.utime_us, sample.position_ned_m, sample.distance_travelled_m, sample.origin);
     }
     samples.clear();
+    if (options.fix_udp_port > 0) publishFixes(since_us);
   };
   // Health: staleness (recovers by itself when data returns), counters, faults logged once.
   loop.addTimer(0.5, [&] {
@@ -261,6 +293,19 @@ int main(int argc, char** argv) {
     health.setCounter("ins_epochs_out_of_order", static_cast<double>(bridge.epochsOutOfOrder()));
     health.setCounter("odometer_m", bridge.odometer().distance_travelled_m);
     health.setCounter("odometer_write_failures", static_cast<double>(odometer_write_failures));
+    if (options.fix_udp_port > 0) {
+      const auto& aligned = fix_aligner.counters();
+      health.setCounter("fixes_in", static_cast<double>(aligned.fixes_in));
+      health.setCounter("fixes_published", static_cast<double>(fixes_published));
+      health.setCounter("fixes_below_surface", static_cast<double>(aligned.below_surface));
+      health.setCounter("fixes_outside_navigation", static_cast<double>(aligned.outside_navigation));
+      const auto& read = fix_reader.counters();
+      health.setCounter("fix_sentences_skipped", static_cast<double>(read.rejected_sentences + read.malformed));
+      if (!fix_problem_reported && !fix_reader.firstProblem().empty()) {  // once: later ones are counted
+        loop.reportFaults("fix_input", {"fixes: " + fix_reader.firstProblem()});
+        fix_problem_reported = true;
+      }
+    }
     if (bridge.origin()) {  // the mission frame, for the operator (NaN-free: only once it is known)
       health.setCounter("origin_latitude_deg", bridge.origin()->latitude_deg);
       health.setCounter("origin_longitude_deg", bridge.origin()->longitude_deg);
@@ -277,8 +322,28 @@ int main(int argc, char** argv) {
   sss::transport::ReplayPacer pacer(options.replay_speed);
   bool replay_eof = false;
 
+  int fix_fd = -1;
+  if (options.fix_udp_port > 0) {
+    fix_fd = openUdp(options.bind_address, options.fix_udp_port, error);
+    if (fix_fd < 0) {
+      spdlog::critical("fixes: {}", error);
+      return 1;
+    }
+    spdlog::info("absolute fixes (NMEA GGA + GST + ZDA) on UDP {}:{} -> {}", options.bind_address, options.fix_udp_port,
+                 options.fix_channel);
+    loop.addFileDescriptor(fix_fd, [&] {
+      char datagram[65536];
+      ssize_t n;
+      while ((n = ::recv(fix_fd, datagram, sizeof(datagram), 0)) > 0) {
+        fix_reader.feed(std::string_view(datagram, static_cast<size_t>(n)));
+        for (const sss::ins::PositionFix& fix : fix_reader.take()) fix_aligner.addFix(fix);
+      }
+      publishFixes(monotonicUtime());
+    });
+  }
+
   if (options.source == "udp") {
-    input_fd = openUdp(options, error);
+    input_fd = openUdp(options.bind_address, options.udp_port, error);
     if (input_fd < 0) {
       spdlog::critical("{}", error);
       return 1;
@@ -379,5 +444,6 @@ int main(int argc, char** argv) {
   const int code = loop.run();
   saveOdometerIfMoved();
   if (input_fd >= 0) ::close(input_fd);
+  if (fix_fd >= 0) ::close(fix_fd);
   return code;
 }

@@ -1,4 +1,4 @@
-// sss-optimiser: SSS_SUBFRAME + SSS_LOOP -> pose graph -> SSS_TRAJECTORY (matcher); SSS_NAV ->
+// sss-optimiser: SSS_SUBFRAME + SSS_LOOP (+ SSS_FIX: absolute fixes) -> pose graph -> SSS_TRAJECTORY (matcher); SSS_NAV ->
 // SSS_POSE for every nav sample and the correction on DDS for the navigation computer.
 // Translation only; the logic is in OptimiserEngine. The graph is solved on a worker thread; the
 // process loop answers each nav sample from a snapshot of the newest solved graph, so a solve never
@@ -31,6 +31,7 @@
 #include "pipeline/core/time.hpp"
 #include "pipeline/matcher/loop_closure_message.hpp"
 #include "pipeline/optimiser/optimiser_engine.hpp"
+#include "pipeline/optimiser/fix_message.hpp"
 #include "pipeline/optimiser/pose_message.hpp"
 #include "pipeline/subframe/subframe_message.hpp"
 #include "pipeline/transport/dds.hpp"
@@ -52,6 +53,7 @@ struct NodeOptions {
   std::optional<sss::core::MissionOrigin> configured_origin;
   std::string subframe_channel = "SSS_SUBFRAME";
   std::string loop_channel = "SSS_LOOP";
+  std::string fix_channel = "SSS_FIX";
   std::string nav_channel = "SSS_NAV";
   std::string pose_channel = "SSS_POSE";
   std::string trajectory_channel = "SSS_TRAJECTORY";
@@ -76,6 +78,7 @@ struct Shared {
   std::condition_variable wake;
   std::deque<sss::subframe::Subframe> subframes;
   std::deque<sss::matcher::LoopClosure> closures;
+  std::deque<sss::optimiser::AbsoluteFix> fixes;  // SSS_FIX, in the navigation's frame
   bool products_requested = false;
   bool stop = false;
   std::optional<sss::core::MissionOrigin> origin;  // of the navigation (SSS_NAV), for the products
@@ -84,6 +87,7 @@ struct Shared {
   std::optional<std::vector<sss::matcher::TrajectoryNode>> trajectory;  // to publish
   sss::optimiser::PoseGraphCounters graph_counters;
   sss::optimiser::OptimiserEngineCounters engine_counters;
+  sss::optimiser::FixCounters fix_counters;
   double last_update_s = 0.0;
   double last_checkpoint_s = 0.0;
   size_t memory_bytes = 0;
@@ -134,6 +138,7 @@ int main(int argc, char** argv) {
     sss::optimiser::readOptimiserEngineOptions(section, options.engine);
     section.optional("subframe_channel", options.subframe_channel, {nonEmpty()});
     section.optional("loop_channel", options.loop_channel, {nonEmpty()});
+    section.optional("fix_channel", options.fix_channel, {nonEmpty()});
     section.optional("nav_channel", options.nav_channel, {nonEmpty()});
     section.optional("pose_channel", options.pose_channel, {nonEmpty()});
     section.optional("trajectory_channel", options.trajectory_channel, {nonEmpty()});
@@ -209,16 +214,19 @@ int main(int argc, char** argv) {
     for (;;) {
       std::deque<sss::subframe::Subframe> subframes;
       std::deque<sss::matcher::LoopClosure> closures;
+      std::deque<sss::optimiser::AbsoluteFix> fixes;
       bool products = false;
       std::optional<sss::core::MissionOrigin> origin;
       {
         std::unique_lock<std::mutex> lock(shared.mutex);
         shared.wake.wait_for(lock, std::chrono::duration<double>(std::max(options.update_period_s, 0.05)), [&] {
-          return shared.stop || !shared.subframes.empty() || !shared.closures.empty() || shared.products_requested;
+          return shared.stop || !shared.subframes.empty() || !shared.closures.empty() || !shared.fixes.empty() ||
+                 shared.products_requested;
         });
         if (shared.stop) return;
         subframes.swap(shared.subframes);
         closures.swap(shared.closures);
+        fixes.swap(shared.fixes);
         products = shared.products_requested;
         shared.products_requested = false;
         origin = shared.origin;
@@ -235,6 +243,10 @@ int main(int argc, char** argv) {
           messages.push_back("closure " + std::to_string(closure.subframe_id_a) + "-" +
                              std::to_string(closure.subframe_id_b) + " refused: " + status.message);
         }
+      }
+      for (const auto& fix : fixes) {
+        const auto status = engine.addFix(fix);
+        if (!status.ok) messages.push_back("fix refused: " + status.message);
       }
       const double now_s = 1e-6 * static_cast<double>(sss::core::monotonicUtime());
       bool updated = false;
@@ -265,6 +277,7 @@ int main(int argc, char** argv) {
         }
         shared.graph_counters = engine.graph().counters();
         shared.engine_counters = engine.counters();
+        shared.fix_counters = engine.graph().fixCounters();
         shared.last_update_s = engine.graph().counters().last_update_s;
         if (checkpoint_s >= 0.0) shared.last_checkpoint_s = checkpoint_s;
         shared.memory_bytes = engine.memoryBytes();
@@ -402,6 +415,26 @@ int main(int argc, char** argv) {
     shared.wake.notify_one();
   });
 
+  // Absolute fixes placed in the mission frame by the INS bridge: used only in the navigation's frame.
+  loop.bus().subscribe<sss_msgs::fix_t>(options.fix_channel, [&](const sss_msgs::fix_t& message) {
+    std::string error;
+    std::optional<sss::optimiser::AbsoluteFix> fix = sss::optimiser::fromFixMessage(message, error);
+    std::lock_guard<std::mutex> lock(shared.mutex);
+    const sss::core::MissionOrigin origin = sss::optimiser::fixMessageOrigin(message);
+    if (fix && shared.origin && (std::abs(origin.latitude_deg - shared.origin->latitude_deg) > 1e-9 ||
+                                 std::abs(origin.longitude_deg - shared.origin->longitude_deg) > 1e-9)) {
+      error = "the fix's mission origin differs from the navigation's (another INS bridge?)";
+      fix.reset();
+    }
+    if (!fix) {
+      if (health.recordError("bad_fix", error, sss::core::nowUtime()))
+        spdlog::warn("fix rejected: {}; further ones are counted in SSS_STATUS", error);
+      return;
+    }
+    shared.fixes.push_back(*fix);
+    shared.wake.notify_one();
+  });
+
   loop.addFileDescriptor(results_fd, [&] {
     uint64_t count = 0;
     if (read(results_fd, &count, sizeof count) < 0) return;
@@ -409,6 +442,7 @@ int main(int argc, char** argv) {
     std::vector<std::string> messages;
     sss::optimiser::PoseGraphCounters graph_counters;
     sss::optimiser::OptimiserEngineCounters engine_counters;
+    sss::optimiser::FixCounters fix_counters;
     size_t memory_bytes = 0;
     double last_checkpoint_s = 0.0;
     {
@@ -417,6 +451,7 @@ int main(int argc, char** argv) {
       messages.swap(shared.messages);
       graph_counters = shared.graph_counters;
       engine_counters = shared.engine_counters;
+      fix_counters = shared.fix_counters;
       memory_bytes = shared.memory_bytes;
       last_checkpoint_s = shared.last_checkpoint_s;
     }
@@ -436,6 +471,9 @@ int main(int argc, char** argv) {
     health.setCounter("closures_waiting", static_cast<double>(engine_counters.closures_waiting));
     health.setCounter("subframes_refused", static_cast<double>(engine_counters.subframes_refused));
     health.setCounter("odometer_resets", static_cast<double>(engine_counters.odometer_resets));
+    health.setCounter("fixes_received", static_cast<double>(fix_counters.received));
+    health.setCounter("fixes_accepted", static_cast<double>(fix_counters.accepted));
+    health.setCounter("fixes_rejected", static_cast<double>(fix_counters.rejected_gate + fix_counters.refused));
     health.setCounter("updates", static_cast<double>(graph_counters.updates));
     health.setCounter("solver_failures", static_cast<double>(graph_counters.solver_failures));
     health.setCounter("last_update_ms", 1e3 * graph_counters.last_update_s);
@@ -484,6 +522,7 @@ int main(int argc, char** argv) {
     if (!status.message.empty()) spdlog::info("subframe {}: {}", subframe.id, status.message);
   }
   for (const auto& closure : shared.closures) engine.addLoopClosure(closure);
+  for (const auto& fix : shared.fixes) engine.addFix(fix);
   if (engine.graph().numNodes() > 0) {
     engine.finish();
     std::vector<std::string> messages;

@@ -1,9 +1,14 @@
 // sss-ins-emulator: sends a recorded iXblue NMEA stream as the INS does, one datagram per output
-// burst over UDP (default) or as a TCP server, paced by the epoch times, with fault injection.
+// burst over UDP (default) or as a TCP server, paced by the epoch times, with fault injection; with
+// --fixes, also the absolute fixes of sss-sim's fixes.nmea (GNSS, USBL) as their receivers would, one
+// UDP datagram per fix to --fixes-port, in step with the INS stream.
 //   sss-ins-emulator --file ins.nmea [--udp | --tcp] [--host 127.0.0.1] [--port 8110] [--speed 1]
+//                    [--fixes fixes.nmea --fixes-port 8111]
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
+#include <thread>
 
 #include "tools/emulators/emulator_options.hpp"
 #include "tools/emulators/recorded_streams.hpp"
@@ -16,13 +21,18 @@ void onSignal(int) { g_stop = true; }
 int main(int argc, char** argv) {
   sss::emulators::StreamServerOptions options;
   options.port = 8110;
-  std::string file;
+  std::string file, fixes_file;
+  int fixes_port = 8111;
   bool tcp = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     std::string error;
     if (arg == "--file" && i + 1 < argc) {
       file = argv[++i];
+    } else if (arg == "--fixes" && i + 1 < argc) {
+      fixes_file = argv[++i];
+    } else if (arg == "--fixes-port" && i + 1 < argc) {
+      fixes_port = std::atoi(argv[++i]);
     } else if (arg == "--tcp") {
       tcp = true;
     } else if (arg == "--udp") {
@@ -30,8 +40,10 @@ int main(int argc, char** argv) {
     } else if (!sss::emulators::parseStreamOption(argc, argv, i, options, error) || !error.empty()) {
       if (!error.empty()) std::fprintf(stderr, "sss-ins-emulator: %s\n", error.c_str());
       std::fprintf(stderr,
-                   "usage: sss-ins-emulator --file ins.nmea [--udp | --tcp] [--host ADDR] [--port 8110] [options]\n"
-                   "  UDP sends to --host:--port; TCP listens on --host:--port\n%s",
+                   "usage: sss-ins-emulator --file ins.nmea [--udp | --tcp] [--host ADDR] [--port 8110]\n"
+                   "                        [--fixes fixes.nmea [--fixes-port 8111]] [options]\n"
+                   "  UDP sends to --host:--port; TCP listens on --host:--port; fixes go by UDP to\n"
+                   "  --host:--fixes-port (no faults injected into them)\n%s",
                    sss::emulators::streamOptionsHelp());
       return arg == "--help" ? 0 : 2;
     }
@@ -50,6 +62,28 @@ int main(int argc, char** argv) {
   }
   std::printf("sss-ins-emulator: %zu bursts from %s %s %s:%d at speed %g\n", chunks.size(), file.c_str(),
               tcp ? "served on" : "sent to", options.bind_address.c_str(), options.port, options.speed);
+  // Fixes: their own sender, paced from the INS stream's first epoch so both keep the mission's time.
+  std::thread fixes_thread;
+  std::string fixes_error;
+  if (!fixes_file.empty()) {
+    std::vector<sss::emulators::TimedChunk> fix_chunks =
+        sss::emulators::loadFixChunks(fixes_file, chunks.front().time_us, error);
+    if (!error.empty()) {
+      std::fprintf(stderr, "sss-ins-emulator: %s\n", error.c_str());
+      return 1;
+    }
+    sss::emulators::StreamServerOptions fix_options;
+    fix_options.bind_address = options.bind_address;
+    fix_options.port = fixes_port;
+    fix_options.speed = options.speed;
+    fix_options.pacing_origin_us = chunks.front().time_us;
+    std::printf("sss-ins-emulator: %zu fixes from %s sent to %s:%d\n", fix_chunks.size(), fixes_file.c_str(),
+                options.bind_address.c_str(), fixes_port);
+    fixes_thread = std::thread([fix_options, fix_chunks = std::move(fix_chunks), &fixes_error]() mutable {
+      sss::emulators::UdpStreamSender sender(fix_options, std::move(fix_chunks));
+      sender.run(g_stop, fixes_error);
+    });
+  }
   std::fflush(stdout);
   sss::emulators::StreamStats stats;
   if (tcp) {
@@ -68,6 +102,8 @@ int main(int argc, char** argv) {
     }
     stats = sender.stats();
   }
+  if (fixes_thread.joinable()) fixes_thread.join();
+  if (!fixes_error.empty()) std::fprintf(stderr, "sss-ins-emulator: fixes: %s\n", fixes_error.c_str());
   // What was injected, for the fault tests' logs (tools/run-chain).
   std::printf("sss-ins-emulator: sent %llu whole, %llu faulted, %llu garbage runs, %llu connections, %llu drops, "
               "%llu pauses, %llu skipped\n",

@@ -1,11 +1,13 @@
 // Recorded sensor files -> timed chunks, see recorded_streams.hpp.
 #include "tools/emulators/recorded_streams.hpp"
 
+#include <algorithm>
 #include <fstream>
 
 #include "drivers/edgetech/jsf_file_reader.hpp"
 #include "drivers/ins/ins_state_assembler.hpp"
 #include "drivers/ins/nmea_stream_parser.hpp"
+#include "drivers/ins/position_fix.hpp"
 
 namespace sss::emulators {
 
@@ -66,6 +68,21 @@ std::vector<TimedChunk> loadInsChunks(const std::string& path, std::string& erro
     pending.time_us = last_time_us;
     chunks.push_back(std::move(pending));
   }
+  return chunks;
+}
+
+std::vector<TimedChunk> loadFixChunks(const std::string& path, int64_t reference_utime_us, std::string& error) {
+  std::vector<sss::ins::PositionFix> fixes;
+  sss::ins::FixReaderCounters counters;
+  std::string problem;
+  if (!sss::ins::readPositionFixFile(path, sss::ins::FixReaderOptions{}, fixes, counters, problem, error)) return {};
+  sss::ins::resolveFixDates(fixes, reference_utime_us);
+  std::vector<TimedChunk> chunks;
+  for (const sss::ins::PositionFix& fix : fixes) {
+    const std::string text = sss::ins::encodePositionFix(fix, fix.source == sss::ins::FixSource::kGnss ? "GP" : "II");
+    chunks.push_back({fix.utime_us, std::vector<uint8_t>(text.begin(), text.end())});
+  }
+  std::stable_sort(chunks.begin(), chunks.end(), [](const TimedChunk& a, const TimedChunk& b) { return a.time_us < b.time_us; });
   return chunks;
 }
 

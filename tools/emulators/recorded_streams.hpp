@@ -2,6 +2,7 @@
 // message per chunk (at its ping time), one INS output burst per chunk (at its epoch time).
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -14,5 +15,8 @@ std::vector<TimedChunk> loadJsfChunks(const std::string& path, std::string& erro
 // The NMEA lines of an INS file grouped into bursts ending with $PIXSE,STATUS (the iXblue
 // output period), each stamped with the epoch time the INS assembler reads from it.
 std::vector<TimedChunk> loadInsChunks(const std::string& path, std::string& error);
+// The absolute fixes of a fixes.nmea file (sss-sim), one chunk per fix (ZDA + GGA + GST, re-encoded;
+// GNSS talker GP, USBL II), stamped with its time; fixes without a date take reference_utime_us's day.
+std::vector<TimedChunk> loadFixChunks(const std::string& path, int64_t reference_utime_us, std::string& error);
 
 }  // namespace sss::emulators

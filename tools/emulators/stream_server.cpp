@@ -143,7 +143,7 @@ int TcpStreamServer::acceptClient(const std::atomic<bool>& stop) {
 void TcpStreamServer::run(const std::atomic<bool>& stop) {
   if (chunks_.empty()) return;
   std::mt19937 rng(options_.faults.seed);
-  Pacer pacer(options_.speed, chunks_.front().time_us);
+  Pacer pacer(options_.speed, options_.pacing_origin_us.value_or(chunks_.front().time_us));
   std::vector<uint8_t> bytes;
   int client = acceptClient(stop);
   for (size_t i = 0; i < chunks_.size() && client >= 0; ++i) {
@@ -192,7 +192,7 @@ bool UdpStreamSender::run(const std::atomic<bool>& stop, std::string& error) {
     return true;
   }
   std::mt19937 rng(options_.faults.seed);
-  Pacer pacer(options_.speed, chunks_.front().time_us);
+  Pacer pacer(options_.speed, options_.pacing_origin_us.value_or(chunks_.front().time_us));
   std::vector<uint8_t> bytes;
   for (size_t i = 0; i < chunks_.size(); ++i) {
     if (!pacer.waitFor(chunks_[i].time_us, stop)) break;

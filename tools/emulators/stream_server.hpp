@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,9 @@ struct StreamServerOptions {
   std::string bind_address = "127.0.0.1";
   int port = 1701;              // 0: any free port (see port())
   double speed = 1.0;           // 1 = real time, 10 = ten times faster, 0 = as fast as the client reads
+  // Set: chunk times are paced from this sensor time rather than from the first chunk's, so that two
+  // streams of one mission (INS and fixes) started together stay in step.
+  std::optional<int64_t> pacing_origin_us;
   FaultPlan faults;
 };
 
