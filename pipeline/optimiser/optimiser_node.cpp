@@ -31,6 +31,7 @@
 #include "pipeline/core/time.hpp"
 #include "pipeline/matcher/loop_closure_message.hpp"
 #include "pipeline/optimiser/optimiser_engine.hpp"
+#include "pipeline/optimiser/correction_slew.hpp"
 #include "pipeline/optimiser/fix_message.hpp"
 #include "pipeline/optimiser/pose_message.hpp"
 #include "pipeline/subframe/subframe_message.hpp"
@@ -57,6 +58,8 @@ struct NodeOptions {
   std::string nav_channel = "SSS_NAV";
   std::string pose_channel = "SSS_POSE";
   std::string trajectory_channel = "SSS_TRAJECTORY";
+  // The published correction slews towards the graph's at a bounded rate (a fix can move it by metres).
+  sss::optimiser::CorrectionSlewOptions slew;
   double update_period_s = 1.0;  // at most one solve per period, when there is new input
   // Checkpoint and products. Empty: $STATE_DIRECTORY (systemd StateDirectory=), else none.
   std::string state_directory;
@@ -136,6 +139,7 @@ int main(int argc, char** argv) {
     ConfigSection section = config.section("optimiser");
     sss::transport::readProcessOptions(section, options.process);
     sss::optimiser::readOptimiserEngineOptions(section, options.engine);
+    sss::optimiser::readCorrectionSlewOptions(section, options.slew);
     section.optional("subframe_channel", options.subframe_channel, {nonEmpty()});
     section.optional("loop_channel", options.loop_channel, {nonEmpty()});
     section.optional("fix_channel", options.fix_channel, {nonEmpty()});
@@ -155,6 +159,9 @@ int main(int argc, char** argv) {
     dds.rejectUnknownKeys();
     section.rejectUnknownKeys();
     for (const std::string& problem : sss::optimiser::validateOptimiserEngineOptions(options.engine)) {
+      section.addProblem("optimiser", "", problem);
+    }
+    for (const std::string& problem : sss::optimiser::validateCorrectionSlewOptions(options.slew)) {
       section.addProblem("optimiser", "", problem);
     }
     config_problems = config.problemReport();
@@ -333,6 +340,7 @@ int main(int argc, char** argv) {
     }
   };
 
+  sss::optimiser::CorrectionSlew slew(options.slew);
   // ---- subscriptions ------------------------------------------------------------------------------
   loop.bus().subscribe<sss_msgs::nav_t>(options.nav_channel, [&](const sss_msgs::nav_t& message) {
     const int64_t arrival = sss::core::monotonicUtime();
@@ -370,7 +378,14 @@ int main(int argc, char** argv) {
       shared.origin = nav.origin;
     }
     const auto graph = snapshot();
-    const sss::optimiser::Correction correction = graph->correctionAt(nav.utime_us);
+    const sss::optimiser::Correction correction = slew.apply(graph->correctionAt(nav.utime_us), nav.utime_us);
+    if (const auto jump = slew.takeNewJump()) {
+      spdlog::info("the correction of the present pose jumped {:.2f} m (a fix or closures accepted); the published "
+                   "pose follows at {:.2f} m/s, its covariance widened by what is left", *jump, options.slew.max_rate_m_s);
+    }
+    health.setCounter("correction_lag_m", slew.lagM());
+    health.setCounter("correction_last_jump_m", slew.lastJumpM());
+    health.setCounter("correction_jumps", static_cast<double>(slew.jumps()));
     const auto dr = sss::subframe::poseOf(nav);
     const sss_msgs::pose_t pose = sss::optimiser::toPoseMessage(nav.utime_us, dr, correction, *plane);
     loop.bus().publish(options.pose_channel, pose, arrival);
