@@ -295,17 +295,41 @@ void resolveFixDates(std::vector<PositionFix>& fixes, int64_t reference_utime_us
   }
 }
 
-std::string encodePositionFix(const PositionFix& fix, std::string_view talker) {
-  const int64_t seconds = fix.utime_us >= 0 ? fix.utime_us / 1000000 : (fix.utime_us - 999999) / 1000000;
-  const double fraction_s = 1e-6 * static_cast<double>(fix.utime_us - seconds * 1000000);
-  const time_t t = static_cast<time_t>(seconds);
+namespace {
+
+// hhmmss.ss of a utime and its calendar date (UTC).
+struct NmeaTime {
+  char text[16];
   std::tm tm{};
-  gmtime_r(&t, &tm);
-  char time_text[16];
-  std::snprintf(time_text, sizeof time_text, "%02d%02d%05.2f", tm.tm_hour, tm.tm_min,
-                std::min(tm.tm_sec + fraction_s, 59.99));
-  const double lat = std::abs(fix.latitude_deg), lon = std::abs(fix.longitude_deg);
-  // Degrees and minutes rounded as printed (1e-7 minute), so 59.99999999' never prints as 60'.
+};
+NmeaTime nmeaTime(int64_t utime_us) {
+  NmeaTime out;
+  const int64_t seconds = utime_us >= 0 ? utime_us / 1000000 : (utime_us - 999999) / 1000000;
+  const double fraction_s = 1e-6 * static_cast<double>(utime_us - seconds * 1000000);
+  const time_t t = static_cast<time_t>(seconds);
+  gmtime_r(&t, &out.tm);
+  std::snprintf(out.text, sizeof out.text, "%02d%02d%05.2f", out.tm.tm_hour, out.tm.tm_min,
+                std::min(out.tm.tm_sec + fraction_s, 59.99));
+  return out;
+}
+
+std::string nmeaSentence(const std::string& body) {
+  char tail[8];
+  std::snprintf(tail, sizeof tail, "*%02X\r\n", nmeaChecksum(body));
+  return "$" + body + tail;
+}
+
+std::string zdaSentence(const std::string& talker, const NmeaTime& time) {
+  char body[96];
+  std::snprintf(body, sizeof body, "%sZDA,%s,%02d,%02d,%04d,00,00", talker.c_str(), time.text, time.tm.tm_mday,
+                time.tm.tm_mon + 1, time.tm.tm_year + 1900);
+  return nmeaSentence(body);
+}
+
+// GGA with latitude and longitude to 1e-7 minute (0.2 mm).
+std::string ggaSentence(const std::string& talker, const NmeaTime& time, double latitude_deg, double longitude_deg,
+                        int quality, int satellites, double hdop, double altitude_m) {
+  // Degrees and minutes rounded as printed, so 59.99999999' never prints as 60'.
   auto split = [](double value, double& degrees, double& minutes) {
     degrees = std::floor(value);
     minutes = std::round((value - degrees) * 60.0 * 1e7) / 1e7;
@@ -315,29 +339,45 @@ std::string encodePositionFix(const PositionFix& fix, std::string_view talker) {
     }
   };
   double lat_degrees = 0, lat_minutes = 0, lon_degrees = 0, lon_minutes = 0;
-  split(lat, lat_degrees, lat_minutes);
-  split(lon, lon_degrees, lon_minutes);
+  split(std::abs(latitude_deg), lat_degrees, lat_minutes);
+  split(std::abs(longitude_deg), lon_degrees, lon_minutes);
+  char body[160];
+  std::snprintf(body, sizeof body, "%sGGA,%s,%02d%010.7f,%c,%03d%010.7f,%c,%d,%02d,%.1f,%.2f,M,0.0,M,,", talker.c_str(),
+                time.text, static_cast<int>(lat_degrees), lat_minutes, latitude_deg < 0 ? 'S' : 'N',
+                static_cast<int>(lon_degrees), lon_minutes, longitude_deg < 0 ? 'W' : 'E', quality, satellites, hdop,
+                altitude_m);
+  return nmeaSentence(body);
+}
+
+}  // namespace
+
+std::string encodePositionFix(const PositionFix& fix, std::string_view talker) {
+  const NmeaTime time = nmeaTime(fix.utime_us);
   const std::string t2(talker.substr(0, 2));
-  auto sentence = [](const std::string& body) {
-    char tail[8];
-    std::snprintf(tail, sizeof tail, "*%02X\r\n", nmeaChecksum(body));
-    return "$" + body + tail;
-  };
-  char body[256];
-  std::string out;
-  std::snprintf(body, sizeof body, "%sZDA,%s,%02d,%02d,%04d,00,00", t2.c_str(), time_text, tm.tm_mday, tm.tm_mon + 1,
-                tm.tm_year + 1900);
-  out += sentence(body);
-  std::snprintf(body, sizeof body, "%sGGA,%s,%02d%010.7f,%c,%03d%010.7f,%c,%d,%02d,%.1f,0.0,M,0.0,M,,", t2.c_str(),
-                time_text, static_cast<int>(lat_degrees), lat_minutes, fix.latitude_deg < 0 ? 'S' : 'N',
-                static_cast<int>(lon_degrees), lon_minutes, fix.longitude_deg < 0 ? 'W' : 'E',
-                fix.quality, fix.satellites, fix.hdop);
-  out += sentence(body);
+  std::string out = zdaSentence(t2, time);
+  out += ggaSentence(t2, time, fix.latitude_deg, fix.longitude_deg, fix.quality, fix.satellites, fix.hdop, 0.0);
   const double rms = std::hypot(fix.sigma_north_m, fix.sigma_east_m);
-  std::snprintf(body, sizeof body, "%sGST,%s,%.3f,%.3f,%.3f,0.0,%.3f,%.3f,%.3f", t2.c_str(), time_text, rms,
+  char body[160];
+  std::snprintf(body, sizeof body, "%sGST,%s,%.3f,%.3f,%.3f,0.0,%.3f,%.3f,%.3f", t2.c_str(), time.text, rms,
                 std::max(fix.sigma_north_m, fix.sigma_east_m), std::min(fix.sigma_north_m, fix.sigma_east_m),
                 fix.sigma_north_m, fix.sigma_east_m, 2.0 * std::max(fix.sigma_north_m, fix.sigma_east_m));
-  out += sentence(body);
+  out += nmeaSentence(body);
+  return out;
+}
+
+std::string encodeNavigationNmea(int64_t utime_us, double latitude_deg, double longitude_deg, double depth_m,
+                                 double heading_rad, std::string_view talker) {
+  const NmeaTime time = nmeaTime(utime_us);
+  const std::string t2(talker.substr(0, 2));
+  std::string out = zdaSentence(t2, time);
+  // Quality 6: an estimated (dead-reckoned) position, never taken for a fix (not even by this reader).
+  out += ggaSentence(t2, time, latitude_deg, longitude_deg, 6, 0, 0.0, -depth_m);
+  double heading_deg = std::fmod(heading_rad * 180.0 / M_PI, 360.0);
+  if (heading_deg < 0.0) heading_deg += 360.0;
+  if (heading_deg >= 359.995) heading_deg = 0.0;  // as printed with 2 decimals
+  char body[64];
+  std::snprintf(body, sizeof body, "%sHDT,%.2f,T", t2.c_str(), heading_deg);
+  out += nmeaSentence(body);
   return out;
 }
 

@@ -107,4 +107,9 @@ void resolveFixDates(std::vector<PositionFix>& fixes, int64_t reference_utime_us
 // (position to 1e-7 minute, quality, satellites, HDOP) and GST (its sigmas), all from `talker`.
 std::string encodePositionFix(const PositionFix& fix, std::string_view talker = "GP");
 
+// A navigation solution as NMEA for tools that take a nav stream: ZDA, GGA (quality 6, estimated:
+// never a fix; antenna altitude = -depth) and HDT (true heading, 0.01 deg).
+std::string encodeNavigationNmea(int64_t utime_us, double latitude_deg, double longitude_deg, double depth_m,
+                                 double heading_rad, std::string_view talker = "IN");
+
 }  // namespace sss::ins

@@ -29,6 +29,7 @@
 #include "drivers/xtf/xtf_writer.hpp"
 #include "drivers/edgetech/jsf_format.hpp"
 #include "drivers/ins/ixblue_nmea.hpp"
+#include "drivers/ins/nmea_gga.hpp"
 
 namespace fs = std::filesystem;
 
@@ -111,7 +112,7 @@ TEST_F(OfflineRunnerTest, SonarAndInsFilesGiveEveryOutputAndBeatDeadReckoning) {
   const auto result = sss::offline::runOffline(r);
   ASSERT_TRUE(result.ok) << result.error;
   EXPECT_EQ(result.exit_code, 0);
-  for (const char* file : {"dead_reckoning.tum", "slam.tum", "loop_closures.csv", "bathymetry.ply", "bathymetry_dr.ply",
+  for (const char* file : {"dead_reckoning.tum", "slam.tum", "navigation.csv", "navigation.nmea", "loop_closures.csv", "bathymetry.ply", "bathymetry_dr.ply",
                            "heightmap.yaml", "heightmap_depth.f32", "heightmap.png", "heightmap_dr.yaml", "mosaic_dr.png",
                            "mosaic_dr.yaml", "mosaic_slam.png", "mosaic_slam.yaml", "summary.json"}) {
     EXPECT_TRUE(fs::is_regular_file(r.out_dir + "/" + file)) << file;
@@ -162,6 +163,55 @@ TEST_F(OfflineRunnerTest, SonarAndInsFilesGiveEveryOutputAndBeatDeadReckoning) {
   std::printf("heightmap MAE: DR %.3f m (%zu cells), SLAM %.3f m (%zu cells)\n", mae_dr, cells_dr, mae_slam, cells_slam);
   EXPECT_GT(cells_slam, 800u);
   EXPECT_LT(mae_slam, 0.75 * mae_dr);
+
+  // The corrected navigation for other tools: navigation.csv and navigation.nmea agree with slam.tum
+  // (lat/lon to 1e-9 deg in the CSV, 1e-7 minute in GGA, heading to 0.01 deg in HDT), one row per ping.
+  {
+    ASSERT_TRUE(result.summary.origin);
+    const sss::core::LocalTangentPlane plane(result.summary.origin->latitude_deg, result.summary.origin->longitude_deg);
+    std::istringstream csv_rows(readFile(r.out_dir + "/navigation.csv"));
+    std::string row;
+    size_t rows = 0, corrected = 0;
+    double worst_csv_m = 0.0;
+    while (std::getline(csv_rows, row)) {
+      if (row.empty() || row[0] == '#' || row.rfind("utc_time", 0) == 0) continue;
+      std::vector<std::string> f;
+      std::stringstream split(row);
+      for (std::string field; std::getline(split, field, ',');) f.push_back(field);
+      ASSERT_EQ(f.size(), 13u) << row;
+      ASSERT_LT(rows, slam.poses.size());
+      EXPECT_EQ(std::stoll(f[1]), slam.poses[rows].utime_us);
+      const Eigen::Vector3d ned = plane.toNed({std::stod(f[2]), std::stod(f[3]), std::stod(f[6])});
+      worst_csv_m = std::max(worst_csv_m, (ned - slam.poses[rows].T_world_body.translation).norm());
+      corrected += f[12] == "SLAM";
+      ++rows;
+    }
+    EXPECT_EQ(rows, s.pings);
+    EXPECT_GT(corrected, rows / 2) << "most pings come after the first accepted closure";
+    EXPECT_LT(worst_csv_m, 0.001);
+    std::istringstream nmea_lines(readFile(r.out_dir + "/navigation.nmea"));
+    size_t gga = 0, hdt = 0;
+    double worst_gga_m = 0.0, worst_heading_deg = 0.0;
+    for (std::string line; std::getline(nmea_lines, line);) {
+      if (line.find("GGA,") != std::string::npos) {
+        const auto fix = sss::ins::parseGga(line);
+        ASSERT_TRUE(fix) << line;
+        EXPECT_EQ(fix->quality, 6) << "an estimated position, never taken for a fix";
+        const Eigen::Vector3d ned = plane.toNed({fix->latitude_deg, fix->longitude_deg, -fix->altitude_m});
+        worst_gga_m = std::max(worst_gga_m, (ned - slam.poses[gga].T_world_body.translation).head<2>().norm());
+        ++gga;
+      } else if (line.rfind("$INHDT,", 0) == 0) {
+        const double heading_deg = std::stod(line.substr(7));
+        const double truth_deg = sss::core::eulerFromQuaternion(slam.poses[hdt].T_world_body.rotation).heading_rad * 180.0 / M_PI;
+        worst_heading_deg = std::max(worst_heading_deg, std::abs(std::remainder(heading_deg - truth_deg, 360.0)));
+        ++hdt;
+      }
+    }
+    EXPECT_EQ(gga, s.pings);
+    EXPECT_EQ(hdt, s.pings);
+    EXPECT_LT(worst_gga_m, 0.001);
+    EXPECT_LE(worst_heading_deg, 0.0051);
+  }
 
   // The closures table: header + one line per closure, statuses from the optimiser.
   const std::string csv = readFile(r.out_dir + "/loop_closures.csv");

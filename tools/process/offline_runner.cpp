@@ -6,6 +6,7 @@
 #include <sys/resource.h>
 
 #include <lcm/lcm-cpp.hpp>
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cstring>
@@ -32,6 +33,7 @@
 #include "pipeline/core/config.hpp"
 #include "pipeline/core/geodesy.hpp"
 #include "pipeline/core/mission_origin.hpp"
+#include "pipeline/core/time.hpp"
 #include "pipeline/matcher/matcher_engine.hpp"
 #include "pipeline/optimiser/optimiser_engine.hpp"
 #include "pipeline/subframe/pictures.hpp"
@@ -881,6 +883,7 @@ class Runner {
 
   bool writeOutputs(std::string& error);
   bool writeFixOutputs(const std::string& dir, std::string& error);
+  bool writeNavigation(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& slam, std::string& error) const;
   bool writeAltitudeCsv(const std::string& path, std::string& error) const;
   OfflineSummary& summary() { return summary_; }
   const std::optional<sss::core::MissionOrigin>& origin() const { return origin_; }
@@ -1100,6 +1103,67 @@ bool Runner::writeFixOutputs(const std::string& dir, std::string& error) {
                                   error, origin_);
 }
 
+// The corrected navigation for the survey's own tools: navigation.csv (every ping: UTC time,
+// latitude, longitude, local north/east, depth below the ellipsoid, attitude, altitude, horizontal 1-sigma,
+// DR or SLAM) and, when
+// the frame is geographic, navigation.nmea (ZDA + GGA + HDT per ping, GGA quality 6: estimated).
+bool Runner::writeNavigation(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& slam,
+                             std::string& error) const {
+  std::optional<sss::core::LocalTangentPlane> plane;
+  if (origin_) plane.emplace(origin_->latitude_deg, origin_->longitude_deg);
+  const std::string csv_path = dir + "/navigation.csv";
+  std::FILE* csv = std::fopen(csv_path.c_str(), "w");
+  std::FILE* nmea = plane ? std::fopen((dir + "/navigation.nmea").c_str(), "w") : nullptr;
+  if (!csv || (plane && !nmea)) {
+    if (csv) std::fclose(csv);
+    if (nmea) std::fclose(nmea);
+    error = "cannot write " + (csv ? dir + "/navigation.nmea" : csv_path);
+    return false;
+  }
+  std::fprintf(csv, "# sss-process: corrected navigation at every ping%s; horizontal_sigma_m: 1-sigma of the position "
+                    "(the larger axis); source: SLAM (corrected by closures or fixes) or DR\n"
+                    "utc_time,utime_us,latitude_deg,longitude_deg,north_m,east_m,depth_m,heading_deg,pitch_deg,roll_deg,"
+                    "altitude_m,horizontal_sigma_m,source\n",
+               plane ? "" : " (projected frame without a CRS: no latitude/longitude)");
+  for (size_t i = 0; i < slam.size(); ++i) {
+    const int64_t t = slam[i].utime_us;
+    const sss::core::Pose& pose = slam[i].T_world_body;
+    const sss::optimiser::Correction correction = optimiser_.correctionAt(t);
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> horizontal(correction.covariance.topLeftCorner<2, 2>());
+    const double sigma_m = std::sqrt(std::max(horizontal.eigenvalues().maxCoeff(), 0.0));
+    const sss::core::EulerAngles euler = sss::core::eulerFromQuaternion(pose.rotation);
+    const double altitude_m = i < altitude_per_ping_.size() ? altitude_per_ping_[i].altitude_m : -1.0;
+    const char* source = correction.status == sss::optimiser::CorrectionStatus::kDrOnly ? "DR" : "SLAM";
+    double heading_deg = std::fmod(euler.heading_rad * 180.0 / M_PI, 360.0);
+    if (heading_deg < 0.0) heading_deg += 360.0;
+    std::string lat = "", lon = "";
+    double depth_m = pose.translation.z();  // below the ellipsoid when geographic, else the frame's down
+    if (plane) {
+      const sss::core::GeodeticPosition geo = plane->toGeodetic(pose.translation);
+      char text[32];
+      std::snprintf(text, sizeof text, "%.9f", geo.latitude_deg);
+      lat = text;
+      std::snprintf(text, sizeof text, "%.9f", geo.longitude_deg);
+      lon = text;
+      depth_m = geo.depth_m;
+      const std::string sentences =
+          sss::ins::encodeNavigationNmea(t, geo.latitude_deg, geo.longitude_deg, geo.depth_m, euler.heading_rad);
+      std::fputs(sentences.c_str(), nmea);
+    }
+    std::fprintf(csv, "%s,%lld,%s,%s,%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.3f,%.3f,%s\n",
+                 sss::core::formatUtimeIso8601(t).c_str(), static_cast<long long>(t), lat.c_str(), lon.c_str(),
+                 pose.translation.x(), pose.translation.y(), depth_m, heading_deg,
+                 euler.pitch_rad * 180.0 / M_PI, euler.roll_rad * 180.0 / M_PI, altitude_m, sigma_m, source);
+  }
+  const bool csv_ok = std::fclose(csv) == 0;
+  const bool nmea_ok = !nmea || std::fclose(nmea) == 0;
+  if (!csv_ok || !nmea_ok) {
+    error = "cannot write " + (csv_ok ? dir + "/navigation.nmea" : csv_path);
+    return false;
+  }
+  return true;
+}
+
 // altitude.csv: the altitude every ping was processed with and where it came from.
 bool Runner::writeAltitudeCsv(const std::string& path, std::string& error) const {
   std::FILE* f = std::fopen(path.c_str(), "w");
@@ -1137,6 +1201,7 @@ bool Runner::writeOutputs(std::string& error) {
     return false;
   }
   if (!writeFixOutputs(dir, error)) return false;
+  if (!writeNavigation(dir, slam, error)) return false;
   if (!writeClosuresCsv(dir + "/loop_closures.csv", optimiser_, error)) return false;
   if (!writeAltitudeCsv(dir + "/altitude.csv", error)) return false;
   if (!match_writer_.close(error)) return false;

@@ -30,6 +30,7 @@ void usage(std::FILE* out) {
                "                         --inject-seed, default 1) get a relative pose 3-10 m and 2-10 deg wrong\n"
                "                         before the optimiser (summary.json: false_closures_injected)\n"
                "Writes to DIR: dead_reckoning.tum, slam.tum (every ping, TUM, local NED of the mission origin),\n"
+               "navigation.csv and navigation.nmea (the corrected navigation per ping for other tools),\n"
                "loop_closures.csv, bathymetry.ply (+ bathymetry_dr.ply), heightmap.yaml/.png (+ heightmap_dr),\n"
                "mosaic_dr.png, mosaic_slam.png (+ .yaml geo-references) and summary.json (counts, where the pings\n"
                "went, the mission origin and, when a stage yielded nothing, why).\n"
