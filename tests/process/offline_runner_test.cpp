@@ -30,6 +30,9 @@
 #include "drivers/edgetech/jsf_format.hpp"
 #include "drivers/ins/ixblue_nmea.hpp"
 #include "drivers/ins/nmea_gga.hpp"
+#include "pipeline/core/time.hpp"
+
+#include <nlohmann/json.hpp>
 
 namespace fs = std::filesystem;
 
@@ -211,6 +214,41 @@ TEST_F(OfflineRunnerTest, SonarAndInsFilesGiveEveryOutputAndBeatDeadReckoning) {
     EXPECT_EQ(hdt, s.pings);
     EXPECT_LT(worst_gga_m, 0.001);
     EXPECT_LE(worst_heading_deg, 0.0051);
+  }
+
+  // GeoJSON for GIS: the SLAM and DR tracks, and a closed footprint per subframe that holds the SLAM
+  // track along its middle and is the canonical swath wide.
+  {
+    const nlohmann::json tracks = nlohmann::json::parse(readFile(r.out_dir + "/track.geojson"));
+    ASSERT_EQ(tracks["features"].size(), 2u);
+    EXPECT_EQ(tracks["features"][0]["properties"]["name"], "SLAM");
+    const auto& first = tracks["features"][0]["geometry"]["coordinates"][0];
+    const sss::core::LocalTangentPlane plane(result.summary.origin->latitude_deg, result.summary.origin->longitude_deg);
+    const Eigen::Vector3d first_ned = plane.toNed({first[1].get<double>(), first[0].get<double>(), 0.0});
+    EXPECT_LT((first_ned - slam.poses.front().T_world_body.translation).head<2>().norm(), 0.01);
+    const nlohmann::json footprints = nlohmann::json::parse(readFile(r.out_dir + "/subframes.geojson"));
+    ASSERT_EQ(footprints["features"].size(), s.subframes);
+    for (const auto& feature : footprints["features"]) {
+      const auto& ring = feature["geometry"]["coordinates"][0];
+      ASSERT_GE(ring.size(), 5u);
+      EXPECT_EQ(ring.front(), ring.back()) << "a closed ring";
+      std::vector<Eigen::Vector2d> corners;
+      for (const auto& c : ring) corners.push_back(plane.toNed({c[1].get<double>(), c[0].get<double>(), 0.0}).head<2>());
+      // The ring: port edge forward, starboard edge back. Its width is twice the swath.
+      const size_t half = (corners.size() - 1) / 2;
+      EXPECT_NEAR((corners[0] - corners[corners.size() - 2]).norm(), 2.0 * feature["properties"]["swath_m"].get<double>(), 0.5);
+      // The midpoint of the first port and starboard corners is the SLAM pose at the subframe's start.
+      const Eigen::Vector2d middle = 0.5 * (corners[0] + corners[corners.size() - 2]);
+      const int64_t start_us = [&] {
+        for (const auto& p : slam.poses)
+          if (sss::core::formatUtimeIso8601(p.utime_us) == feature["properties"]["start_utc"].get<std::string>()) return p.utime_us;
+        return int64_t{-1};
+      }();
+      ASSERT_GE(start_us, 0);
+      const auto at = std::find_if(slam.poses.begin(), slam.poses.end(), [&](const auto& p) { return p.utime_us == start_us; });
+      EXPECT_LT((middle - at->T_world_body.translation.head<2>()).norm(), 0.05) << feature["properties"];
+      EXPECT_EQ(half * 2 + 1, corners.size());
+    }
   }
 
   // The closures table: header + one line per closure, statuses from the optimiser.

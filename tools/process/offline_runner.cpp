@@ -6,6 +6,7 @@
 #include <sys/resource.h>
 
 #include <lcm/lcm-cpp.hpp>
+#include <nlohmann/json.hpp>
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
@@ -884,6 +885,7 @@ class Runner {
   bool writeOutputs(std::string& error);
   bool writeFixOutputs(const std::string& dir, std::string& error);
   bool writeNavigation(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& slam, std::string& error) const;
+  bool writeGeoJson(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& slam, std::string& error) const;
   bool writeAltitudeCsv(const std::string& path, std::string& error) const;
   OfflineSummary& summary() { return summary_; }
   const std::optional<sss::core::MissionOrigin>& origin() const { return origin_; }
@@ -1012,6 +1014,7 @@ class Runner {
     for (sss::subframe::Subframe& subframe : subframes_) {
       ++summary_.subframes;
       centres_.push_back({subframe.line_id, subframe.centre().T_world_body});
+      footprints_.push_back(footprintOf(subframe));
       optimiser_.addSubframe(subframe);
       if (request_.write_mosaics) mosaic_subframes_.push_back(decimateForMosaic(subframe, mosaic_factor_));
       addOutcomes(timedMatch([&] { return matcher_.addSubframe(std::move(subframe)); }));
@@ -1029,6 +1032,20 @@ class Runner {
   std::vector<sss::subframe::Subframe> subframes_;  // reused
   std::vector<sss::subframe::Subframe> mosaic_subframes_;
   std::vector<std::pair<int, sss::core::Pose>> centres_;  // line id and DR centre pose of every subframe
+  // Of every subframe: its id, line and a few pings along it (DR), for subframes.geojson.
+  struct Footprint {
+    int64_t id = 0;
+    int line_id = 0;
+    double half_width_m = 0.0;  // the canonical swath per side
+    std::vector<sss::optimiser::StampedPose> pings;  // first, every 25th, last
+  };
+  static Footprint footprintOf(const sss::subframe::Subframe& s) {
+    Footprint f{s.id, s.line_id, s.geometry.bins_per_side * s.geometry.bin_size_m + s.geometry.first_bin_range_m, {}};
+    for (size_t i = 0; i < s.pings.size(); ++i)
+      if (i % 25 == 0 || i + 1 == s.pings.size()) f.pings.push_back({s.pings[i].utime_us, s.pings[i].T_world_body});
+    return f;
+  }
+  std::vector<Footprint> footprints_;
   std::vector<sss::optimiser::StampedPose> dr_per_ping_;
   sss::ins::FixAligner fix_aligner_;  // the request's fixes, tied to the navigation as it comes
   struct PingAltitude {
@@ -1164,6 +1181,66 @@ bool Runner::writeNavigation(const std::string& dir, const std::vector<sss::opti
   return true;
 }
 
+// For GIS (QGIS opens them as they are; RFC 7946, WGS 84 longitude/latitude): track.geojson, the SLAM
+// and DR tracks (a vertex every 4 pings), and subframes.geojson, each subframe's footprint on the
+// seabed under the SLAM poses (its swath of canonical ground range either side, a vertex every 25
+// pings) with its id and line. Only in a geographic frame.
+bool Runner::writeGeoJson(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& slam,
+                          std::string& error) const {
+  if (!origin_) return true;
+  const sss::core::LocalTangentPlane plane(origin_->latitude_deg, origin_->longitude_deg);
+  auto lonLat = [&](const Eigen::Vector3d& ned) {
+    const sss::core::GeodeticPosition g = plane.toGeodetic(ned);
+    // 1e-8 deg (~1 mm) is all a GIS needs and keeps the files small.
+    return nlohmann::json::array({std::round(g.longitude_deg * 1e8) / 1e8, std::round(g.latitude_deg * 1e8) / 1e8});
+  };
+  auto write = [&](const std::string& path, const nlohmann::json& json) {
+    std::ofstream out(path);
+    out << json.dump() << "\n";
+    if (!out) error = "cannot write " + path;
+    return static_cast<bool>(out);
+  };
+  nlohmann::json tracks = {{"type", "FeatureCollection"}, {"features", nlohmann::json::array()}};
+  for (const auto& [name, poses] : {std::pair<const char*, const std::vector<sss::optimiser::StampedPose>*>{"SLAM", &slam},
+                                    {"DR", &dr_per_ping_}}) {
+    nlohmann::json line = nlohmann::json::array();
+    for (size_t i = 0; i < poses->size(); ++i)
+      if (i % 4 == 0 || i + 1 == poses->size()) line.push_back(lonLat((*poses)[i].T_world_body.translation));
+    if (line.size() < 2) continue;
+    tracks["features"].push_back({{"type", "Feature"},
+                                  {"properties", {{"name", name},
+                                                  {"start_utc", sss::core::formatUtimeIso8601(poses->front().utime_us)},
+                                                  {"end_utc", sss::core::formatUtimeIso8601(poses->back().utime_us)}}},
+                                  {"geometry", {{"type", "LineString"}, {"coordinates", line}}}});
+  }
+  if (!write(dir + "/track.geojson", tracks)) return false;
+
+  nlohmann::json footprints = {{"type", "FeatureCollection"}, {"features", nlohmann::json::array()}};
+  for (const Footprint& f : footprints_) {
+    if (f.pings.size() < 2) continue;
+    std::vector<Eigen::Vector3d> port, starboard;
+    for (const auto& ping : f.pings) {
+      const sss::core::Pose pose = optimiser_.correctionAt(ping.utime_us).T_corrected_dr * ping.T_world_body;
+      // The swath edges on the level seabed plane through the vehicle, across its heading.
+      const double heading = sss::core::eulerFromQuaternion(pose.rotation).heading_rad;
+      const Eigen::Vector3d across(-std::sin(heading), std::cos(heading), 0.0);  // starboard, NED
+      port.push_back(pose.translation - f.half_width_m * across);
+      starboard.push_back(pose.translation + f.half_width_m * across);
+    }
+    nlohmann::json ring = nlohmann::json::array();
+    for (const auto& p : port) ring.push_back(lonLat(p));
+    for (auto it = starboard.rbegin(); it != starboard.rend(); ++it) ring.push_back(lonLat(*it));
+    ring.push_back(ring.front());  // closed
+    footprints["features"].push_back(
+        {{"type", "Feature"},
+         {"properties", {{"subframe_id", f.id}, {"line_id", f.line_id}, {"swath_m", f.half_width_m},
+                         {"start_utc", sss::core::formatUtimeIso8601(f.pings.front().utime_us)},
+                         {"end_utc", sss::core::formatUtimeIso8601(f.pings.back().utime_us)}}},
+         {"geometry", {{"type", "Polygon"}, {"coordinates", nlohmann::json::array({ring})}}}});
+  }
+  return write(dir + "/subframes.geojson", footprints);
+}
+
 // altitude.csv: the altitude every ping was processed with and where it came from.
 bool Runner::writeAltitudeCsv(const std::string& path, std::string& error) const {
   std::FILE* f = std::fopen(path.c_str(), "w");
@@ -1202,6 +1279,7 @@ bool Runner::writeOutputs(std::string& error) {
   }
   if (!writeFixOutputs(dir, error)) return false;
   if (!writeNavigation(dir, slam, error)) return false;
+  if (!writeGeoJson(dir, slam, error)) return false;
   if (!writeClosuresCsv(dir + "/loop_closures.csv", optimiser_, error)) return false;
   if (!writeAltitudeCsv(dir + "/altitude.csv", error)) return false;
   if (!match_writer_.close(error)) return false;
