@@ -308,11 +308,18 @@ std::vector<SeabedPoint> OptimiserEngine::seabedPoints(bool use_dr) const {
 
 std::vector<ClosureSummary> OptimiserEngine::closureSummaries() const {
   std::vector<ClosureSummary> out;
+  std::map<int64_t, NodeState> node_of;
+  for (const NodeState& n : graph_.nodes()) node_of[n.subframe_id] = n;
   for (const ClosureRecord& record : graph_.closures()) {
     ClosureSummary summary;
     summary.record = record;
-    if (auto a = graph_.estimate(record.closure.subframe_id_a)) summary.centre_a_ned_m = a->translation;
-    if (auto b = graph_.estimate(record.closure.subframe_id_b)) summary.centre_b_ned_m = b->translation;
+    const auto a = node_of.find(record.closure.subframe_id_a), b = node_of.find(record.closure.subframe_id_b);
+    if (a != node_of.end() && b != node_of.end()) {
+      summary.centre_a_ned_m = a->second.T_world_body.translation;
+      summary.centre_b_ned_m = b->second.T_world_body.translation;
+      summary.T_a_b_dr = sss::core::between(a->second.T_world_body_dr, b->second.T_world_body_dr);
+      summary.T_a_b_estimate = sss::core::between(a->second.T_world_body, b->second.T_world_body);
+    }
     const auto key = pairKey(record.closure.subframe_id_a, record.closure.subframe_id_b);
     if (auto found = correspondences_.find(key); found != correspondences_.end()) summary.mean_zncc = found->second.mean_zncc;
     out.push_back(summary);

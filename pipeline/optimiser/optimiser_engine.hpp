@@ -70,6 +70,10 @@ struct ClosureSummary {
   ClosureRecord record;
   Eigen::Vector3d centre_a_ned_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d centre_b_ned_m = Eigen::Vector3d::Zero();
+  // B's centre in A's body frame as DR has it (before the solve) and as the current estimate has it
+  // (after): the closure's offset from each is what a tie report lists.
+  sss::core::Pose T_a_b_dr;
+  sss::core::Pose T_a_b_estimate;
   float mean_zncc = 0.0f;
 };
 

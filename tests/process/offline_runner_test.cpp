@@ -255,6 +255,37 @@ TEST_F(OfflineRunnerTest, SonarAndInsFilesGiveEveryOutputAndBeatDeadReckoning) {
   const std::string csv = readFile(r.out_dir + "/loop_closures.csv");
   EXPECT_NE(csv.find("subframe_id_a,subframe_id_b,utime_a_us,utime_b_us,round,status"), std::string::npos);
   EXPECT_NE(csv.find(",accepted,none,"), std::string::npos);
+  // The tie report's columns: accepted closures sit closer to the solved trajectory than to DR.
+  {
+    std::istringstream rows(csv);
+    std::string row, header;
+    std::vector<std::string> names;
+    double before_sq = 0.0, after_sq = 0.0;
+    int accepted = 0;
+    while (std::getline(rows, row)) {
+      if (row.empty() || row[0] == '#') continue;
+      std::vector<std::string> f;
+      std::stringstream split(row);
+      for (std::string field; std::getline(split, field, ',');) f.push_back(field);
+      if (names.empty()) {
+        names = f;
+        continue;
+      }
+      auto column = [&](const std::string& name) {
+        const auto it = std::find(names.begin(), names.end(), name);
+        EXPECT_NE(it, names.end()) << name;
+        return std::stod(f.at(static_cast<size_t>(it - names.begin())));
+      };
+      if (f.at(5) != "accepted") continue;
+      ++accepted;
+      before_sq += std::pow(column("before_along_m"), 2) + std::pow(column("before_across_m"), 2);
+      after_sq += std::pow(column("after_along_m"), 2) + std::pow(column("after_across_m"), 2);
+    }
+    ASSERT_GT(accepted, 0);
+    std::printf("tie report: accepted closures' horizontal offset RMS before %.3f m, after %.3f m\n",
+                std::sqrt(before_sq / accepted), std::sqrt(after_sq / accepted));
+    EXPECT_LT(after_sq, before_sq);
+  }
 
   // Deterministic, and the recorded LCM log replays to the very same trajectory.
   auto replay = request("replay");

@@ -604,10 +604,13 @@ bool writeClosuresCsv(const std::string& path, const sss::optimiser::OptimiserEn
   std::fprintf(f, "# loop closures from the matcher and the optimiser's decision; T_a_b maps B's centre body frame into A's;\n"
                   "# north/east: the two subframe centres under the final SLAM estimate (local NED, m);\n"
                   "# cov_*: the closure's published covariance of B's centre position, in A's body frame (m^2);\n"
-                  "# sigma_heading_rad: of its heading\n");
+                  "# sigma_heading_rad: of its heading\n"
+                  "# before_* / after_*: the closure's offset from DR's relative pose (before the solve) and from the final\n"
+                  "# estimate's (after): along, across (A's body x, y), depth (m) and heading (rad): the tie report\n");
   std::fprintf(f, "subframe_id_a,subframe_id_b,utime_a_us,utime_b_us,round,status,rejection,dx_m,dy_m,dz_m,droll_rad,"
                   "dpitch_rad,dheading_rad,num_inliers,mean_zncc,north_a_m,east_a_m,north_b_m,east_b_m,cov_xx_m2,"
-                  "cov_xy_m2,cov_yy_m2,sigma_heading_rad\n");
+                  "cov_xy_m2,cov_yy_m2,sigma_heading_rad,before_along_m,before_across_m,before_depth_m,before_heading_rad,"
+                  "after_along_m,after_across_m,after_depth_m,after_heading_rad\n");
   for (const auto& summary : engine.closureSummaries()) {
     const auto& c = summary.record.closure;
     const sss::core::EulerAngles euler = sss::core::eulerFromQuaternion(c.T_a_b.rotation);
@@ -618,8 +621,16 @@ bool writeClosuresCsv(const std::string& path, const sss::optimiser::OptimiserEn
     // Heading variance: of the rotation about A's down axis, from the rotation block (B's frame).
     const Eigen::Vector3d down_in_b = R_a_b.transpose() * Eigen::Vector3d::UnitZ();
     const double heading_variance = down_in_b.dot(c.covariance.bottomRightCorner<3, 3>() * down_in_b);
+    // Offsets of the closure from DR's and from the estimate's relative pose of the same two centres.
+    auto offset = [&](const sss::core::Pose& reference) {
+      const Eigen::Vector3d d = c.T_a_b.translation - reference.translation;
+      const double heading = sss::core::wrapAngle(euler.heading_rad -
+                                                  sss::core::eulerFromQuaternion(reference.rotation).heading_rad);
+      return Eigen::Vector4d(d.x(), d.y(), d.z(), heading);
+    };
+    const Eigen::Vector4d before = offset(summary.T_a_b_dr), after = offset(summary.T_a_b_estimate);
     std::fprintf(f, "%lld,%lld,%lld,%lld,%d,%s,%s,%.4f,%.4f,%.4f,%.6f,%.6f,%.6f,%d,%.4f,%.3f,%.3f,%.3f,%.3f,%.6g,%.6g,"
-                    "%.6g,%.6g\n",
+                    "%.6g,%.6g,%.4f,%.4f,%.4f,%.6f,%.4f,%.4f,%.4f,%.6f\n",
                  static_cast<long long>(c.subframe_id_a), static_cast<long long>(c.subframe_id_b),
                  static_cast<long long>(utime_of[c.subframe_id_a]), static_cast<long long>(utime_of[c.subframe_id_b]),
                  c.association_round, statusName(summary.record.status), rejectionName(summary.record.rejection),
@@ -627,7 +638,8 @@ bool writeClosuresCsv(const std::string& path, const sss::optimiser::OptimiserEn
                  euler.pitch_rad, euler.heading_rad, c.num_inliers, summary.mean_zncc, summary.centre_a_ned_m.x(),
                  summary.centre_a_ned_m.y(), summary.centre_b_ned_m.x(), summary.centre_b_ned_m.y(),
                  position_covariance(0, 0), position_covariance(0, 1), position_covariance(1, 1),
-                 std::sqrt(std::max(heading_variance, 0.0)));
+                 std::sqrt(std::max(heading_variance, 0.0)), before(0), before(1), before(2), before(3), after(0),
+                 after(1), after(2), after(3));
   }
   const bool ok = std::fclose(f) == 0;
   if (!ok) error = "cannot write " + path;
