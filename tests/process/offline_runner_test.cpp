@@ -115,7 +115,8 @@ TEST_F(OfflineRunnerTest, SonarAndInsFilesGiveEveryOutputAndBeatDeadReckoning) {
   const auto result = sss::offline::runOffline(r);
   ASSERT_TRUE(result.ok) << result.error;
   EXPECT_EQ(result.exit_code, 0);
-  for (const char* file : {"dead_reckoning.tum", "slam.tum", "navigation.csv", "navigation.nmea", "loop_closures.csv", "bathymetry.ply", "bathymetry_dr.ply",
+  for (const char* file : {"dead_reckoning.tum", "slam.tum", "navigation.csv", "navigation.nmea", "track.geojson",
+                           "subframes.geojson", "coverage.yaml", "coverage_lines.u8", "coverage.png", "loop_closures.csv", "bathymetry.ply", "bathymetry_dr.ply",
                            "heightmap.yaml", "heightmap_depth.f32", "heightmap.png", "heightmap_dr.yaml", "mosaic_dr.png",
                            "mosaic_dr.yaml", "mosaic_slam.png", "mosaic_slam.yaml", "summary.json"}) {
     EXPECT_TRUE(fs::is_regular_file(r.out_dir + "/" + file)) << file;
@@ -215,6 +216,12 @@ TEST_F(OfflineRunnerTest, SonarAndInsFilesGiveEveryOutputAndBeatDeadReckoning) {
     EXPECT_LT(worst_gga_m, 0.001);
     EXPECT_LE(worst_heading_deg, 0.0051);
   }
+
+  // Coverage: 3 lines of 200 m, 50 m apart, 75 m per side: 250 x 200 m covered (east -75..175), 150 x 200
+  // m seen twice (-25..125: the overlaps of neighbours).
+  std::printf("coverage: %.0f m2 covered, %.0f m2 seen from two lines\n", s.coverage_covered_m2, s.coverage_seen_twice_m2);
+  EXPECT_NEAR(s.coverage_covered_m2, 250.0 * 200.0, 0.1 * 250.0 * 200.0);
+  EXPECT_NEAR(s.coverage_seen_twice_m2, 150.0 * 200.0, 0.1 * 150.0 * 200.0);
 
   // GeoJSON for GIS: the SLAM and DR tracks, and a closed footprint per subframe that holds the SLAM
   // track along its middle and is the canonical swath wide.

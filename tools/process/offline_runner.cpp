@@ -41,6 +41,7 @@
 #include "pipeline/subframe/subframe_buffer.hpp"
 #include "pipeline/subframe/subframe_message.hpp"
 #include "tools/eval/json_writer.hpp"
+#include "tools/process/coverage.hpp"
 #include "tools/process/match_writer.hpp"
 
 namespace sss::offline {
@@ -741,6 +742,11 @@ bool writeSummaryJson(const std::string& path, const OfflineRequest& request, co
   json.key("refused").value(s.fixes.refused);
   json.key("rms_residual_m").value(s.fixes.rms_residual_m, 4);
   json.endObject();
+  json.key("coverage").beginObject();  // coverage.yaml: how many lines saw each 5 m cell (SLAM poses)
+  json.key("covered_m2").value(s.coverage_covered_m2, 8);
+  json.key("seen_twice_m2").value(s.coverage_seen_twice_m2, 8);
+  json.key("fraction_seen_twice").value(s.coverage_covered_m2 > 0.0 ? s.coverage_seen_twice_m2 / s.coverage_covered_m2 : 0.0, 4);
+  json.endObject();
   json.key("calibration").beginObject();  // DVL scale and INS heading error, when fixes observed them
   json.key("estimated").value(s.calibration.estimated);
   json.key("dvl_scale").value(s.calibration.dvl_scale, 6);
@@ -898,6 +904,24 @@ class Runner {
   bool writeFixOutputs(const std::string& dir, std::string& error);
   bool writeNavigation(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& slam, std::string& error) const;
   bool writeGeoJson(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& slam, std::string& error) const;
+  // Every subframe's swath edges under the SLAM poses (footprints_ order).
+  std::vector<FootprintStrip> slamStrips() const {
+    std::vector<FootprintStrip> strips;
+    for (const Footprint& f : footprints_) {
+      FootprintStrip strip;
+      strip.line_id = f.line_id;
+      for (const auto& ping : f.pings) {
+        const sss::core::Pose pose = optimiser_.correctionAt(ping.utime_us).T_corrected_dr * ping.T_world_body;
+        // The swath edges on the level seabed plane through the vehicle, across its heading.
+        const double heading = sss::core::eulerFromQuaternion(pose.rotation).heading_rad;
+        const Eigen::Vector2d across(-std::sin(heading), std::cos(heading));  // starboard, north/east
+        strip.port_ne_m.push_back(pose.translation.head<2>() - f.half_width_m * across);
+        strip.starboard_ne_m.push_back(pose.translation.head<2>() + f.half_width_m * across);
+      }
+      strips.push_back(std::move(strip));
+    }
+    return strips;
+  }
   bool writeAltitudeCsv(const std::string& path, std::string& error) const;
   OfflineSummary& summary() { return summary_; }
   const std::optional<sss::core::MissionOrigin>& origin() const { return origin_; }
@@ -1228,20 +1252,15 @@ bool Runner::writeGeoJson(const std::string& dir, const std::vector<sss::optimis
   if (!write(dir + "/track.geojson", tracks)) return false;
 
   nlohmann::json footprints = {{"type", "FeatureCollection"}, {"features", nlohmann::json::array()}};
-  for (const Footprint& f : footprints_) {
-    if (f.pings.size() < 2) continue;
-    std::vector<Eigen::Vector3d> port, starboard;
-    for (const auto& ping : f.pings) {
-      const sss::core::Pose pose = optimiser_.correctionAt(ping.utime_us).T_corrected_dr * ping.T_world_body;
-      // The swath edges on the level seabed plane through the vehicle, across its heading.
-      const double heading = sss::core::eulerFromQuaternion(pose.rotation).heading_rad;
-      const Eigen::Vector3d across(-std::sin(heading), std::cos(heading), 0.0);  // starboard, NED
-      port.push_back(pose.translation - f.half_width_m * across);
-      starboard.push_back(pose.translation + f.half_width_m * across);
-    }
+  const std::vector<FootprintStrip> strips = slamStrips();
+  for (size_t k = 0; k < footprints_.size(); ++k) {
+    const Footprint& f = footprints_[k];
+    const FootprintStrip& strip = strips[k];
+    if (strip.port_ne_m.size() < 2) continue;
     nlohmann::json ring = nlohmann::json::array();
-    for (const auto& p : port) ring.push_back(lonLat(p));
-    for (auto it = starboard.rbegin(); it != starboard.rend(); ++it) ring.push_back(lonLat(*it));
+    for (const auto& p : strip.port_ne_m) ring.push_back(lonLat(Eigen::Vector3d(p.x(), p.y(), 0.0)));
+    for (auto it = strip.starboard_ne_m.rbegin(); it != strip.starboard_ne_m.rend(); ++it)
+      ring.push_back(lonLat(Eigen::Vector3d(it->x(), it->y(), 0.0)));
     ring.push_back(ring.front());  // closed
     footprints["features"].push_back(
         {{"type", "Feature"},
@@ -1292,6 +1311,12 @@ bool Runner::writeOutputs(std::string& error) {
   if (!writeFixOutputs(dir, error)) return false;
   if (!writeNavigation(dir, slam, error)) return false;
   if (!writeGeoJson(dir, slam, error)) return false;
+  if (!footprints_.empty()) {
+    const CoverageGrid coverage = computeCoverage(slamStrips(), 5.0);
+    summary_.coverage_covered_m2 = coverage.covered_m2;
+    summary_.coverage_seen_twice_m2 = coverage.seen_twice_m2;
+    if (!writeCoverageFiles(dir + "/coverage.yaml", coverage, error, origin_)) return false;
+  }
   if (!writeClosuresCsv(dir + "/loop_closures.csv", optimiser_, error)) return false;
   if (!writeAltitudeCsv(dir + "/altitude.csv", error)) return false;
   if (!match_writer_.close(error)) return false;

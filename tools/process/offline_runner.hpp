@@ -91,6 +91,9 @@ struct OfflineSummary {
   FixSummary fixes;
   // The DR calibration the final smoothing estimated (estimated: false when nothing observed it).
   sss::optimiser::DrCalibration calibration;
+  // Seabed seen by the subframes under the SLAM poses (coverage.yaml), and by two lines or more.
+  double coverage_covered_m2 = 0.0;
+  double coverage_seen_twice_m2 = 0.0;
   uint64_t seabed_points = 0;
   uint64_t input_faults = 0;       // corrupt records, bad messages, dropped pings
   // Where the pings went: the fusion's drops by cause and altitude sources, the line builder's.
