@@ -109,6 +109,22 @@ void pathMoments(const Pose& a, const Pose& b, double distance_m, Eigen::Vector2
   moment_sin = 0.5 * (std::sin(heading_b) - std::sin(heading_a)) * displacement;
 }
 
+// The marginal 1-sigma of each element of a parameter block of the solved problem (its covariance's
+// diagonal); NaN where the covariance cannot be computed.
+template <int N>
+Eigen::Matrix<double, N, 1> marginalSigmas(ceres::Problem& problem, const double* block) {
+  ceres::Covariance::Options options;
+  options.algorithm_type = ceres::SPARSE_QR;
+  ceres::Covariance covariance(options);
+  Eigen::Matrix<double, N, N, N == 1 ? Eigen::ColMajor : Eigen::RowMajor> c;
+  c.setConstant(std::numeric_limits<double>::quiet_NaN());
+  const std::vector<std::pair<const double*, const double*>> blocks = {{block, block}};
+  if (covariance.Compute(blocks, &problem)) covariance.GetCovarianceBlock(block, block, c.data());
+  Eigen::Matrix<double, N, 1> sigmas;
+  for (int i = 0; i < N; ++i) sigmas(i) = c(i, i) >= 0.0 ? std::sqrt(c(i, i)) : std::numeric_limits<double>::quiet_NaN();
+  return sigmas;
+}
+
 // Whitening of the first node's anchor.
 Matrix6d firstNodeSqrtInformation(const PoseGraphOptions& o) {
   Vector6d inverse_sigma;
@@ -277,9 +293,13 @@ SlidingWindowPoseGraph::SlidingWindowPoseGraph(const PoseGraphOptions& options) 
 }
 
 Matrix6d SlidingWindowPoseGraph::odometryCovariance(const PoseGraphOptions& o, double distance_m) {
+  return odometryCovariance(o, distance_m, o.odometry_drift_fraction);
+}
+
+Matrix6d SlidingWindowPoseGraph::odometryCovariance(const PoseGraphOptions& o, double distance_m, double drift_fraction) {
   const double d = std::max(distance_m, 0.0);
   const double horizontal = o.odometry_random_walk_m_per_sqrt_m * o.odometry_random_walk_m_per_sqrt_m * d +
-                            (o.odometry_drift_fraction * d) * (o.odometry_drift_fraction * d) +
+                            (drift_fraction * d) * (drift_fraction * d) +
                             o.odometry_min_sigma_m * o.odometry_min_sigma_m;
   const double heading = o.odometry_heading_random_walk_rad_per_sqrt_m *
                              o.odometry_heading_random_walk_rad_per_sqrt_m * d +
@@ -610,11 +630,9 @@ ceres::CostFunction* SlidingWindowPoseGraph::makeCost(const Factor& f) const {
       }
       return InsAbsoluteError::create(nodes_[f.index].dr, w);
     }
-    case FactorKind::kOdometry: {
-      const Matrix6d sqrt_information = odometrySqrtInformation(f.index, calibration_.estimated);
+    case FactorKind::kOdometry:
       if (calibration_.estimated) return CalibratedOdometryError::createHeld(calibratedOdometry(f.index));
-      return RelativePoseError::create(nodes_[f.index].odometry, sqrt_information);
-    }
+      return RelativePoseError::create(nodes_[f.index].odometry, odometrySqrtInformation(f.index, false));
     case FactorKind::kClosure: {
       const Closure& c = closures_[f.index];
       Matrix6d sqrt_information = closureSqrtInformation(c);
@@ -881,10 +899,10 @@ Eigen::Vector3d SlidingWindowPoseGraph::separationDirection(const Closure& c) co
 Matrix6d SlidingWindowPoseGraph::odometrySqrtInformation(int k, bool calibrated) const {
   const Node& node = nodes_[k];
   if (!calibrated || k == 0) return node.odometry_sqrt_information / std::sqrt(variance_factors_.odometry);
-  PoseGraphOptions model = options_;
-  model.odometry_drift_fraction = options_.calibrated_odometry_drift_fraction;
   Matrix6d sqrt_information;
-  sqrtInformation(odometryCovariance(model, node.distance_m - nodes_[k - 1].distance_m), sqrt_information);
+  sqrtInformation(odometryCovariance(options_, node.distance_m - nodes_[k - 1].distance_m,
+                                     options_.calibrated_odometry_drift_fraction),
+                  sqrt_information);
   return sqrt_information / std::sqrt(variance_factors_.odometry);
 }
 
@@ -1034,30 +1052,18 @@ bool SlidingWindowPoseGraph::solve(const std::vector<Factor>& factors, int max_i
     calibration_.heading_bias_rad = calibration[1];
     calibration_.heading_cos_rad = calibration[2];
     calibration_.heading_sin_rad = calibration[3];
-    ceres::Covariance::Options covariance_options;
-    covariance_options.algorithm_type = ceres::SPARSE_QR;
-    ceres::Covariance covariance(covariance_options);
-    const std::vector<std::pair<const double*, const double*>> blocks = {{calibration.data(), calibration.data()}};
-    Eigen::Matrix<double, 4, 4, Eigen::RowMajor> c = Eigen::Matrix<double, 4, 4, Eigen::RowMajor>::Constant(
-        std::numeric_limits<double>::quiet_NaN());
-    if (covariance.Compute(blocks, &problem)) covariance.GetCovarianceBlock(calibration.data(), calibration.data(), c.data());
-    for (int i = 0; i < 4; ++i) calibration_.sigma(i) = c(i, i) >= 0.0 ? std::sqrt(c(i, i)) : std::numeric_limits<double>::quiet_NaN();
+    calibration_.sigma = marginalSigmas<kCalibrationSize>(problem, calibration.data());
   }
   if (estimate_separation_bias && biased_closures > 0 && std::isfinite(separation_bias_m)) {
     separation_bias_.estimate_m = separation_bias_.tested_m = separation_bias_m;
     // Its sigma: the bias's marginal covariance (every node a variable at full smoothing).
-    ceres::Covariance::Options covariance_options;
-    covariance_options.algorithm_type = ceres::SPARSE_QR;
-    ceres::Covariance covariance(covariance_options);
-    const std::vector<std::pair<const double*, const double*>> blocks = {{&separation_bias_m, &separation_bias_m}};
-    double variance = std::numeric_limits<double>::quiet_NaN();
-    if (covariance.Compute(blocks, &problem)) covariance.GetCovarianceBlock(&separation_bias_m, &separation_bias_m, &variance);
-    separation_bias_.sigma_m = variance >= 0.0 ? std::sqrt(variance) : std::numeric_limits<double>::quiet_NaN();
+    separation_bias_.sigma_m = marginalSigmas<1>(problem, &separation_bias_m)(0);
   }
   return true;
 }
 
-void SlidingWindowPoseGraph::reweighFromResiduals(const std::vector<Factor>& factors, UpdateReport& report) {
+void SlidingWindowPoseGraph::reweighFromResiduals(const std::vector<Factor>& factors, UpdateReport& report,
+                                                  bool estimate_calibration) {
   enum Group { kClosures = 0, kOdometry = 1, kGroups = 2 };
   // With "none" one pass: the components are measured (DR's strain is a diagnostic), nothing changes.
   const bool reweigh = options_.closure_reweighting != "none";
@@ -1103,7 +1109,7 @@ void SlidingWindowPoseGraph::reweighFromResiduals(const std::vector<Factor>& fac
     ++variance_factors_.iterations;
     if (settled) return;
     UpdateReport again;
-    if (!solve(factors, options_.full_smoothing_max_iterations, again, separation_bias_.applied, calibrating_)) {
+    if (!solve(factors, options_.full_smoothing_max_iterations, again, separation_bias_.applied, estimate_calibration)) {
       variance_factors_ = before;  // the estimate stays the last good one, and so do its weights
       return;
     }
@@ -1273,7 +1279,6 @@ UpdateReport SlidingWindowPoseGraph::fullSmoothing() {
   const std::vector<Factor> factors = allFactors();
   bool ok = true;
   const bool calibrate = calibrationWanted();
-  calibrating_ = calibrate;
   const DrCalibration calibration_start = calibration_;
   if (options_.separation_bias_sigma_m > 0.0) {
     // The separation bias as a variable. Kept only when significant and asked for; otherwise the
@@ -1300,8 +1305,7 @@ UpdateReport SlidingWindowPoseGraph::fullSmoothing() {
   } else {
     ok = solve(factors, options_.full_smoothing_max_iterations, report, false, calibrate);
   }
-  if (ok) reweighFromResiduals(factors, report);
-  calibrating_ = false;
+  if (ok) reweighFromResiduals(factors, report, calibrate);
   if (ok) {
     // Re-derive the window's prior at the smoothed estimate, eliminating the old nodes in order.
     prior_ = Prior();

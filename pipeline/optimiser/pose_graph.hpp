@@ -392,6 +392,9 @@ class SlidingWindowPoseGraph {
 
   // The odometry model (see PoseGraphOptions) for distance d.
   static sss::core::Matrix6d odometryCovariance(const PoseGraphOptions& options, double distance_m);
+  // The same with another systematic drift fraction (the calibrated model).
+  static sss::core::Matrix6d odometryCovariance(const PoseGraphOptions& options, double distance_m,
+                                                double drift_fraction);
 
  private:
   struct Node {
@@ -492,7 +495,7 @@ class SlidingWindowPoseGraph {
   Eigen::Vector3d separationDirection(const Closure& closure) const;
   // Variance components of closures and odometry at the current estimate, solving again with the
   // new factors until they settle (full smoothing, every node active).
-  void reweighFromResiduals(const std::vector<Factor>& factors, UpdateReport& report);
+  void reweighFromResiduals(const std::vector<Factor>& factors, UpdateReport& report, bool estimate_calibration);
   void marginaliseOldest();
   // Joint covariance of the active nodes (6 x 6 blocks in node order); slot[n - first_active_] is
   // the block of node n.
@@ -522,7 +525,6 @@ class SlidingWindowPoseGraph {
   VarianceFactors variance_factors_;
   SeparationBias separation_bias_;
   DrCalibration calibration_;
-  bool calibrating_ = false;  // within fullSmoothing(): the calibration is a variable of every solve
   int64_t update_utime_us_ = 0;
   // Newest node time of an accepted closure that left the PCM horizon (its decision is final).
   int64_t frozen_newest_accepted_utime_us_ = -1;
