@@ -22,6 +22,26 @@ void run(const std::string& bytes) {
   LLVMFuzzerTestOneInput(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size());
 }
 
+// 2000 mutations of a valid stream (1-8 edits each: random or interesting bytes, cuts, repeats of
+// itself), the same on every run for a given seed.
+void runMutations(const std::string& base, unsigned seed, const std::vector<char>& interesting) {
+  std::mt19937 random(seed);
+  for (int round = 0; round < 2000; ++round) {
+    std::string bytes = base;
+    const int edits = 1 + static_cast<int>(random() % 8);
+    for (int e = 0; e < edits && !bytes.empty(); ++e) {
+      const size_t at = random() % bytes.size();
+      switch (random() % 4) {
+        case 0: bytes[at] = static_cast<char>(random() & 0xFF); break;
+        case 1: bytes[at] = interesting[random() % interesting.size()]; break;
+        case 2: bytes.erase(at, 1 + random() % 16); break;
+        case 3: bytes.insert(at, bytes.substr(random() % bytes.size(), random() % 64)); break;
+      }
+    }
+    run(bytes);
+  }
+}
+
 TEST(NmeaFuzzRegression, ReplaysEveryCorpusFile) {
   int files = 0;
   for (const auto& entry : std::filesystem::directory_iterator(SSS_INS_CORPUS_DIR)) {
@@ -48,22 +68,7 @@ TEST(NmeaFuzzRegression, SurvivesGeneratedMutationsOfValidBursts) {
     state.utime_us += 200000;
     base += encodeInsState(state);
   }
-  std::mt19937 random(12345);  // fixed seed: the same mutations on every run
-  const char interesting[] = {'$', '*', ',', '\r', '\n', '\0', '-', '.', '9', 'A', '\x80'};
-  for (int round = 0; round < 2000; ++round) {
-    std::string bytes = base;
-    const int edits = 1 + static_cast<int>(random() % 8);
-    for (int e = 0; e < edits && !bytes.empty(); ++e) {
-      const size_t at = random() % bytes.size();
-      switch (random() % 4) {
-        case 0: bytes[at] = static_cast<char>(random() & 0xFF); break;
-        case 1: bytes[at] = interesting[random() % sizeof(interesting)]; break;
-        case 2: bytes.erase(at, 1 + random() % 16); break;
-        case 3: bytes.insert(at, bytes.substr(random() % bytes.size(), random() % 64)); break;
-      }
-    }
-    run(bytes);
-  }
+  runMutations(base, 12345, {'$', '*', ',', '\r', '\n', '\0', '-', '.', '9', 'A', '\x80'});
 }
 
 TEST(NmeaFuzzRegression, SurvivesGeneratedMutationsOfFixStreams) {
@@ -80,22 +85,7 @@ TEST(NmeaFuzzRegression, SurvivesGeneratedMutationsOfFixStreams) {
     fix.utime_us += 1000000;
     base += encodePositionFix(fix, i == 1 ? "U0" : "GP");
   }
-  std::mt19937 random(4242);  // fixed seed: the same mutations on every run
-  const char interesting[] = {'$', '*', ',', '\r', '\n', '\0', '-', '.', '9', 'N', 'S', 'E', 'W', '\x80'};
-  for (int round = 0; round < 2000; ++round) {
-    std::string bytes = base;
-    const int edits = 1 + static_cast<int>(random() % 8);
-    for (int e = 0; e < edits && !bytes.empty(); ++e) {
-      const size_t at = random() % bytes.size();
-      switch (random() % 4) {
-        case 0: bytes[at] = static_cast<char>(random() & 0xFF); break;
-        case 1: bytes[at] = interesting[random() % sizeof(interesting)]; break;
-        case 2: bytes.erase(at, 1 + random() % 16); break;
-        case 3: bytes.insert(at, bytes.substr(random() % bytes.size(), random() % 64)); break;
-      }
-    }
-    run(bytes);
-  }
+  runMutations(base, 4242, {'$', '*', ',', '\r', '\n', '\0', '-', '.', '9', 'N', 'S', 'E', 'W', '\x80'});
 }
 
 }  // namespace

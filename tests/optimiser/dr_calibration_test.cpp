@@ -16,18 +16,6 @@ namespace {
 
 using namespace test_helpers;
 
-AbsoluteFix fixAt(const synthetic::Node& node, double sigma_m, std::mt19937_64& random) {
-  std::normal_distribution<double> gauss(0.0, sigma_m);
-  AbsoluteFix fix;
-  fix.utime_us = node.utime_us;
-  fix.position_ne_m = node.truth.translation.head<2>() + Eigen::Vector2d(gauss(random), gauss(random));
-  fix.covariance_m2 = sigma_m * sigma_m * Eigen::Matrix2d::Identity();
-  fix.dr_position_m = node.dr.translation;
-  fix.dr_distance_m = node.distance_m;
-  fix.source = "usbl";
-  return fix;
-}
-
 // Every node's closures and a USBL fix (1 m) at every other node, then full smoothing.
 SlidingWindowPoseGraph solved(const synthetic::Mission& mission, const PoseGraphOptions& options, bool fixes,
                               uint64_t seed) {
@@ -42,7 +30,7 @@ SlidingWindowPoseGraph solved(const synthetic::Mission& mission, const PoseGraph
       }
     }
     if (fixes && i % 2 == 0) {
-      EXPECT_TRUE(graph.addFix(fixAt(n, 1.0, random)).ok);
+      EXPECT_TRUE(graph.addFix(fixAt(n, 1.0, random, "usbl")).ok);
     }
     EXPECT_TRUE(graph.optimize().ok);
   }

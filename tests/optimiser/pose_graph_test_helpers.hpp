@@ -1,9 +1,10 @@
 // Helpers shared by the pose-graph tests: the test lawnmower (5 lines of 400 m, 100 m subframes),
-// feeding it node by node to a graph, and the trajectory errors of a run.
+// feeding it node by node to a graph, noisy absolute fixes of its nodes, and the trajectory errors of a run.
 #pragma once
 
 #include <gtest/gtest.h>
 
+#include <random>
 #include <vector>
 
 #include "pipeline/optimiser/pose_graph.hpp"
@@ -26,6 +27,20 @@ inline PoseGraphOptions graphOptions(int window_size = 8) {
   PoseGraphOptions o;
   o.window_size = window_size;  // two lines of four nodes: most adjacent-line closures stay inside
   return o;
+}
+
+// An absolute fix of the node's true position with noise of sigma_m per axis, tied through its DR.
+inline AbsoluteFix fixAt(const synthetic::Node& node, double sigma_m, std::mt19937_64& random,
+                         const char* source = "gnss") {
+  std::normal_distribution<double> gauss(0.0, sigma_m);
+  AbsoluteFix fix;
+  fix.utime_us = node.utime_us;
+  fix.position_ne_m = node.truth.translation.head<2>() + Eigen::Vector2d(gauss(random), gauss(random));
+  fix.covariance_m2 = sigma_m * sigma_m * Eigen::Matrix2d::Identity();
+  fix.dr_position_m = node.dr.translation;
+  fix.dr_distance_m = node.distance_m;
+  fix.source = source;
+  return fix;
 }
 
 inline std::vector<Pose> estimates(const SlidingWindowPoseGraph& graph) {

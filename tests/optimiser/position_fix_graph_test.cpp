@@ -16,19 +16,6 @@ namespace {
 
 using namespace test_helpers;
 
-// A fix of node i's true position with noise of sigma_m per axis, tied through its DR.
-AbsoluteFix fixAt(const synthetic::Node& node, double sigma_m, std::mt19937_64& random, const char* source = "gnss") {
-  std::normal_distribution<double> gauss(0.0, sigma_m);
-  AbsoluteFix fix;
-  fix.utime_us = node.utime_us;
-  fix.position_ne_m = node.truth.translation.head<2>() + Eigen::Vector2d(gauss(random), gauss(random));
-  fix.covariance_m2 = sigma_m * sigma_m * Eigen::Matrix2d::Identity();
-  fix.dr_position_m = node.dr.translation;
-  fix.dr_distance_m = node.distance_m;
-  fix.source = source;
-  return fix;
-}
-
 double error(const SlidingWindowPoseGraph& graph, const synthetic::Mission& mission, size_t node) {
   return (graph.nodes()[node].T_world_body.translation - mission.nodes[node].truth.translation).head<2>().norm();
 }
