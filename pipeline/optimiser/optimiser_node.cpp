@@ -341,6 +341,12 @@ int main(int argc, char** argv) {
   };
 
   sss::optimiser::CorrectionSlew slew(options.slew);
+  // Off the nav path (200 Hz, latency-bound): the slew's figures go to SSS_STATUS once a second.
+  loop.addTimer(1.0, [&] {
+    health.setCounter("correction_lag_m", slew.lagM());
+    health.setCounter("correction_last_jump_m", slew.lastJumpM());
+    health.setCounter("correction_jumps", static_cast<double>(slew.jumps()));
+  });
   // ---- subscriptions ------------------------------------------------------------------------------
   loop.bus().subscribe<sss_msgs::nav_t>(options.nav_channel, [&](const sss_msgs::nav_t& message) {
     const int64_t arrival = sss::core::monotonicUtime();
@@ -383,9 +389,6 @@ int main(int argc, char** argv) {
       spdlog::info("the correction of the present pose jumped {:.2f} m (a fix or closures accepted); the published "
                    "pose follows at {:.2f} m/s, its covariance widened by what is left", *jump, options.slew.max_rate_m_s);
     }
-    health.setCounter("correction_lag_m", slew.lagM());
-    health.setCounter("correction_last_jump_m", slew.lastJumpM());
-    health.setCounter("correction_jumps", static_cast<double>(slew.jumps()));
     const auto dr = sss::subframe::poseOf(nav);
     const sss_msgs::pose_t pose = sss::optimiser::toPoseMessage(nav.utime_us, dr, correction, *plane);
     loop.bus().publish(options.pose_channel, pose, arrival);
