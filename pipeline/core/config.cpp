@@ -68,6 +68,26 @@ ConfigSection ConfigSection::section(const std::string& key) {
   return ConfigSection(child, keyPath(key), problems_);
 }
 
+std::vector<ConfigSection> ConfigSection::sequence(const std::string& key) {
+  read_keys_.insert(key);
+  std::vector<ConfigSection> items;
+  const YAML::Node child = lookup(key);
+  if (!child.IsDefined() || child.IsNull()) return items;
+  if (!child.IsSequence()) {
+    addProblem(key, describeYamlValue(child), "wrong type; expected a list of sections");
+    return items;
+  }
+  for (size_t i = 0; i < child.size(); ++i) {
+    const std::string item_path = keyPath(key) + "[" + std::to_string(i) + "]";
+    if (!child[i].IsMap()) {
+      addProblem(key + "[" + std::to_string(i) + "]", describeYamlValue(child[i]), "wrong type; expected a section (a map of keys)");
+      continue;
+    }
+    items.emplace_back(child[i], item_path, problems_);
+  }
+  return items;
+}
+
 void ConfigSection::addProblem(const std::string& key, const std::string& value, const std::string& reason) {
   problems_->push_back({keyPath(key), value, reason});
 }

@@ -77,6 +77,9 @@ class ConfigSection {
   bool has(const std::string& key) const;
   // A sub-section; a missing one is empty (every optional key keeps its default).
   ConfigSection section(const std::string& key);
+  // A list of sections (a YAML sequence of maps), each named key[i] in problems; a missing key is
+  // an empty list.
+  std::vector<ConfigSection> sequence(const std::string& key);
   // Adds a problem for a rule that spans several keys (e.g. "min < max").
   void addProblem(const std::string& key, const std::string& value, const std::string& reason);
   // Adds a problem for every key of this section that no one read: catches typos.

@@ -122,5 +122,32 @@ TEST(Config, SectionThatIsNotAMapIsReported) {
   EXPECT_EQ(config.problems()[0].message(), "config key 'matcher' = 3: wrong type; expected a section (a map of keys)");
 }
 
+TEST(Config, SequenceOfSectionsIsReadItemByItemWithIndexedKeys) {
+  Config config = Config::fromString("targets:\n  - {north_m: 1.5, east_m: 2}\n  - {north_m: -3, easting: 4}\n  - 7\n");
+  ConfigSection root = config.root();
+  std::vector<ConfigSection> items = root.sequence("targets");
+  ASSERT_EQ(items.size(), 2u) << "the scalar item is a problem, not a section";
+  std::vector<double> north(2, 0.0), east(2, 0.0);
+  for (size_t i = 0; i < items.size(); ++i) {
+    items[i].required("north_m", north[i]);
+    items[i].optional("east_m", east[i]);
+    items[i].rejectUnknownKeys();
+  }
+  root.rejectUnknownKeys();
+  EXPECT_DOUBLE_EQ(north[0], 1.5);
+  EXPECT_DOUBLE_EQ(east[0], 2.0);
+  EXPECT_DOUBLE_EQ(north[1], -3.0);
+  ASSERT_EQ(config.problems().size(), 2u) << config.problemReport();
+  EXPECT_EQ(config.problems()[0].key, "targets[2]");
+  EXPECT_EQ(config.problems()[1].key, "targets[1].easting");
+
+  Config none = Config::fromString("other: 1\n");
+  EXPECT_TRUE(none.root().sequence("targets").empty());
+  Config not_a_list = Config::fromString("targets: {north_m: 1}\n");
+  EXPECT_TRUE(not_a_list.root().sequence("targets").empty());
+  ASSERT_EQ(not_a_list.problems().size(), 1u);
+  EXPECT_NE(not_a_list.problems()[0].reason.find("expected a list of sections"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace sss::core

@@ -83,6 +83,17 @@ void readSimOptions(sss::core::ConfigSection section, SimOptions& o) {
   seabed.optional("outcrop_relief_m", s.outcrop_relief_m, {inRange(0.0, 10.0)});
   seabed.optional("outcrop_scale_m", s.outcrop_scale_m, {inRange(5.0, 1000.0)});
   seabed.optional("enable_texture", s.enable_texture);
+  // Hand-placed objects (targets a test or a survey check looks for at known coordinates).
+  for (sss::core::ConfigSection item : seabed.sequence("objects")) {
+    SeabedObject object;
+    item.required("north_m", object.north_m);
+    item.required("east_m", object.east_m);
+    item.optional("radius_m", object.radius_m, {inRange(0.05, 50.0)});
+    item.optional("height_m", object.height_m, {inRange(0.0, 20.0)});
+    item.optional("reflectivity", object.reflectivity, {inRange(0.0, 5.0)});
+    item.rejectUnknownKeys();
+    s.objects.push_back(object);
+  }
   seabed.rejectUnknownKeys();
 
   sss::core::ConfigSection vehicle = subsection(section, "vehicle");
@@ -254,6 +265,16 @@ std::string simOptionsYaml(const SimOptions& o) {
       << "megaripple_wavelength_m" << YAML::Value << s.megaripple_wavelength_m << YAML::Key << "outcrop_fraction"
       << YAML::Value << s.outcrop_fraction << YAML::Key << "outcrop_relief_m" << YAML::Value << s.outcrop_relief_m
       << YAML::Key << "outcrop_scale_m" << YAML::Value << s.outcrop_scale_m;
+  if (!s.objects.empty()) {
+    out << YAML::Key << "objects" << YAML::Value << YAML::BeginSeq;
+    for (const SeabedObject& object : s.objects) {
+      out << YAML::Flow << YAML::BeginMap << YAML::Key << "north_m" << YAML::Value << object.north_m << YAML::Key
+          << "east_m" << YAML::Value << object.east_m << YAML::Key << "radius_m" << YAML::Value << object.radius_m
+          << YAML::Key << "height_m" << YAML::Value << object.height_m << YAML::Key << "reflectivity" << YAML::Value
+          << object.reflectivity << YAML::EndMap;
+    }
+    out << YAML::EndSeq;
+  }
   out << YAML::EndMap;
   const TrajectoryOptions& t = o.trajectory;
   out << YAML::Key << "vehicle" << YAML::Value << YAML::BeginMap;
