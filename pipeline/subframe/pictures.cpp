@@ -61,13 +61,12 @@ std::vector<std::string> writeWaterfalls(const std::vector<Subframe>& subframes,
   return files;
 }
 
-bool writeMosaic(const std::vector<Subframe>& subframes,
-                 const std::map<int64_t, std::vector<sss::core::Pose>>& poses_by_subframe, const std::string& path,
-                 const PictureOptions& options, std::string& error,
-                 const std::optional<sss::core::MissionOrigin>& origin) {
+std::optional<MosaicRaster> renderMosaic(const std::vector<Subframe>& subframes,
+                                         const std::map<int64_t, std::vector<sss::core::Pose>>& poses_by_subframe,
+                                         const PictureOptions& options, std::string& error) {
   if (subframes.empty()) {
-    error = "no subframes for the mosaic " + path;
-    return false;
+    error = "no subframes for the mosaic";
+    return std::nullopt;
   }
   struct Point {
     double north, east;
@@ -100,12 +99,17 @@ bool writeMosaic(const std::vector<Subframe>& subframes,
     }
   }
   if (points.empty()) {
-    error = "no valid pixels for the mosaic " + path;
-    return false;
+    error = "no valid pixels for the mosaic";
+    return std::nullopt;
   }
+  MosaicRaster mosaic;
   const double res = options.mosaic_resolution_m;
-  const int rows = static_cast<int>(std::ceil((n_max - n_min) / res)) + 1;
-  const int cols = static_cast<int>(std::ceil((e_max - e_min) / res)) + 1;
+  mosaic.resolution_m = res;
+  mosaic.rows = static_cast<int>(std::ceil((n_max - n_min) / res)) + 1;
+  mosaic.cols = static_cast<int>(std::ceil((e_max - e_min) / res)) + 1;
+  mosaic.north_max_m = n_min + mosaic.rows * res;
+  mosaic.east_min_m = e_min;
+  const int rows = mosaic.rows, cols = mosaic.cols;
   cv::Mat sum(rows, cols, CV_64F, cv::Scalar(0.0));
   cv::Mat count(rows, cols, CV_32S, cv::Scalar(0));
   for (const Point& p : points) {
@@ -115,15 +119,21 @@ bool writeMosaic(const std::vector<Subframe>& subframes,
     sum.at<double>(row, col) += p.value;
     count.at<int>(row, col) += 1;
   }
-  cv::Mat image(rows, cols, CV_8UC3, cv::Scalar(0, 0, 0));  // black = no data (data is 1..255)
+  mosaic.gray.assign(static_cast<size_t>(rows) * cols, 0);  // 0 = no data (data is 1..255)
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < cols; ++c) {
       const int n = count.at<int>(r, c);
       if (n == 0) continue;
       const double v = 1.0 + std::clamp(sum.at<double>(r, c) / n / options.display_max_intensity, 0.0, 1.0) * 254.0;
-      image.at<cv::Vec3b>(r, c) = cv::Vec3b(static_cast<uint8_t>(v), static_cast<uint8_t>(v), static_cast<uint8_t>(v));
+      mosaic.gray[static_cast<size_t>(r) * cols + c] = static_cast<uint8_t>(v);
     }
   }
+  return mosaic;
+}
+
+bool writeMosaic(const MosaicRaster& mosaic, const std::string& path, std::string& error,
+                 const std::optional<sss::core::MissionOrigin>& origin) {
+  cv::Mat image(mosaic.rows, mosaic.cols, CV_8UC1, const_cast<uint8_t*>(mosaic.gray.data()));
   if (!cv::imwrite(path, image)) {
     error = "cannot write " + path;
     return false;
@@ -136,14 +146,26 @@ bool writeMosaic(const std::vector<Subframe>& subframes,
        << ": mean normalised intensity per cell, geo-referenced with the poses given.\n"
        << "# Pixel (row, col): north = north_max_m - (row + 0.5) * resolution_m, east = east_min_m + (col + 0.5) * "
           "resolution_m.\n"
-       << "resolution_m: " << res << "\nnorth_max_m: " << n_min + rows * res << "\neast_min_m: " << e_min
-       << "\nrows: " << rows << "\ncols: " << cols << "\n";
+       << "resolution_m: " << mosaic.resolution_m << "\nnorth_max_m: " << mosaic.north_max_m
+       << "\neast_min_m: " << mosaic.east_min_m << "\nrows: " << mosaic.rows << "\ncols: " << mosaic.cols << "\n";
   if (origin) yaml << sss::core::originYamlKeys(*origin);
   if (!yaml) {
     error = "cannot write " + yaml_path;
     return false;
   }
   return true;
+}
+
+bool writeMosaic(const std::vector<Subframe>& subframes,
+                 const std::map<int64_t, std::vector<sss::core::Pose>>& poses_by_subframe, const std::string& path,
+                 const PictureOptions& options, std::string& error,
+                 const std::optional<sss::core::MissionOrigin>& origin) {
+  const std::optional<MosaicRaster> mosaic = renderMosaic(subframes, poses_by_subframe, options, error);
+  if (!mosaic) {
+    error += " " + path;
+    return false;
+  }
+  return writeMosaic(*mosaic, path, error, origin);
 }
 
 }  // namespace sss::subframe

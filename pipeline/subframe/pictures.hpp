@@ -2,6 +2,7 @@
 // PNG of a whole mission (OpenCV), for eyes and reports, not for the matcher.
 #pragma once
 
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
@@ -25,7 +26,31 @@ struct PictureOptions {
 std::vector<std::string> writeWaterfalls(const std::vector<Subframe>& subframes, const std::string& dir,
                                          const PictureOptions& options, std::string& error);
 
-// Writes a north-up mosaic: mean normalised intensity per cell of every valid pixel geo-referenced
+// A north-up mosaic raster: row 0 is the northernmost; cell (row, col) covers north
+// north_max_m - (row + 1) * resolution_m .. north_max_m - row * resolution_m and east
+// east_min_m + col * resolution_m .. + resolution_m (mission frame, metres).
+struct MosaicRaster {
+  int rows = 0;
+  int cols = 0;
+  double resolution_m = 0.5;
+  double north_max_m = 0.0;  // top edge of row 0
+  double east_min_m = 0.0;   // left edge of column 0
+  std::vector<uint8_t> gray;  // mean normalised intensity 1..255; 0 = no data
+};
+
+// The mosaic's mean normalised intensity per cell of every valid pixel geo-referenced with the
+// given poses per subframe id (DR when a subframe has none there); nullopt (and error) when
+// nothing can be placed.
+std::optional<MosaicRaster> renderMosaic(const std::vector<Subframe>& subframes,
+                                         const std::map<int64_t, std::vector<sss::core::Pose>>& poses_by_subframe,
+                                         const PictureOptions& options, std::string& error);
+
+// Writes a rendered mosaic as an 8-bit grey PNG (black = no data) with its geo-reference beside it
+// (same name, .yaml; keys as below).
+bool writeMosaic(const MosaicRaster& mosaic, const std::string& path, std::string& error,
+                 const std::optional<sss::core::MissionOrigin>& origin = std::nullopt);
+
+// Renders and writes a north-up mosaic: mean normalised intensity per cell of every valid pixel geo-referenced
 // with the given poses per subframe id (DR when a subframe has none there); black = no data. Its geo-reference goes
 // beside it as the same name with .yaml (keys resolution_m, north_max_m, east_min_m, rows, cols,
 // and origin_latitude_deg / origin_longitude_deg when the frame's origin is given).
