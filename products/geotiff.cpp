@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <memory>
 #include <mutex>
 
@@ -212,7 +213,13 @@ bool writeGeoTiff(const std::string& path, const FrameRaster& raster, const Rast
     GDALTranslateOptions* options = GDALTranslateOptionsNew(argv.get(), nullptr);
     output.reset(GDALTranslate(path.c_str(), static_cast<GDALDatasetH>(memory.get()), options, nullptr));
     GDALTranslateOptionsFree(options);
-    if (srs) written.crs_name = crsName(static_cast<OGRSpatialReferenceH>(srs.get()));
+    if (srs) {
+      OGRSpatialReferenceH handle = static_cast<OGRSpatialReferenceH>(srs.get());
+      written.crs_name = crsName(handle);
+      OSRAutoIdentifyEPSG(handle);
+      const char* code = OSRGetAuthorityCode(handle, nullptr);
+      if (code) written.epsg = std::atoi(code);
+    }
   } else {
     // The tangent plane warped into the origin's UTM zone, on a grid aligned to the resolution.
     Srs plane = tangentPlaneSrs(*frame.origin);

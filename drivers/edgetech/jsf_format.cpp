@@ -97,6 +97,25 @@ std::optional<JsfMessageHeader> decodeHeader(const uint8_t* bytes) {
   return header;
 }
 
+void encodeSonarNavigation(const SonarChannelRecord& record, uint8_t* b) {
+  writeLe<uint16_t>(b, 30, record.validity);
+  if (record.projected_position) {
+    writeLe<int32_t>(b, 80, clampToInt32(record.easting_m * 1000.0));
+    writeLe<int32_t>(b, 84, clampToInt32(record.northing_m * 1000.0));
+    writeLe<int16_t>(b, 88, 1);  // coordinate units: millimetres
+  } else {
+    writeLe<int32_t>(b, 80, clampToInt32(record.longitude_deg * kMinutesX10000PerDegree));
+    writeLe<int32_t>(b, 84, clampToInt32(record.latitude_deg * kMinutesX10000PerDegree));
+    writeLe<int16_t>(b, 88, 2);  // coordinate units: minutes of arc x 10000
+  }
+  writeLe<int32_t>(b, 136, clampToInt32(record.depth_m * 1000.0));
+  double heading_deg = std::fmod(record.heading_rad * kRadToDeg, 360.0);
+  if (heading_deg < 0.0) heading_deg += 360.0;
+  writeLe<uint16_t>(b, 172, static_cast<uint16_t>(std::lround(heading_deg * 100.0) % 36000));
+  writeLe<int16_t>(b, 174, clampToInt16(record.pitch_rad * kRadToDeg / kAngleScale));
+  writeLe<int16_t>(b, 176, clampToInt16(record.roll_rad * kRadToDeg / kAngleScale));
+}
+
 std::vector<uint8_t> encodeSonarData(const SonarChannelRecord& record, const std::vector<uint16_t>& envelope_codes,
                                      uint8_t sequence) {
   const size_t num_samples = std::min<size_t>(envelope_codes.size(), 0xFFFFF);  // 20 bits with the MSBs
@@ -124,16 +143,11 @@ std::vector<uint8_t> encodeSonarData(const SonarChannelRecord& record, const std
                                               (((num_samples >> 16) & 0xF) << 8));
   writeLe<uint16_t>(b, 16, msbs);
   writeLe<int16_t>(b, 28, 1);  // id code: 1 = seismic/sonar data
-  writeLe<uint16_t>(b, 30, record.validity);
   writeLe<int16_t>(b, 34, 0);  // envelope
-  writeLe<int32_t>(b, 80, clampToInt32(record.longitude_deg * kMinutesX10000PerDegree));
-  writeLe<int32_t>(b, 84, clampToInt32(record.latitude_deg * kMinutesX10000PerDegree));
-  writeLe<int16_t>(b, 88, 2);  // coordinate units: minutes of arc x 10000
   writeLe<uint16_t>(b, 114, static_cast<uint16_t>(num_samples & 0xFFFF));
   writeLe<uint32_t>(b, 116, static_cast<uint32_t>(std::llround(record.sample_interval_s * 1e9)));
   writeLe<uint16_t>(b, 126, start_freq);
   writeLe<uint16_t>(b, 128, end_freq);
-  writeLe<int32_t>(b, 136, clampToInt32(record.depth_m * 1000.0));
   writeLe<int32_t>(b, 144, clampToInt32(record.altitude_m * 1000.0));
   writeLe<float>(b, 148, record.sound_speed_m_s);
   // Calendar fields (offsets 156-166) and milliseconds today (200).
@@ -147,11 +161,7 @@ std::vector<uint8_t> encodeSonarData(const SonarChannelRecord& record, const std
   writeLe<int16_t>(b, 164, static_cast<int16_t>(utc.tm_sec));
   writeLe<int16_t>(b, 166, 0);
   writeLe<int16_t>(b, 168, record.weighting_factor);
-  double heading_deg = std::fmod(record.heading_rad * kRadToDeg, 360.0);
-  if (heading_deg < 0.0) heading_deg += 360.0;
-  writeLe<uint16_t>(b, 172, static_cast<uint16_t>(std::lround(heading_deg * 100.0) % 36000));
-  writeLe<int16_t>(b, 174, clampToInt16(record.pitch_rad * kRadToDeg / kAngleScale));
-  writeLe<int16_t>(b, 176, clampToInt16(record.roll_rad * kRadToDeg / kAngleScale));
+  encodeSonarNavigation(record, b);
   const int64_t ms_today = (static_cast<int64_t>(utc.tm_hour) * 3600 + utc.tm_min * 60 + utc.tm_sec) * 1000 + micros / 1000;
   writeLe<uint32_t>(b, 200, static_cast<uint32_t>(ms_today));
   writeLe<int32_t>(b, 216, -1);  // spherical correction off

@@ -98,6 +98,11 @@ std::vector<uint16_t> quantiseEnvelope(const std::vector<float>& magnitudes, int
 std::vector<uint8_t> encodeSonarData(const SonarChannelRecord& record, const std::vector<uint16_t>& envelope_codes,
                                      uint8_t sequence = 0);
 
+// Writes the navigation fields of a type 80 body's 240-byte header in place: validity (30),
+// position (80, 84; coordinate units 88: 2 = minutes x 10000, or 1 = mm when projected_position),
+// depth (136), heading (172), pitch (174), roll (176). Nothing else is touched.
+void encodeSonarNavigation(const SonarChannelRecord& record, uint8_t* body);
+
 // Header from 16 bytes; nullopt when the start marker is wrong.
 std::optional<JsfMessageHeader> decodeHeader(const uint8_t* bytes);
 void encodeHeader(const JsfMessageHeader& header, uint8_t* bytes);

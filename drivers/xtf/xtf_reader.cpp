@@ -258,6 +258,7 @@ bool XtfReader::next(sss::edgetech::DriverPing& ping) {
     ++counters_.pings;
     if (result.ship_coordinates) ++counters_.pings_ship_coordinates;
     ping = std::move(*result.ping);
+    last_ping_offset_ = packet_offset;
     return true;
   }
 }

@@ -64,6 +64,8 @@ class XtfReader {
 
   // The next sonar ping; false at the end of the data.
   bool next(sss::edgetech::DriverPing& ping);
+  // Byte offset in the file of the sonar packet the last next() gave (to patch it in a copy).
+  uint64_t lastPingOffset() const { return last_ping_offset_; }
   // The navigation packets (types 3, 42, 107) read since the last call, in file order: those
   // before the ping next() just gave.
   std::vector<XtfNavigationRecord> takeNavigation();
@@ -104,6 +106,7 @@ class XtfReader {
   size_t start_ = 0;              // first unconsumed byte in buffer_
   uint64_t consumed_offset_ = 0;  // file offset of buffer_[start_]
   uint64_t bytes_read_ = 0;
+  uint64_t last_ping_offset_ = 0;
   bool first_packet_found_ = false;
   bool skipping_ = false;
   XtfReaderCounters counters_;

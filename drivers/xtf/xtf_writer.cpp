@@ -56,6 +56,15 @@ std::vector<uint8_t> encodeFileHeader(const XtfWriterOptions& options) {
   return bytes;
 }
 
+void encodePingNavigation(const XtfPingInput& ping, uint8_t* p) {
+  writeF64(p, offset::kSensorY, ping.sensor_y);
+  writeF64(p, offset::kSensorX, ping.sensor_x);
+  writeF32(p, offset::kSensorDepth, ping.depth_m);
+  writeF32(p, offset::kSensorPitch, ping.pitch_deg);
+  writeF32(p, offset::kSensorRoll, ping.roll_deg);
+  writeF32(p, offset::kSensorHeading, ping.heading_deg);
+}
+
 std::vector<uint8_t> encodeSonarPacket(const XtfWriterOptions& options, const XtfPingInput& ping) {
   size_t size = kPingHeaderBytes;
   for (const XtfChannelData& channel : ping.channels) {
@@ -85,13 +94,8 @@ std::vector<uint8_t> encodeSonarPacket(const XtfWriterOptions& options, const Xt
   writeU16(p, offset::kJulianDay, static_cast<uint16_t>(utc.tm_yday + 1));
   writeU32(p, offset::kPingNumber, ping.ping_number);
   writeF32(p, offset::kSoundVelocity, ping.sound_velocity);
-  writeF64(p, offset::kSensorY, ping.sensor_y);
-  writeF64(p, offset::kSensorX, ping.sensor_x);
-  writeF32(p, offset::kSensorDepth, ping.depth_m);
   writeF32(p, offset::kSensorPrimaryAltitude, ping.altitude_m);
-  writeF32(p, offset::kSensorPitch, ping.pitch_deg);
-  writeF32(p, offset::kSensorRoll, ping.roll_deg);
-  writeF32(p, offset::kSensorHeading, ping.heading_deg);
+  encodePingNavigation(ping, p);
 
   size_t at = kPingHeaderBytes;
   for (const XtfChannelData& channel : ping.channels) {

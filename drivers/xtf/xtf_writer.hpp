@@ -56,6 +56,9 @@ struct XtfPingInput {
 std::vector<uint8_t> encodeFileHeader(const XtfWriterOptions& options);
 // One sonar packet (header type 0): ping header, then per channel a channel header and samples.
 std::vector<uint8_t> encodeSonarPacket(const XtfWriterOptions& options, const XtfPingInput& ping);
+// Writes the ping header's navigation in place (packet = the packet start): SensorY/X, depth,
+// pitch, roll, heading; nothing else (the altitude is the sonar's own measurement).
+void encodePingNavigation(const XtfPingInput& ping, uint8_t* packet);
 // A packet of another type (notes, attitude, ...) of total_bytes zero-filled bytes (>= 14).
 std::vector<uint8_t> encodeOtherPacket(uint8_t header_type, size_t total_bytes);
 

@@ -26,6 +26,7 @@
 #include "tools/eval/trajectory_metrics.hpp"
 #include "tools/process/offline_runner.hpp"
 #include "pipeline/core/geodesy.hpp"
+#include "drivers/xtf/xtf_reader.hpp"
 #include "drivers/xtf/xtf_writer.hpp"
 #include "drivers/edgetech/jsf_format.hpp"
 #include "drivers/ins/ixblue_nmea.hpp"
@@ -602,6 +603,50 @@ TEST_F(OfflineRunnerTest, XtfInProjectedMetresWithoutAltitudeIsProcessedInItsGri
     near_truth += std::abs(std::stod(line.substr(line.find(',') + 1)) - 15.0) < 0.2 ? 1 : 0;
   }
   EXPECT_GE(near_truth, rows * 95 / 100) << "bottom-tracked altitude within 0.2 m of the 15 m";
+  EXPECT_FALSE(s.geotiffs.empty()) << "the heightmap and coverage in the grid's coordinates";
+  EXPECT_EQ(s.geotiff_crs, "") << "no CRS is guessed for a grid the file does not name";
+  EXPECT_NE(std::find_if(s.findings.begin(), s.findings.end(),
+                         [](const std::string& f) { return f.find("products.projected_crs") != std::string::npos; }),
+            s.findings.end())
+      << "a projected input without a CRS is told how to name it";
+
+  // With the grid's CRS named: GeoTIFFs in the file's grid, and a corrected copy of the XTF whose
+  // pings hold slam.tum plus the grid offsets (f64 in XTF: the TUM file's 0.1 mm rounding).
+  {
+    const std::string config_path = root_ + "/projected_products.yaml";
+    std::ofstream(config_path) << "products:\n  projected_crs: EPSG:32633\n";
+    sss::offline::OfflineRequest products;
+    products.sonar_path = path;
+    products.out_dir = root_ + "/run_projected_products";
+    products.config_path = config_path;
+    products.corrected_dir = products.out_dir + "/corrected";
+    const auto run = sss::offline::runOffline(products);
+    ASSERT_TRUE(run.ok) << run.error;
+    EXPECT_EQ(run.summary.geotiff_epsg, 32633);
+    EXPECT_EQ(run.summary.geotiff_crs, "WGS 84 / UTM zone 33N");
+    EXPECT_NE(std::find(run.summary.geotiffs.begin(), run.summary.geotiffs.end(), "mosaic_slam.tif"),
+              run.summary.geotiffs.end());
+    EXPECT_EQ(run.summary.corrected_records, run.summary.pings_with_pose);
+    const auto corrected_slam = sss::eval::readTum(products.out_dir + "/slam.tum");
+    ASSERT_TRUE(corrected_slam.ok) << corrected_slam.error;
+    std::map<int64_t, Eigen::Vector3d> slam_at;
+    for (const auto& p : corrected_slam.poses) slam_at[p.utime_us] = p.T_world_body.translation;
+    sss::xtf::XtfReader reader(products.corrected_dir + "/projected.xtf");
+    ASSERT_TRUE(reader.isOpen()) << reader.error();
+    sss::edgetech::DriverPing ping;
+    size_t compared = 0;
+    double worst_m = 0.0;
+    while (reader.next(ping)) {
+      const auto found = slam_at.find(ping.utime_us);
+      if (found == slam_at.end()) continue;  // a ping the chain dropped keeps its recorded navigation
+      const auto& side = *ping.ping.port;
+      worst_m = std::max(worst_m, std::hypot(side.easting_m - 650123.0 - found->second.y(),
+                                             side.northing_m - 6580456.0 - found->second.x()));
+      ++compared;
+    }
+    EXPECT_EQ(compared, run.summary.pings_with_pose);
+    EXPECT_LT(worst_m, 1e-3);
+  }
 
   // A multibeam-only XTF: refused with the reason, exit 2.
   sss::xtf::XtfWriterOptions multibeam;

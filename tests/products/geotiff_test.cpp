@@ -175,6 +175,7 @@ TEST_F(GeoTiffTest, ProjectedGridKeepsTheFilesCoordinatesAndTheNamedCrs) {
   GeoTiffInfo info;
   ASSERT_TRUE(writeGeoTiff(dir_ + "/grid.tif", raster, frame, error, &info)) << error;
   EXPECT_EQ(info.crs_name, "WGS 84 / UTM zone 33N");
+  EXPECT_EQ(info.epsg, 32633);
   auto back = sss::test::readGeoTiff(dir_ + "/grid.tif");
   ASSERT_TRUE(back.ok) << back.error;
   EXPECT_EQ(back.epsg, 32633);
@@ -190,6 +191,7 @@ TEST_F(GeoTiffTest, ProjectedGridKeepsTheFilesCoordinatesAndTheNamedCrs) {
   frame.projected_crs.clear();
   ASSERT_TRUE(writeGeoTiff(dir_ + "/grid_no_crs.tif", raster, frame, error, &info)) << error;
   EXPECT_EQ(info.crs_name, "");
+  EXPECT_EQ(info.epsg, 0);
   back = sss::test::readGeoTiff(dir_ + "/grid_no_crs.tif");
   ASSERT_TRUE(back.ok) << back.error;
   EXPECT_EQ(back.wkt, "");

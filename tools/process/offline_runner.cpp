@@ -16,6 +16,7 @@
 #include <deque>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <optional>
@@ -37,6 +38,9 @@
 #include "pipeline/matcher/matcher_engine.hpp"
 #include "pipeline/optimiser/optimiser_engine.hpp"
 #include "pipeline/subframe/pictures.hpp"
+#include "products/corrected_copy.hpp"
+#include "products/geotiff.hpp"
+#include "products/survey_rasters.hpp"
 #include "pipeline/subframe/subframe_buffer.hpp"
 #include "pipeline/subframe/subframe_message.hpp"
 #include "tools/eval/json_writer.hpp"
@@ -67,6 +71,28 @@ bool hasExtension(const std::string& path, const char* extension) {
   return path.size() > n && strcasecmp(path.c_str() + path.size() - n, extension) == 0;
 }
 
+// The coverage grid (distinct lines per cell, centres at north_min_m + row * resolution_m) as an
+// 8-bit GeoTIFF raster, north up; cells no line saw are no data.
+sss::products::FrameRaster coverageRaster(const CoverageGrid& grid) {
+  sss::products::FrameRaster raster;
+  raster.rows = grid.rows;
+  raster.cols = grid.cols;
+  raster.resolution_m = grid.resolution_m;
+  raster.north_top_edge_m = grid.north_min_m + (grid.rows - 0.5) * grid.resolution_m;
+  raster.east_left_edge_m = grid.east_min_m - 0.5 * grid.resolution_m;
+  raster.type = sss::products::RasterType::kByte;
+  raster.categorical = true;
+  raster.description = "sss-process: survey lines that saw each cell (SLAM poses)";
+  raster.values.assign(grid.lines.size(), std::numeric_limits<float>::quiet_NaN());
+  for (int row = 0; row < grid.rows; ++row) {
+    for (int col = 0; col < grid.cols; ++col) {
+      const uint8_t lines = grid.lines[static_cast<size_t>(row) * grid.cols + col];
+      if (lines > 0) raster.values[static_cast<size_t>(grid.rows - 1 - row) * grid.cols + col] = lines;
+    }
+  }
+  return raster;
+}
+
 struct Options {
   // mission.origin_*: an override; unset, the first valid position of the navigation.
   std::optional<sss::core::MissionOrigin> origin;
@@ -81,6 +107,10 @@ struct Options {
   // antenna is out of the water only at the surface; below, a receiver reports stale or no fixes).
   sss::ins::FixReaderOptions fix_reader;
   sss::ins::FixAlignerOptions fix_aligner;
+  // Section `products`: the CRS of a projected input's grid (XTF does not record it), and whether
+  // to write the GeoTIFFs.
+  std::string projected_crs;
+  bool write_geotiff = true;
 };
 
 // The library keys of each process's section; keys only a live process uses (ports, channels)
@@ -114,6 +144,12 @@ bool readOptions(const std::string& path, Options& options, std::string& error) 
       fixes.optional("usbl_default_sigma_m", options.fix_reader.usbl_default_sigma_m, {greaterThan(0.0)});
       fixes.optional("min_sigma_m", options.fix_reader.min_sigma_m, {greaterThan(0.0)});
       fixes.rejectUnknownKeys();
+    }
+    {
+      ConfigSection products = config.section("products");
+      products.optional("projected_crs", options.projected_crs);
+      products.optional("geotiff", options.write_geotiff);
+      products.rejectUnknownKeys();
     }
     if (!config.ok()) {
       error = "invalid configuration " + path + ": " + config.problemReport();
@@ -769,6 +805,19 @@ bool writeSummaryJson(const std::string& path, const OfflineRequest& request, co
   json.key("relative_pose").value(s.pairs_pose_rejected);
   json.key("first_reason").value(s.first_pair_rejection);
   json.endObject();
+  // The GeoTIFFs written and their CRS (QGIS and gdalinfo read it from the files too).
+  json.key("corrected_copy").beginObject();
+  json.key("path").value(s.corrected_copy);
+  json.key("pings_corrected").value(s.corrected_records);
+  json.key("pings_without_pose").value(s.corrected_records_without_pose);
+  json.endObject();
+  json.key("geotiff").beginObject();
+  json.key("crs").value(s.geotiff_crs);
+  json.key("epsg").value(static_cast<uint64_t>(s.geotiff_epsg));
+  json.key("files").beginArray();
+  for (const std::string& file : s.geotiffs) json.value(file);
+  json.endArray();
+  json.endObject();
   json.key("findings").beginArray();
   for (const std::string& finding : s.findings) json.value(finding);
   json.endArray();
@@ -903,6 +952,13 @@ class Runner {
   bool writeFixOutputs(const std::string& dir, std::string& error);
   bool writeNavigation(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& slam, std::string& error) const;
   bool writeGeoJson(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& slam, std::string& error) const;
+  // --write-corrected: the sonar file with the SLAM navigation in every ping.
+  bool writeCorrectedCopy(const std::vector<sss::optimiser::StampedPose>& slam, std::string& error);
+  // The GeoTIFFs' frame: the origin's tangent plane, or the file's projected grid; nullopt: neither.
+  std::optional<sss::products::RasterFrame> rasterFrame() const;
+  // Writes dir/name as a GeoTIFF when the run has a frame on Earth and GeoTIFFs are on.
+  bool writeRaster(const std::string& dir, const std::string& name, const sss::products::FrameRaster& raster,
+                   std::string& error);
   // Every subframe's swath edges under the SLAM poses (footprints_ order).
   std::vector<FootprintStrip> slamStrips() const {
     std::vector<FootprintStrip> strips;
@@ -932,6 +988,7 @@ class Runner {
                   "east = easting - %.3f",
                   easting_northing_m.y(), easting_northing_m.x());
     frame_comment_ = text;
+    projected_origin_ = easting_northing_m;
   }
   const sss::subframe::SubframeBuffer& buffer() const { return buffer_; }
   // The stage counters and the survey's layout into the summary (after finish()).
@@ -1097,6 +1154,7 @@ class Runner {
   int64_t last_ping_us_ = 0;
   std::optional<sss::core::MissionOrigin> origin_;
   std::string frame_comment_;  // appended to the trajectories' comment (a projected frame)
+  std::optional<Eigen::Vector2d> projected_origin_;  // the file's grid (easting, northing) at the frame's origin
   double start_s_ = wallSeconds();
   double last_progress_s_ = 0.0;
 };
@@ -1220,6 +1278,89 @@ bool Runner::writeNavigation(const std::string& dir, const std::vector<sss::opti
 // and DR tracks (a vertex every 4 pings), and subframes.geojson, each subframe's footprint on the
 // seabed under the SLAM poses (its swath of canonical ground range either side, a vertex every 25
 // pings) with its id and line. Only in a geographic frame.
+bool Runner::writeCorrectedCopy(const std::vector<sss::optimiser::StampedPose>& slam, std::string& error) {
+  std::optional<sss::core::LocalTangentPlane> plane;
+  if (origin_) plane.emplace(origin_->latitude_deg, origin_->longitude_deg);
+  if (!plane && !projected_origin_) return true;  // no frame on Earth: said in the findings
+  std::error_code ec;
+  fs::create_directories(request_.corrected_dir, ec);
+  const std::string out_path = (fs::path(request_.corrected_dir) / fs::path(request_.sonar_path).filename()).string();
+  // The pose at a ping's time: slam has one pose per ping, so an exact time; else the nearest
+  // neighbours interpolated when they are less than a second apart.
+  const sss::products::NavigationAt navigation =
+      [&](int64_t utime_us) -> std::optional<sss::products::PingNavigation> {
+    auto after = std::lower_bound(slam.begin(), slam.end(), utime_us,
+                                  [](const sss::optimiser::StampedPose& p, int64_t t) { return p.utime_us < t; });
+    sss::core::Pose pose;
+    if (after != slam.end() && after->utime_us == utime_us) {
+      pose = after->T_world_body;
+    } else {
+      if (after == slam.begin() || after == slam.end() || after->utime_us - (after - 1)->utime_us > 1000000) {
+        return std::nullopt;
+      }
+      const auto before = after - 1;
+      const double fraction =
+          static_cast<double>(utime_us - before->utime_us) / static_cast<double>(after->utime_us - before->utime_us);
+      pose = sss::core::interpolate(before->T_world_body, after->T_world_body, fraction);
+    }
+    sss::products::PingNavigation nav;
+    const sss::core::EulerAngles euler = sss::core::eulerFromQuaternion(pose.rotation);
+    nav.heading_rad = euler.heading_rad;
+    nav.pitch_rad = euler.pitch_rad;
+    nav.roll_rad = euler.roll_rad;
+    if (plane) {
+      // The inverse of how the readers place a ping: toNed(latitude, longitude, depth).
+      const sss::core::GeodeticPosition geo = plane->toGeodetic(pose.translation);
+      nav.latitude_deg = geo.latitude_deg;
+      nav.longitude_deg = geo.longitude_deg;
+      nav.depth_m = geo.depth_m;
+    } else {
+      nav.projected = true;
+      nav.easting_m = projected_origin_->x() + pose.translation.y();
+      nav.northing_m = projected_origin_->y() + pose.translation.x();
+      nav.depth_m = pose.translation.z();
+    }
+    return nav;
+  };
+  sss::products::CorrectedCopyCounters counters;
+  const bool ok = hasExtension(request_.sonar_path, ".xtf")
+                      ? sss::products::writeCorrectedXtf(request_.sonar_path, out_path, navigation, counters, error,
+                                                         options_.xtf.pair_index)
+                      : sss::products::writeCorrectedJsf(request_.sonar_path, out_path, navigation, counters, error);
+  if (!ok) return false;
+  summary_.corrected_copy = out_path;
+  summary_.corrected_records = counters.records_corrected;
+  summary_.corrected_records_without_pose = counters.records_without_pose;
+  return true;
+}
+
+std::optional<sss::products::RasterFrame> Runner::rasterFrame() const {
+  sss::products::RasterFrame frame;
+  if (projected_origin_) {
+    frame.projected = true;
+    frame.grid_easting_offset_m = projected_origin_->x();
+    frame.grid_northing_offset_m = projected_origin_->y();
+    frame.projected_crs = options_.projected_crs;
+    return frame;
+  }
+  if (!origin_) return std::nullopt;
+  frame.origin = origin_;
+  return frame;
+}
+
+bool Runner::writeRaster(const std::string& dir, const std::string& name, const sss::products::FrameRaster& raster,
+                         std::string& error) {
+  if (!options_.write_geotiff) return true;
+  const std::optional<sss::products::RasterFrame> frame = rasterFrame();
+  if (!frame) return true;  // no frame on Earth (said once in the findings)
+  sss::products::GeoTiffInfo info;
+  if (!sss::products::writeGeoTiff(dir + "/" + name, raster, *frame, error, &info)) return false;
+  summary_.geotiffs.push_back(name);
+  summary_.geotiff_crs = info.crs_name;
+  summary_.geotiff_epsg = info.epsg;
+  return true;
+}
+
 bool Runner::writeGeoJson(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& slam,
                           std::string& error) const {
   if (!origin_) return true;
@@ -1310,11 +1451,13 @@ bool Runner::writeOutputs(std::string& error) {
   if (!writeFixOutputs(dir, error)) return false;
   if (!writeNavigation(dir, slam, error)) return false;
   if (!writeGeoJson(dir, slam, error)) return false;
+  if (!request_.corrected_dir.empty() && !writeCorrectedCopy(slam, error)) return false;
   if (!footprints_.empty()) {
     const CoverageGrid coverage = computeCoverage(slamStrips(), 5.0);
     summary_.coverage_covered_m2 = coverage.covered_m2;
     summary_.coverage_seen_twice_m2 = coverage.seen_twice_m2;
     if (!writeCoverageFiles(dir + "/coverage.yaml", coverage, error, origin_)) return false;
+    if (!writeRaster(dir, "coverage.tif", coverageRaster(coverage), error)) return false;
   }
   if (!writeClosuresCsv(dir + "/loop_closures.csv", optimiser_, error)) return false;
   if (!writeAltitudeCsv(dir + "/altitude.csv", error)) return false;
@@ -1336,16 +1479,22 @@ bool Runner::writeOutputs(std::string& error) {
   summary_.seabed_points = points.size();
   if (!sss::optimiser::writeSeabedPly(dir + "/bathymetry.ply", points, error, origin_)) return false;
   if (!sss::optimiser::writeSeabedPly(dir + "/bathymetry_dr.ply", points_dr, error, origin_)) return false;
-  if (!points.empty() &&
-      !sss::optimiser::writeHeightmapFiles(dir + "/heightmap.yaml", sss::optimiser::gridSeabedPoints(points, bathymetry),
-                                           "sss-process: seabed re-triangulated with the SLAM poses", error, origin_)) {
-    return false;
-  }
-  if (!points_dr.empty() &&
-      !sss::optimiser::writeHeightmapFiles(dir + "/heightmap_dr.yaml",
-                                           sss::optimiser::gridSeabedPoints(points_dr, bathymetry),
-                                           "sss-process: seabed triangulated with the DR poses", error, origin_)) {
-    return false;
+  const struct {
+    const std::vector<sss::optimiser::SeabedPoint>& points;
+    const char* name;
+    const char* description;
+  } heightmaps[] = {{points, "heightmap", "sss-process: seabed re-triangulated with the SLAM poses"},
+                    {points_dr, "heightmap_dr", "sss-process: seabed triangulated with the DR poses"}};
+  for (const auto& heightmap : heightmaps) {
+    if (heightmap.points.empty()) continue;
+    const sss::optimiser::HeightmapGrid grid = sss::optimiser::gridSeabedPoints(heightmap.points, bathymetry);
+    if (!sss::optimiser::writeHeightmapFiles(dir + "/" + heightmap.name + ".yaml", grid, heightmap.description, error,
+                                             origin_) ||
+        !writeRaster(dir, std::string(heightmap.name) + ".tif",
+                     sss::products::heightmapRaster(grid, std::string(heightmap.description) + " (depth m, down)"),
+                     error)) {
+      return false;
+    }
   }
 
   if (request_.write_mosaics && !mosaic_subframes_.empty()) {
@@ -1356,12 +1505,21 @@ bool Runner::writeOutputs(std::string& error) {
         poses.push_back(optimiser_.correctionAt(ping.utime_us).T_corrected_dr * ping.T_world_body);
       }
     }
-    if (!sss::subframe::writeMosaic(mosaic_subframes_, {}, dir + "/mosaic_dr.png", options_.pictures, error, origin_)) {
-      return false;
-    }
-    if (!sss::subframe::writeMosaic(mosaic_subframes_, slam_poses, dir + "/mosaic_slam.png", options_.pictures, error,
-                                    origin_)) {
-      return false;
+    const std::map<int64_t, std::vector<Pose>> dr_poses;  // none: each subframe's own DR poses
+    const struct {
+      const std::map<int64_t, std::vector<Pose>>& poses;
+      const char* name;
+      const char* description;
+    } mosaics[] = {{dr_poses, "mosaic_dr", "sss-process: side-scan mosaic geo-referenced with dead reckoning"},
+                   {slam_poses, "mosaic_slam", "sss-process: side-scan mosaic geo-referenced with the SLAM poses"}};
+    for (const auto& mosaic : mosaics) {
+      const auto raster = sss::subframe::renderMosaic(mosaic_subframes_, mosaic.poses, options_.pictures, error);
+      if (!raster || !sss::subframe::writeMosaic(*raster, dir + "/" + mosaic.name + ".png", error, origin_) ||
+          !writeRaster(dir, std::string(mosaic.name) + ".tif", sss::products::mosaicRaster(*raster, mosaic.description),
+                       error)) {
+        if (!raster) error += " " + dir + "/" + mosaic.name + ".png";
+        return false;
+      }
     }
   }
   return true;
@@ -1375,6 +1533,10 @@ OfflineResult runOffline(const OfflineRequest& request) {
   const bool from_log = !request.lcm_log_path.empty();
   if (from_log == !request.sonar_path.empty()) {
     result.error = "give either a sonar file (--sonar) or an LCM log (--lcm-log)";
+    return result;
+  }
+  if (from_log && !request.corrected_dir.empty()) {
+    result.error = "--write-corrected copies a sonar file: give --sonar, not --lcm-log";
     return result;
   }
   if (request.out_dir.empty()) {
@@ -1620,6 +1782,28 @@ OfflineResult runOffline(const OfflineRequest& request) {
   summary.peak_rss_mib = peakRssMib();
   summary.findings = explainRun(summary, options);
   for (const std::string& finding : explainFixes(summary.fixes, options)) summary.findings.push_back(finding);
+  if (!request.corrected_dir.empty() && summary.pings_with_pose > 0) {
+    if (summary.corrected_copy.empty()) {
+      summary.findings.push_back("no corrected copy of " + request.sonar_path +
+                                 ": the mission frame has no position on Earth; set mission.origin_latitude_deg and "
+                                 "origin_longitude_deg");
+    } else if (summary.corrected_records_without_pose > 0) {
+      summary.findings.push_back(std::to_string(summary.corrected_records_without_pose) + " sonar records of " +
+                                 summary.corrected_copy +
+                                 " keep their recorded navigation: no pose at their time (before the navigation "
+                                 "started, in a gap, or dropped by the chain)");
+    }
+  }
+  if (options.write_geotiff && summary.pings_with_pose > 0) {
+    if (summary.origin_source == "projected_first_fix" && options.projected_crs.empty()) {
+      summary.findings.push_back(
+          "GeoTIFFs without a CRS: the sonar file gives positions in projected metres (XTF NavUnits 0) and does not "
+          "name its grid; set products.projected_crs (e.g. EPSG:32633) so that GIS software places them");
+    } else if (summary.geotiffs.empty() && !summary.origin && summary.origin_source != "projected_first_fix") {
+      summary.findings.push_back("no GeoTIFF: the mission frame has no position on Earth; set mission.origin_latitude_deg "
+                                 "and origin_longitude_deg");
+    }
+  }
   result.summary = summary;
   if (!writeSummaryJson(request.out_dir + "/summary.json", request, summary, result.error)) return result;
   if (summary.pings_with_pose == 0 || summary.subframes == 0) {

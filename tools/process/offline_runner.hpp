@@ -35,6 +35,9 @@ struct OfflineRequest {
   // made from the sonar's embedded navigation are not in it (give --ins for a complete log).
   std::string record_lcm_log_path;
   bool write_mosaics = true;
+  // Non-empty (sonar file input): also write a copy of the sonar file into this folder with every
+  // ping's navigation fields replaced by the SLAM pose and every other byte unchanged.
+  std::string corrected_dir;
   // Also write out_dir/matches.csv: every dense match, subframe row and recall probe of every pair the
   // matcher tried (for sss-eval --matches; format in match_writer.hpp).
   bool write_matches = false;
@@ -95,6 +98,16 @@ struct OfflineSummary {
   double coverage_covered_m2 = 0.0;
   double coverage_seen_twice_m2 = 0.0;
   uint64_t seabed_points = 0;
+  // GeoTIFFs written (names in the output folder) and their CRS: the origin's UTM zone, the
+  // projected input's products.projected_crs, or "" (a projected grid with no CRS named).
+  std::vector<std::string> geotiffs;
+  std::string geotiff_crs;
+  int geotiff_epsg = 0;
+  // The corrected copy of the sonar file (--write-corrected): its path, pings rewritten and pings
+  // left with their recorded navigation (no pose at their time).
+  std::string corrected_copy;
+  uint64_t corrected_records = 0;
+  uint64_t corrected_records_without_pose = 0;
   uint64_t input_faults = 0;       // corrupt records, bad messages, dropped pings
   // Where the pings went: the fusion's drops by cause and altitude sources, the line builder's.
   sss::subframe::SubframeBufferCounters buffer;

@@ -15,7 +15,7 @@ namespace {
 void usage(std::FILE* out) {
   std::fprintf(out,
                "usage: sss-process --sonar FILE.jsf|FILE.xtf [--ins FILE.nmea] [--fixes FILE]... [--config FILE] --out DIR\n"
-               "                   [--quiet]\n"
+               "                   [--write-corrected DIR] [--quiet]\n"
                "                   [--write-matches] [--inject-false-closures FRACTION [--inject-seed N]]\n"
                "       sss-process --lcm-log FILE [--ping-channel C] [--nav-channel C] [--config FILE] --out DIR\n"
                "                   [--no-mosaics] [--quiet]\n"
@@ -23,6 +23,9 @@ void usage(std::FILE* out) {
                "                         GNSS counts only at the surface; the talker says GNSS (GP, GN, ...) or USBL\n"
                "                         (any other) unless the prefix does. Adds fixes.csv and dead_reckoning_fixed.tum\n"
                "                         (the same fixes without side-scan)\n"
+               "  --write-corrected DIR  also write DIR/<sonar file name>: a copy of the sonar file with every ping's\n"
+               "                         navigation (position, depth, heading, pitch, roll) replaced by the SLAM pose,\n"
+               "                         every other byte unchanged, for the mosaicking software already in use\n"
                "  --record-lcm-log FILE  also write the SSS_PING and SSS_NAV messages fed to the chain to an LCM log\n"
                "  --write-matches        also write matches.csv: every dense match, subframe row and recall probe of\n"
                "                         every pair the matcher tried (for sss-eval --matches FILE --mission DIR)\n"
@@ -33,7 +36,9 @@ void usage(std::FILE* out) {
                "navigation.csv and navigation.nmea (the corrected navigation per ping for other tools), track.geojson and\n"
                "subframes.geojson (tracks and subframe footprints for GIS),\n"
                "loop_closures.csv, bathymetry.ply (+ bathymetry_dr.ply), heightmap.yaml/.png (+ heightmap_dr),\n"
-               "mosaic_dr.png, mosaic_slam.png (+ .yaml geo-references) and summary.json (counts, where the pings\n"
+               "mosaic_dr.png, mosaic_slam.png (+ .yaml geo-references), GeoTIFFs of the mosaics, heightmaps and coverage\n"
+               "(mosaic_dr.tif, mosaic_slam.tif, heightmap.tif, heightmap_dr.tif, coverage.tif: UTM zone of the origin,\n"
+               "or the file's grid with products.projected_crs) and summary.json (counts, where the pings\n"
                "went, the mission origin and, when a stage yielded nothing, why).\n"
                "Exit: 0 ok, 1 an output could not be written, 2 bad arguments or input, 3 nothing could be\n"
                "processed (no ping got a pose, or no subframe).\n");
@@ -59,6 +64,7 @@ int main(int argc, char** argv) {
     else if (arg == "--ping-channel") ok = value(request.ping_channel);
     else if (arg == "--nav-channel") ok = value(request.nav_channel);
     else if (arg == "--record-lcm-log") ok = value(request.record_lcm_log_path);
+    else if (arg == "--write-corrected") ok = value(request.corrected_dir);
     else if (arg == "--fixes") {
       std::string spec;
       ok = value(spec);
@@ -102,6 +108,9 @@ int main(int argc, char** argv) {
   if (s.false_closures_injected > 0)
     std::printf("sss-process: %llu of the matcher's closures made false on purpose (--inject-false-closures)\n",
                 static_cast<unsigned long long>(s.false_closures_injected));
+  if (!s.corrected_copy.empty())
+    std::printf("sss-process: corrected copy %s (%llu sonar records with the SLAM navigation)\n", s.corrected_copy.c_str(),
+                static_cast<unsigned long long>(s.corrected_records));
   std::printf("sss-process: %llu pings, %llu subframes, %llu pairs, %llu closures (%llu accepted, %llu rejected), "
               "%llu seabed points; mission %.0f s in %.1f s (%.1fx real time), peak %.0f MiB -> %s\n",
               static_cast<unsigned long long>(s.pings), static_cast<unsigned long long>(s.subframes),

@@ -1,0 +1,153 @@
+// Corrected copies of JSF and XTF files, see corrected_copy.hpp. The file is copied whole, then
+// each ping's navigation fields are overwritten in place at the offsets the project's own reader
+// found: every byte the readers do not attribute to a ping's navigation stays as it was.
+#include "products/corrected_copy.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <vector>
+
+#include "drivers/edgetech/jsf_file_reader.hpp"
+#include "drivers/edgetech/jsf_format.hpp"
+#include "drivers/xtf/xtf_reader.hpp"
+#include "drivers/xtf/xtf_writer.hpp"
+
+namespace sss::products {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+struct FileCloser {
+  void operator()(std::FILE* f) const { std::fclose(f); }
+};
+using File = std::unique_ptr<std::FILE, FileCloser>;
+
+// The copy to patch: in_path copied to out_path and opened for update.
+File copyForUpdate(const std::string& in_path, const std::string& out_path, std::string& error) {
+  std::error_code ec;
+  if (std::filesystem::equivalent(in_path, out_path, ec)) {
+    error = "the corrected copy " + out_path + " would overwrite its input; write it to another folder";
+    return nullptr;
+  }
+  std::filesystem::copy_file(in_path, out_path, std::filesystem::copy_options::overwrite_existing, ec);
+  if (ec) {
+    error = "cannot copy " + in_path + " to " + out_path + ": " + ec.message();
+    return nullptr;
+  }
+  File file(std::fopen(out_path.c_str(), "r+b"));
+  if (!file) error = "cannot open " + out_path + " for update";
+  return file;
+}
+
+bool patch(std::FILE* file, uint64_t offset, const uint8_t* bytes, size_t size) {
+  return std::fseek(file, static_cast<long>(offset), SEEK_SET) == 0 && std::fwrite(bytes, 1, size, file) == size;
+}
+
+bool read(std::FILE* file, uint64_t offset, uint8_t* bytes, size_t size) {
+  return std::fseek(file, static_cast<long>(offset), SEEK_SET) == 0 && std::fread(bytes, 1, size, file) == size;
+}
+
+bool fail(File& file, const std::string& out_path, const std::string& message, std::string& error) {
+  file.reset();
+  std::error_code ec;
+  std::filesystem::remove(out_path, ec);
+  error = message;
+  return false;
+}
+
+double wrapDegrees(double degrees) {
+  double wrapped = std::fmod(degrees, 360.0);
+  return wrapped < 0.0 ? wrapped + 360.0 : wrapped;
+}
+
+}  // namespace
+
+bool writeCorrectedJsf(const std::string& in_path, const std::string& out_path, const NavigationAt& navigation,
+                       CorrectedCopyCounters& counters, std::string& error) {
+  sss::edgetech::JsfFileReader reader(in_path);
+  if (!reader.isOpen()) {
+    error = reader.error();
+    return false;
+  }
+  File out = copyForUpdate(in_path, out_path, error);
+  if (!out) return false;
+  sss::edgetech::JsfMessage message;
+  while (reader.next(message)) {
+    if (message.header.message_type != sss::edgetech::kJsfSonarData) continue;
+    const sss::edgetech::SonarDecodeResult decoded =
+        sss::edgetech::decodeSonarData(message.header, message.body.data(), message.body.size());
+    const std::optional<PingNavigation> nav =
+        decoded.record ? navigation(decoded.record->ping_time_us) : std::nullopt;
+    if (!nav) {
+      ++counters.records_without_pose;
+      continue;
+    }
+    sss::edgetech::SonarChannelRecord record = *decoded.record;
+    record.projected_position = nav->projected;
+    record.latitude_deg = nav->latitude_deg;
+    record.longitude_deg = nav->longitude_deg;
+    record.easting_m = nav->easting_m;
+    record.northing_m = nav->northing_m;
+    record.depth_m = nav->depth_m;
+    record.heading_rad = nav->heading_rad;
+    record.pitch_rad = nav->pitch_rad;
+    record.roll_rad = nav->roll_rad;
+    // The original validity bits (the decoder may have cleared some), with the fields now written.
+    uint16_t validity = static_cast<uint16_t>(message.body[30] | (message.body[31] << 8));
+    validity |= sss::edgetech::kValidHeading | sss::edgetech::kValidDepth | sss::edgetech::kValidPitchRoll;
+    if (!nav->projected) validity |= sss::edgetech::kValidLatLon;
+    record.validity = validity;
+    std::vector<uint8_t> header(message.body.begin(), message.body.begin() + sss::edgetech::kSonarDataHeaderSize);
+    sss::edgetech::encodeSonarNavigation(record, header.data());
+    if (!patch(out.get(), message.stream_offset + sss::edgetech::kJsfHeaderSize, header.data(), header.size())) {
+      return fail(out, out_path, "cannot write " + out_path, error);
+    }
+    ++counters.records_corrected;
+  }
+  if (std::fclose(out.release()) != 0) return fail(out, out_path, "cannot write " + out_path, error);
+  return true;
+}
+
+bool writeCorrectedXtf(const std::string& in_path, const std::string& out_path, const NavigationAt& navigation,
+                       CorrectedCopyCounters& counters, std::string& error, int xtf_pair_index) {
+  sss::xtf::XtfReaderOptions options;
+  options.pair_index = xtf_pair_index;
+  sss::xtf::XtfReader reader(in_path, options);
+  if (!reader.isOpen()) {
+    error = reader.error();
+    return false;
+  }
+  File out = copyForUpdate(in_path, out_path, error);
+  if (!out) return false;
+  sss::edgetech::DriverPing ping;
+  std::vector<uint8_t> header(sss::xtf::kPingHeaderBytes);
+  while (reader.next(ping)) {
+    const std::optional<PingNavigation> nav = navigation(ping.utime_us);
+    if (!nav) {
+      ++counters.records_without_pose;
+      continue;
+    }
+    const uint64_t offset = reader.lastPingOffset();
+    if (!read(out.get(), offset, header.data(), header.size())) {
+      return fail(out, out_path, "cannot read back " + out_path, error);
+    }
+    sss::xtf::XtfPingInput fields;
+    fields.sensor_y = nav->projected ? nav->northing_m : nav->latitude_deg;
+    fields.sensor_x = nav->projected ? nav->easting_m : nav->longitude_deg;
+    fields.depth_m = static_cast<float>(nav->depth_m);
+    fields.pitch_deg = static_cast<float>(nav->pitch_rad * kRadToDeg);
+    fields.roll_deg = static_cast<float>(nav->roll_rad * kRadToDeg);
+    fields.heading_deg = static_cast<float>(wrapDegrees(nav->heading_rad * kRadToDeg));
+    sss::xtf::encodePingNavigation(fields, header.data());
+    if (!patch(out.get(), offset, header.data(), header.size())) {
+      return fail(out, out_path, "cannot write " + out_path, error);
+    }
+    ++counters.records_corrected;
+  }
+  if (std::fclose(out.release()) != 0) return fail(out, out_path, "cannot write " + out_path, error);
+  return true;
+}
+
+}  // namespace sss::products
