@@ -4,7 +4,8 @@
 // process loop answers each nav sample from a snapshot of the newest solved graph, so a solve never
 // delays a pose. The engine (graph, ping poses, correspondences) is checkpointed after every update
 // into the state directory and restored at start. On SIGTERM (end of mission) or SIGUSR1 (on request) it runs full smoothing and
-// writes the products: optimised trajectory (TUM), bathymetry (PLY), heightmap (raster + PNG).
+// writes the products: optimised trajectory (TUM), corrected navigation (navigation.csv, .nmea), tie report
+// (loop_closures.csv), bathymetry (PLY), heightmap (raster + PNG, GeoTIFF in the origin's UTM zone).
 //   sss-optimiser [--config FILE [--check-config]] [--lcm-url URL]
 #include <sys/eventfd.h>
 #include <unistd.h>
@@ -33,6 +34,9 @@
 #include "pipeline/optimiser/optimiser_engine.hpp"
 #include "pipeline/optimiser/correction_slew.hpp"
 #include "pipeline/optimiser/fix_message.hpp"
+#include "products/geotiff.hpp"
+#include "products/navigation_products.hpp"
+#include "products/survey_rasters.hpp"
 #include "pipeline/optimiser/pose_message.hpp"
 #include "pipeline/subframe/subframe_message.hpp"
 #include "pipeline/transport/dds.hpp"
@@ -115,6 +119,20 @@ bool writeProducts(OptimiserEngine& engine, const std::string& directory,
                                              sss::optimiser::gridSeabedPoints(points, engine.options().bathymetry),
                                              "sss-optimiser: seabed re-triangulated with the optimised poses", error,
                                              origin);
+  }
+  // The survey products sss-process writes that need no sonar image: the corrected navigation,
+  // the tie report and the heightmap as GeoTIFF (mosaics need the images, which the vehicle keeps
+  // as raw JSF: sss-process --write-corrected on recovery).
+  if (ok) ok = sss::products::writeNavigationFiles(directory, trajectory, engine, origin, {}, error);
+  if (ok) ok = sss::products::writeTieReportCsv(directory + "/loop_closures.csv", engine, error);
+  if (ok && !points.empty() && origin) {
+    sss::products::RasterFrame frame;
+    frame.origin = origin;
+    ok = sss::products::writeGeoTiff(
+        directory + "/heightmap.tif",
+        sss::products::heightmapRaster(sss::optimiser::gridSeabedPoints(points, engine.options().bathymetry),
+                                       "sss-optimiser: seabed re-triangulated with the optimised poses (depth m, down)"),
+        frame, error);
   }
   messages.push_back(ok ? "products written to " + directory + ": " + std::to_string(trajectory.size()) +
                               " poses, " + std::to_string(points.size()) + " seabed points"

@@ -20,6 +20,7 @@
 #include <sstream>
 #include <string>
 
+#include "tests/support/geotiff_read.hpp"
 #include "tools/eval/trajectory_io.hpp"
 #include "tools/eval/trajectory_metrics.hpp"
 
@@ -284,6 +285,19 @@ TEST_F(LiveChainTest, KeepsUpAtTwentyTimesRealTimeBeatsDeadReckoningAndReplaysTo
   std::printf("nominal: horizontal ATE RMSE DR %.3f m, SLAM %.3f m (%zu poses)\n", a.dr_m, a.slam_m, a.poses);
   EXPECT_GT(a.dr_m, 0.3) << "the simulated DR must drift for this test to mean anything";
   EXPECT_LT(a.slam_m, 0.75 * a.dr_m);
+  // The end-of-mission products beside slam.tum: the corrected navigation (a row per pose), the
+  // tie report and the heightmap as a GeoTIFF in the origin's UTM zone (59.35 N 18.07 E: 34N).
+  const std::string products = run.dir + "/optimiser/products/";
+  std::ifstream navigation(products + "navigation.csv");
+  size_t navigation_rows = 0;
+  for (std::string line; std::getline(navigation, line);) navigation_rows += (!line.empty() && line[0] == '2') ? 1 : 0;
+  EXPECT_EQ(navigation_rows, a.poses) << "a navigation.csv row (UTC time first) per pose of slam.tum";
+  EXPECT_TRUE(fs::is_regular_file(products + "navigation.nmea"));
+  EXPECT_NE(readFile(products + "loop_closures.csv").find(",accepted,"), std::string::npos);
+  const auto heightmap = sss::test::readGeoTiff(products + "heightmap.tif");
+  ASSERT_TRUE(heightmap.ok) << heightmap.error;
+  EXPECT_EQ(heightmap.epsg, 32634);
+  EXPECT_EQ(heightmap.nodata, -9999.0);
 
   // What lcm-logger recorded: sss-process reads the log (and writes a pose for every ping in it).
   // LCM udpm is lossy: with the machine busy the logger has missed a few messages (once 6 of

@@ -242,6 +242,55 @@ TEST_F(RunReport, WritesEveryFigureAndMetricsMatchTheKnownErrors) {
   EXPECT_NE(html.find(verdict.substr(0, 40)), std::string::npos);
 }
 
+// The tie report and the survey products from sss-process's newer columns and summary blocks.
+TEST_F(RunReport, ShowsTheTieReportCoverageFixesAndCalibration) {
+  {
+    std::ofstream csv(run_dir() / "loop_closures.csv");
+    csv << "subframe_id_a,subframe_id_b,status,rejection,north_a_m,east_a_m,north_b_m,east_b_m,before_along_m,"
+           "before_across_m,before_depth_m,before_heading_rad,after_along_m,after_across_m,after_depth_m,"
+           "after_heading_rad\n"
+           "0,3,accepted,none,25,0,95,40,0.40,-0.85,0.02,0.0035,0.05,-0.10,0.01,0.0002\n"
+           "1,2,accepted,none,75,0,45,40,0.10,2.25,0.00,0.0010,0.30,1.40,0.00,0.0001\n"
+           "0,2,rejected,chi_square_gate,25,0,45,40,6.00,1.00,0.00,0.0500,5.50,1.20,0.00,0.0400\n";
+    std::ofstream summary(run_dir() / "summary.json");
+    summary << "{\"pings\": 100, \"subframes\": 4, \"pairs_attempted\": 6, \"closures_accepted\": 2,"
+               " \"closures_rejected\": 1, \"wall_s\": 1, \"mission_s\": 10, \"real_time_factor\": 10,"
+               " \"peak_rss_mib\": 100,\n"
+               " \"coverage\": {\"covered_m2\": 27125, \"seen_twice_m2\": 16150, \"fraction_seen_twice\": 0.5954},\n"
+               " \"fixes\": {\"fed\": 12, \"accepted\": 11, \"rejected_gate\": 1, \"rms_residual_m\": 0.84},\n"
+               " \"calibration\": {\"estimated\": true, \"dvl_scale\": 0.0021, \"dvl_scale_sigma\": 0.0004,"
+               " \"heading_bias_rad\": 0.0052, \"heading_bias_sigma_rad\": 0.0009},\n"
+               " \"geotiff\": {\"crs\": \"WGS 84 / UTM zone 34N\", \"epsg\": 32634,"
+               " \"files\": [\"mosaic_slam.tif\", \"heightmap.tif\"]}}\n";
+  }
+  fs::copy_file(mission_dir_ / "mosaic.png", run_dir() / "coverage.png", fs::copy_options::overwrite_existing);
+  const ProgramRun result = report();
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const std::string html = slurp(out_dir() / "index.html");
+  const std::string markdown = slurp(out_dir() / "report.md");
+  EXPECT_NE(html.find("Tie report"), std::string::npos);
+  // Largest offset before the solve first: 0-2 (6.08 m), then 1-2 (2.25 m), then 0-3.
+  const size_t first = html.find(">0-2<"), second = html.find(">1-2<"), third = html.find(">0-3<");
+  ASSERT_NE(first, std::string::npos) << html;
+  EXPECT_LT(first, second);
+  EXPECT_LT(second, third);
+  EXPECT_NE(html.find("rejected (chi_square_gate)"), std::string::npos);
+  EXPECT_NE(html.find("<td>-0.85</td>"), std::string::npos) << "before across of 0-3";
+  EXPECT_NE(html.find("<td>0.20</td>"), std::string::npos) << "before heading of 0-3 in degrees (0.0035 rad)";
+  EXPECT_NE(html.find("<td class=\"bad\">1.40</td>"), std::string::npos)
+      << "an accepted closure the solution leaves 1.4 m off stands out";
+  EXPECT_NE(markdown.find("Tie report"), std::string::npos);
+  // The products section: coverage, the GeoTIFFs' CRS, the fixes and the calibration with sigmas.
+  EXPECT_NE(html.find("59.5 % of it seen from two lines"), std::string::npos) << html;
+  EXPECT_NE(html.find("2.71 ha"), std::string::npos);
+  EXPECT_NE(html.find("WGS 84 / UTM zone 34N"), std::string::npos);
+  EXPECT_NE(html.find("<img src=\"coverage.png\""), std::string::npos);
+  EXPECT_TRUE(fs::exists(out_dir() / "coverage.png"));
+  EXPECT_NE(html.find("11 / 12"), std::string::npos);
+  EXPECT_NE(html.find("<td>0.210</td><td>0.040</td>"), std::string::npos) << "DVL scale error in % with its sigma";
+  EXPECT_NE(html.find("<td>0.298</td><td>0.052</td>"), std::string::npos) << "heading bias in deg with its sigma";
+}
+
 TEST_F(RunReport, MissingSlamTrajectoryExitsTwoNamingTheFile) {
   fs::remove(run_dir() / "slam.tum");
   ProgramRun result = report();

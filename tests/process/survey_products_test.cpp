@@ -154,6 +154,11 @@ TEST_F(SurveyProductsTest, HeightmapAndCoverageGeoTiffsHoldTheRunsValues) {
   }
   EXPECT_NEAR(static_cast<double>(valid), static_cast<double>(grid_depths.size()), 0.1 * grid_depths.size());
 
+  const auto depth_dr = sss::test::readGeoTiff(root_ + "/run/heightmap_dr.tif");
+  ASSERT_TRUE(depth_dr.ok) << depth_dr.error;
+  EXPECT_EQ(depth_dr.epsg, 32756);
+  EXPECT_EQ(depth_dr.nodata, -9999.0);
+
   const auto coverage = sss::test::readGeoTiff(root_ + "/run/coverage.tif");
   ASSERT_TRUE(coverage.ok) << coverage.error;
   EXPECT_EQ(coverage.epsg, 32756);

@@ -416,6 +416,44 @@ void trajectoryFigures(FigureContext& context, const Trajectory& truth, const Gr
   context.sections.push_back(errors);
 }
 
+// The tie report as mbnavadjust users read it: each closure's offset from DR's relative pose
+// (before the solve) and from the final estimate's (after), and the decision. The largest
+// offsets before the solve first; at most kMaxTieRows rows (loop_closures.csv has them all).
+constexpr size_t kMaxTieRows = 60;
+Table tieTable(const std::vector<LoopClosureRecord>& closures) {
+  Table table;
+  std::vector<const LoopClosureRecord*> ties;
+  for (const LoopClosureRecord& r : closures) {
+    if (r.before && r.after) ties.push_back(&r);
+  }
+  if (ties.empty()) return table;
+  std::stable_sort(ties.begin(), ties.end(), [](const LoopClosureRecord* a, const LoopClosureRecord* b) {
+    return a->before->head<2>().norm() > b->before->head<2>().norm();
+  });
+  table.caption = "Tie report: offset of each closure from DR (before) and from the solution (after), along / across "
+                  "/ depth in m and heading in deg, in A's body frame" +
+                  (ties.size() > kMaxTieRows ? " (the " + std::to_string(kMaxTieRows) + " largest of " +
+                                                   std::to_string(ties.size()) + "; all in loop_closures.csv)"
+                                             : std::string());
+  table.header = {"subframes", "decision", "before along", "across", "depth", "heading", "after along", "across",
+                  "depth", "heading"};
+  for (size_t i = 0; i < ties.size() && i < kMaxTieRows; ++i) {
+    const LoopClosureRecord& r = *ties[i];
+    std::vector<Cell> row = {{r.subframes.empty() ? "line " + std::to_string(r.line) : r.subframes},
+                             {r.status + (r.status == "rejected" && !r.rejection.empty() ? " (" + r.rejection + ")" : "")}};
+    for (const Eigen::Vector4d* offset : {&*r.before, &*r.after}) {
+      for (int k = 0; k < 3; ++k) row.push_back({fixed((*offset)(k), 2)});
+      row.push_back({fixed((*offset)(3) * 180.0 / M_PI, 2)});
+    }
+    // Accepted closures the solution does not explain within a metre stand out.
+    if (r.status == "accepted" && r.after->head<2>().norm() > 1.0) {
+      for (size_t c = 6; c < 8; ++c) row[c].tone = -1;
+    }
+    table.rows.push_back(std::move(row));
+  }
+  return table;
+}
+
 void closureFigure(FigureContext& context, const GreyMosaic* mosaic) {
   RunReport& report = context.report;
   Section section{"3. Loop closures", "", {}, {}};
@@ -457,6 +495,59 @@ void closureFigure(FigureContext& context, const GreyMosaic* mosaic) {
     caption += "; grey: superseded or still pending.";
     section.figures.push_back({"", "loop_closures.png", "loop-closure graph", caption});
   }
+  section.tables.push_back(tieTable(report.closures));
+  if (section.tables.back().rows.empty()) section.tables.pop_back();
+  context.sections.push_back(section);
+}
+
+// What the run leaves for the survey: coverage, the fixes and calibration, the GeoTIFFs.
+void productsSection(FigureContext& context) {
+  const RunReport& report = context.report;
+  if (!report.has_summary) return;
+  const RunSummary& s = report.summary;
+  Section section{"6. Survey products", "", {}, {}};
+  std::string text;
+  if (std::isfinite(s.covered_m2)) {
+    text += "Coverage under the SLAM poses: " + fixed(s.covered_m2 / 10000.0, 2) + " ha, " +
+            fixed(100.0 * s.fraction_seen_twice, 1) + " % of it seen from two lines or more (what side-scan " +
+            "SLAM can use). ";
+  }
+  if (!s.geotiffs.empty()) {
+    text += "GeoTIFFs (" + (s.geotiff_crs.empty() ? std::string("no CRS: set products.projected_crs") : s.geotiff_crs) +
+            "): ";
+    for (size_t i = 0; i < s.geotiffs.size(); ++i) text += (i ? ", " : "") + s.geotiffs[i];
+    text += ".";
+  }
+  section.text = text;
+  const std::string coverage_png = joinPath(context.request.run_dir, "coverage.png");
+  if (fileExists(coverage_png)) {
+    std::error_code ec;
+    fs::copy_file(coverage_png, joinPath(context.request.out_dir, "coverage.png"),
+                  fs::copy_options::overwrite_existing, ec);
+    if (!ec) {
+      section.figures.push_back({"", "coverage.png", "coverage",
+                                 "Survey lines that saw each 5 m cell: grey one, green two, blue three or more."});
+    }
+  }
+  Table fixes;
+  fixes.caption = "Absolute fixes and DR calibration (final smoothing)";
+  fixes.header = {"quantity", "value", "sigma"};
+  if (std::isfinite(s.fixes_fed) && s.fixes_fed > 0) {
+    fixes.rows.push_back({{"fixes accepted / given"},
+                          {fixed(s.fixes_accepted, 0) + " / " + fixed(s.fixes_fed, 0)},
+                          {""}});
+    fixes.rows.push_back({{"fix residual RMS (m)"}, {fixed(s.fixes_rms_residual_m, 2)}, {""}});
+  }
+  if (s.calibration_estimated) {
+    fixes.rows.push_back({{"DVL scale error (%)"},
+                          {fixed(100.0 * s.dvl_scale, 3)},
+                          {fixed(100.0 * s.dvl_scale_sigma, 3)}});
+    fixes.rows.push_back({{"heading bias (deg)"},
+                          {fixed(s.heading_bias_rad * 180.0 / M_PI, 3)},
+                          {fixed(s.heading_bias_sigma_rad * 180.0 / M_PI, 3)}});
+  }
+  if (!fixes.rows.empty()) section.tables.push_back(fixes);
+  if (section.text.empty() && section.figures.empty() && section.tables.empty()) return;
   context.sections.push_back(section);
 }
 
@@ -763,8 +854,9 @@ std::string renderHtml(const RunReport& report, const RunReportRequest& request,
           << htmlEscape(f.caption) << "</figcaption></figure>\n";
       if (ends) out << "</div>\n";
     }
+    for (const Table& table : section.tables) out << htmlTable(table);
   }
-  out << "<h2>6. Metrics</h2>\n";
+  out << "<h2>7. Metrics</h2>\n";
   out << "<p class=\"small\">improvement = (DR - SLAM) / DR; green: SLAM better, red: SLAM worse. ATE: absolute "
          "trajectory error against the truth at the same time stamps; SE(3)-aligned: after the best rigid alignment "
          "of the whole trajectory; gauge-free: after the best horizontal rotation and scale about the estimate's first "
@@ -798,8 +890,9 @@ std::string renderMarkdown(const RunReport& report, const RunReportRequest& requ
     for (const Figure& f : section.figures) {
       out << "![" << markdownEscape(f.alt) << "](" << f.file << ")\n\n" << "*" << markdownEscape(f.caption) << "*\n\n";
     }
+    for (const Table& table : section.tables) out << markdownTable(table);
   }
-  out << "## 6. Metrics\n\nimprovement = (DR - SLAM) / DR, positive: SLAM better.\n\n";
+  out << "## 7. Metrics\n\nimprovement = (DR - SLAM) / DR, positive: SLAM better.\n\n";
   for (const Table& table : tables) out << markdownTable(table);
   out << "## Inputs\n\n";
   for (const std::string& input : inputs) out << "- `" << input << "`\n";
@@ -844,6 +937,18 @@ bool readLoopClosures(const std::string& path, std::vector<LoopClosureRecord>& c
     if (!parseNumberColumns(table, row, kCentres, values, error)) return false;
     record.centre_a_north_east_m = Eigen::Vector2d(values[0], values[1]);
     record.centre_b_north_east_m = Eigen::Vector2d(values[2], values[3]);
+    if (table.has("subframe_id_a") && table.has("subframe_id_b")) {
+      record.subframes = table.field(row, "subframe_id_a") + "-" + table.field(row, "subframe_id_b");
+    }
+    for (auto [prefix, target] : {std::pair{"before_", &record.before}, std::pair{"after_", &record.after}}) {
+      const std::string p = prefix;
+      const std::vector<std::string> names = {p + "along_m", p + "across_m", p + "depth_m", p + "heading_rad"};
+      if (!table.has(names[0])) continue;
+      const std::vector<const char*> columns = {names[0].c_str(), names[1].c_str(), names[2].c_str(), names[3].c_str()};
+      double offset[4];
+      if (!parseNumberColumns(table, row, columns, offset, error)) return false;
+      *target = Eigen::Vector4d(offset[0], offset[1], offset[2], offset[3]);
+    }
     closures.push_back(std::move(record));
   }
   return true;
@@ -895,6 +1000,33 @@ bool readRunSummary(const std::string& path, RunSummary& summary, std::string& e
       *value = number;
     } else {
       result.missing_keys.push_back(key);
+    }
+  }
+  // Optional blocks (older runs lack them): read what is there, quietly.
+  const auto optional = [&](const char* block, const char* key, double& value) {
+    const YAML::Node node = root[block] ? root[block][key] : YAML::Node();
+    double number = kNaN;
+    if (node && node.IsScalar() && parseFiniteDouble(node.Scalar(), number)) value = number;
+  };
+  optional("coverage", "covered_m2", result.covered_m2);
+  optional("coverage", "fraction_seen_twice", result.fraction_seen_twice);
+  optional("fixes", "fed", result.fixes_fed);
+  optional("fixes", "accepted", result.fixes_accepted);
+  optional("fixes", "rejected_gate", result.fixes_rejected);
+  optional("fixes", "rms_residual_m", result.fixes_rms_residual_m);
+  optional("calibration", "dvl_scale", result.dvl_scale);
+  optional("calibration", "dvl_scale_sigma", result.dvl_scale_sigma);
+  optional("calibration", "heading_bias_rad", result.heading_bias_rad);
+  optional("calibration", "heading_bias_sigma_rad", result.heading_bias_sigma_rad);
+  if (root["calibration"] && root["calibration"]["estimated"] && root["calibration"]["estimated"].IsScalar()) {
+    result.calibration_estimated = root["calibration"]["estimated"].Scalar() == "true";
+  }
+  if (root["geotiff"] && root["geotiff"].IsMap()) {
+    if (root["geotiff"]["crs"] && root["geotiff"]["crs"].IsScalar()) result.geotiff_crs = root["geotiff"]["crs"].Scalar();
+    if (root["geotiff"]["files"] && root["geotiff"]["files"].IsSequence()) {
+      for (const auto& file : root["geotiff"]["files"]) {
+        if (file.IsScalar()) result.geotiffs.push_back(file.Scalar());
+      }
     }
   }
   summary = std::move(result);
@@ -1049,6 +1181,7 @@ RunReport writeRunReport(const RunReportRequest& request, const RunReportOptions
     closureFigure(context, background);
     mosaicFigure(context);
     heightmapFigures(context);
+    productsSection(context);
 
     const Table key = keyTable(report, options);
     const std::vector<Table> tables = metricTables(report, options);

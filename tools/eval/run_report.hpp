@@ -77,6 +77,10 @@ struct LoopClosureRecord {
   std::string rejection;         // none | chi_square_gate | inconsistent | no_support | "" (no column)
   Eigen::Vector2d centre_a_north_east_m = Eigen::Vector2d::Zero();  // under the final SLAM estimate
   Eigen::Vector2d centre_b_north_east_m = Eigen::Vector2d::Zero();
+  std::string subframes;  // "A-B" (subframe_id_a, subframe_id_b), "" without those columns
+  // The tie report (before_* / after_* columns): the closure's offset from DR's relative pose and
+  // from the final estimate's, along, across, depth (m) and heading (rad).
+  std::optional<Eigen::Vector4d> before, after;
 };
 
 struct LoopClosureCounts {
@@ -107,6 +111,14 @@ struct RunSummary {
   double mission_s = kMissing;
   double real_time_factor = kMissing;
   double peak_rss_mib = kMissing;
+  // Survey products (optional blocks of summary.json; NaN / empty when absent).
+  double covered_m2 = kMissing, fraction_seen_twice = kMissing;
+  double fixes_fed = kMissing, fixes_accepted = kMissing, fixes_rejected = kMissing, fixes_rms_residual_m = kMissing;
+  bool calibration_estimated = false;
+  double dvl_scale = kMissing, dvl_scale_sigma = kMissing, heading_bias_rad = kMissing,
+         heading_bias_sigma_rad = kMissing;
+  std::string geotiff_crs;
+  std::vector<std::string> geotiffs;
   std::vector<std::string> missing_keys;  // expected keys absent or not numbers
 };
 
