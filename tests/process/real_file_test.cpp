@@ -12,6 +12,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -19,6 +20,7 @@
 #include "drivers/xtf/xtf_reader.hpp"
 #include "pipeline/core/geodesy.hpp"
 #include "pipeline/subframe/bottom_tracker.hpp"
+#include "tests/support/geotiff_read.hpp"
 #include "tools/eval/trajectory_io.hpp"
 #include "tools/process/offline_runner.hpp"
 
@@ -167,6 +169,70 @@ TEST(RealFile, SssProcessWithoutConfigGivesATrajectoryInTheFilesBoxAndAMosaicOfT
               median, bright);
   EXPECT_GT(bright, 1.6 * median);
   EXPECT_LT(dark, 0.5 * median);
+  fs::remove_all(request.out_dir);
+}
+
+// The survey products of the real file: GeoTIFF mosaics in its UTM zone (the Scotsman lies at
+// 48.4 N 68.8 W: zone 19N) holding the PNG's pixels, and a corrected copy of the XTF that the reader
+// gives back as slam.tum, with every byte outside the pings' navigation fields as recorded.
+TEST(RealFile, GeoTiffsInItsUtmZoneAndACorrectedCopyThatReadsBackAsSlam) {
+  SKIP_WITHOUT_REAL_FILE();
+  sss::offline::OfflineRequest request;
+  request.sonar_path = kRealFile;
+  request.out_dir = (fs::temp_directory_path() / ("sss_real_products_test_" + std::to_string(getpid()))).string();
+  request.corrected_dir = request.out_dir + "/corrected";
+  const auto result = sss::offline::runOffline(request);
+  ASSERT_TRUE(result.ok) << result.error;
+  const auto& s = result.summary;
+  EXPECT_EQ(s.geotiff_epsg, 32619);
+  const auto tif = sss::test::readGeoTiff(request.out_dir + "/mosaic_dr.tif");
+  ASSERT_TRUE(tif.ok) << tif.error;
+  EXPECT_EQ(tif.epsg, 32619);
+  EXPECT_EQ(tif.nodata, 0.0);
+  const cv::Mat png = cv::imread(request.out_dir + "/mosaic_dr.png", cv::IMREAD_GRAYSCALE);
+  ASSERT_FALSE(png.empty());
+  const double png_pixels = cv::countNonZero(png);
+  const double tif_pixels = static_cast<double>(std::count_if(tif.values.begin(), tif.values.end(), [](double v) { return v != 0.0; }));
+  EXPECT_NEAR(tif_pixels, png_pixels, 0.05 * png_pixels) << "the same cells, warped by the 0.8 deg grid convergence";
+
+  // The corrected copy: every ping with a pose rewritten (the first ping precedes the first fix).
+  const std::string copy = request.corrected_dir + "/scotsman-iver2.xtf";
+  EXPECT_EQ(s.corrected_copy, copy);
+  EXPECT_EQ(s.corrected_records, s.pings_with_pose);
+  EXPECT_EQ(s.corrected_records + s.corrected_records_without_pose, 461u);
+  const auto slam = sss::eval::readTum(request.out_dir + "/slam.tum");
+  ASSERT_TRUE(slam.ok && slam.origin) << slam.error;
+  const sss::core::LocalTangentPlane plane(slam.origin->latitude_deg, slam.origin->longitude_deg);
+  std::map<int64_t, Eigen::Vector3d> slam_at;
+  for (const auto& pose : slam.poses) slam_at[pose.utime_us] = pose.T_world_body.translation;
+  sss::xtf::XtfReader reader(copy);
+  ASSERT_TRUE(reader.isOpen()) << reader.error();
+  sss::edgetech::DriverPing ping;
+  std::vector<uint64_t> offsets;
+  size_t compared = 0;
+  double worst_m = 0.0;
+  while (reader.next(ping)) {
+    offsets.push_back(reader.lastPingOffset());
+    const auto found = slam_at.find(ping.utime_us);
+    if (found == slam_at.end()) continue;
+    const auto& side = ping.ping.port ? *ping.ping.port : *ping.ping.starboard;
+    const Eigen::Vector3d read_back = plane.toNed({side.latitude_deg, side.longitude_deg, side.depth_m});
+    worst_m = std::max(worst_m, (read_back - found->second).head<2>().norm());
+    ++compared;
+  }
+  EXPECT_EQ(compared, s.pings_with_pose);
+  EXPECT_LT(worst_m, 1e-3) << "XTF stores doubles: slam.tum's 0.1 mm rounding";
+  const std::string before = readFile(kRealFile), after = readFile(copy);
+  ASSERT_EQ(before.size(), after.size());
+  size_t outside = 0;
+  for (size_t i = 0; i < before.size(); ++i) {
+    if (before[i] == after[i]) continue;
+    const auto packet = std::upper_bound(offsets.begin(), offsets.end(), static_cast<uint64_t>(i));
+    const uint64_t at = packet == offsets.begin() ? 0 : i - *(packet - 1);  // 0: the file header
+    const bool navigation = (at >= 160 && at < 176) || (at >= 192 && at < 196) || (at >= 204 && at < 216);
+    outside += navigation ? 0 : 1;
+  }
+  EXPECT_EQ(outside, 0u) << "bytes outside the pings' navigation fields changed";
   fs::remove_all(request.out_dir);
 }
 
