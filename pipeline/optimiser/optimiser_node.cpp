@@ -35,6 +35,7 @@
 #include "pipeline/optimiser/correction_slew.hpp"
 #include "pipeline/optimiser/fix_message.hpp"
 #include "products/geotiff.hpp"
+#include "products/mosaic_products.hpp"
 #include "products/navigation_products.hpp"
 #include "products/survey_rasters.hpp"
 #include "pipeline/optimiser/pose_message.hpp"
@@ -68,6 +69,9 @@ struct NodeOptions {
   // Checkpoint and products. Empty: $STATE_DIRECTORY (systemd StateDirectory=), else none.
   std::string state_directory;
   std::string products_directory;  // empty: <state_directory>/products
+  // The mosaics among the products keep every subframe at mosaic resolution (~0.6 MB per 100 m of
+  // line at 75 m range); beyond this bound the oldest go, and the mosaics show the newest part.
+  double products_mosaic_max_mib = 256.0;
   bool dds_enabled = true;
   int dds_domain_id = 0;
   std::string dds_topic = "sss_navigation_correction";
@@ -84,6 +88,7 @@ struct Shared {
   std::mutex mutex;
   std::condition_variable wake;
   std::deque<sss::subframe::Subframe> subframes;
+  std::deque<sss::subframe::Subframe> mosaic_subframes;  // the same at mosaic resolution, for the products
   std::deque<sss::matcher::LoopClosure> closures;
   std::deque<sss::optimiser::AbsoluteFix> fixes;  // SSS_FIX, in the navigation's frame
   bool products_requested = false;
@@ -101,7 +106,7 @@ struct Shared {
   std::vector<std::string> messages;  // log lines from the worker (logged by the loop)
 };
 
-bool writeProducts(OptimiserEngine& engine, const std::string& directory,
+bool writeProducts(OptimiserEngine& engine, const sss::products::MosaicStore& mosaics, const std::string& directory,
                    const std::optional<sss::core::MissionOrigin>& origin, std::vector<std::string>& messages) {
   std::error_code ec;
   fs::create_directories(directory, ec);
@@ -120,19 +125,29 @@ bool writeProducts(OptimiserEngine& engine, const std::string& directory,
                                              "sss-optimiser: seabed re-triangulated with the optimised poses", error,
                                              origin);
   }
-  // The survey products sss-process writes that need no sonar image: the corrected navigation,
-  // the tie report and the heightmap as GeoTIFF (mosaics need the images, which the vehicle keeps
-  // as raw JSF: sss-process --write-corrected on recovery).
+  // The survey products sss-process writes: the corrected navigation, the tie report, the mosaics
+  // (DR and SLAM) and the heightmap, with GeoTIFFs in the origin's UTM zone.
   if (ok) ok = sss::products::writeNavigationFiles(directory, trajectory, engine, origin, {}, error);
   if (ok) ok = sss::products::writeTieReportCsv(directory + "/loop_closures.csv", engine, error);
-  if (ok && !points.empty() && origin) {
-    sss::products::RasterFrame frame;
-    frame.origin = origin;
+  std::optional<sss::products::RasterFrame> frame;
+  if (origin) frame = sss::products::RasterFrame{origin, false, 0.0, 0.0, ""};
+  std::vector<std::string> geotiffs;
+  sss::products::GeoTiffInfo info;
+  if (ok) {
+    ok = sss::products::writeMosaicProducts(directory, mosaics.subframes(), engine, sss::subframe::PictureOptions{}, origin,
+                                            frame, "sss-optimiser", geotiffs, info, error);
+  }
+  if (ok && mosaics.dropped() > 0) {
+    messages.push_back("products: the mosaics show the newest " + std::to_string(mosaics.subframes().size()) +
+                       " subframes; " + std::to_string(mosaics.dropped()) +
+                       " older ones went to stay within products_mosaic_max_mib");
+  }
+  if (ok && !points.empty() && frame) {
     ok = sss::products::writeGeoTiff(
         directory + "/heightmap.tif",
         sss::products::heightmapRaster(sss::optimiser::gridSeabedPoints(points, engine.options().bathymetry),
                                        "sss-optimiser: seabed re-triangulated with the optimised poses (depth m, down)"),
-        frame, error);
+        *frame, error);
   }
   messages.push_back(ok ? "products written to " + directory + ": " + std::to_string(trajectory.size()) +
                               " poses, " + std::to_string(points.size()) + " seabed points"
@@ -167,6 +182,7 @@ int main(int argc, char** argv) {
     section.optional("update_period_s", options.update_period_s, {inRange(0.0, 3600.0)});
     section.optional("state_directory", options.state_directory);
     section.optional("products_directory", options.products_directory);
+    section.optional("products_mosaic_max_mib", options.products_mosaic_max_mib, {inRange(0.0, 65536.0)});
     ConfigSection dds = section.section("dds");
     dds.optional("enabled", options.dds_enabled);
     dds.optional("domain_id", options.dds_domain_id, {inRange(0, 232)});
@@ -200,6 +216,10 @@ int main(int argc, char** argv) {
   std::optional<sss::core::LocalTangentPlane> plane;
   // Determinism and bounded latency come from the iteration bound; the time limit is the config's.
   OptimiserEngine engine(options.engine);
+  // The subframes at mosaic resolution for the products' mosaics: only since this start (a restart
+  // restores the graph from its checkpoint, not the images).
+  sss::products::MosaicStore mosaics(sss::subframe::PictureOptions{},
+                                     static_cast<size_t>(options.products_mosaic_max_mib * 1024.0 * 1024.0));
   const std::string checkpoint_path =
       options.state_directory.empty() ? std::string() : options.state_directory + "/optimiser.checkpoint";
   if (!checkpoint_path.empty()) {
@@ -237,7 +257,7 @@ int main(int argc, char** argv) {
   std::thread worker([&] {
     double last_update_monotonic_s = -1e9;
     for (;;) {
-      std::deque<sss::subframe::Subframe> subframes;
+      std::deque<sss::subframe::Subframe> subframes, mosaic_subframes;
       std::deque<sss::matcher::LoopClosure> closures;
       std::deque<sss::optimiser::AbsoluteFix> fixes;
       bool products = false;
@@ -250,6 +270,7 @@ int main(int argc, char** argv) {
         });
         if (shared.stop) return;
         subframes.swap(shared.subframes);
+        mosaic_subframes.swap(shared.mosaic_subframes);
         closures.swap(shared.closures);
         fixes.swap(shared.fixes);
         products = shared.products_requested;
@@ -262,6 +283,7 @@ int main(int argc, char** argv) {
         if (!status.ok) messages.push_back("subframe " + std::to_string(subframe.id) + " refused: " + status.message);
         else if (!status.message.empty()) messages.push_back(status.message);  // an odometer reset
       }
+      for (const auto& subframe : mosaic_subframes) mosaics.add(subframe);
       for (const auto& closure : closures) {
         const auto status = engine.addLoopClosure(closure);
         if (!status.ok) {
@@ -277,7 +299,7 @@ int main(int argc, char** argv) {
       bool updated = false;
       if (products) {
         engine.finish();
-        if (!options.products_directory.empty()) writeProducts(engine, options.products_directory, origin, messages);
+        if (!options.products_directory.empty()) writeProducts(engine, mosaics, options.products_directory, origin, messages);
         updated = true;
       } else if (engine.hasNewInput() && now_s - last_update_monotonic_s >= options.update_period_s) {
         const auto report = engine.update();
@@ -430,12 +452,16 @@ int main(int argc, char** argv) {
         spdlog::warn("subframe {} rejected: {}; further ones are counted in SSS_STATUS", message.subframe_id, error);
       return;
     }
-    subframe.image.clear();  // the optimiser keeps poses only
+    // The graph keeps poses only; the products' mosaics a copy at mosaic resolution (~1/5 of it).
+    sss::subframe::Subframe for_mosaic = sss::subframe::decimateForMosaic(
+        subframe, sss::subframe::mosaicDecimationFactor(sss::subframe::PictureOptions{}, subframe.geometry.bin_size_m));
+    subframe.image.clear();
     subframe.image.shrink_to_fit();
     subframe.mask.clear();
     subframe.mask.shrink_to_fit();
     std::lock_guard<std::mutex> lock(shared.mutex);
     shared.subframes.push_back(std::move(subframe));
+    shared.mosaic_subframes.push_back(std::move(for_mosaic));
     shared.wake.notify_one();
   });
   loop.bus().subscribe<sss_msgs::loop_closure_t>(options.loop_channel, [&](const sss_msgs::loop_closure_t& message) {
@@ -557,12 +583,13 @@ int main(int argc, char** argv) {
     const auto status = engine.addSubframe(subframe);
     if (!status.message.empty()) spdlog::info("subframe {}: {}", subframe.id, status.message);
   }
+  for (const auto& subframe : shared.mosaic_subframes) mosaics.add(subframe);
   for (const auto& closure : shared.closures) engine.addLoopClosure(closure);
   for (const auto& fix : shared.fixes) engine.addFix(fix);
   if (engine.graph().numNodes() > 0) {
     engine.finish();
     std::vector<std::string> messages;
-    if (!options.products_directory.empty()) writeProducts(engine, options.products_directory, shared.origin, messages);
+    if (!options.products_directory.empty()) writeProducts(engine, mosaics, options.products_directory, shared.origin, messages);
     if (!checkpoint_path.empty()) {
       const auto saved = engine.saveCheckpoint(checkpoint_path);
       if (!saved.ok) messages.push_back("checkpoint: " + saved.message);

@@ -168,4 +168,45 @@ bool writeMosaic(const std::vector<Subframe>& subframes,
   return writeMosaic(*mosaic, path, error, origin);
 }
 
+Subframe decimateForMosaic(const Subframe& s, int factor) {
+  Subframe out;
+  out.id = s.id;
+  out.line_id = s.line_id;
+  out.centre_ping_index = s.centre_ping_index;
+  out.pings = s.pings;
+  out.geometry = s.geometry;
+  const size_t pixels = static_cast<size_t>(s.rows()) * static_cast<size_t>(std::max(s.cols(), 0));
+  if (factor < 1 || s.image.size() != pixels || s.mask.size() != pixels) {
+    out.geometry.bins_per_side = 0;  // no image (none sent, or an inconsistent one): nothing to draw
+    return out;
+  }
+  const int bins = s.geometry.bins_per_side / factor;
+  out.geometry.bins_per_side = bins;
+  out.geometry.bin_size_m = s.geometry.bin_size_m * factor;
+  out.geometry.first_bin_range_m = s.geometry.first_bin_range_m + 0.5 * (factor - 1) * s.geometry.bin_size_m;
+  const int cols = out.geometry.columns();
+  out.image.assign(static_cast<size_t>(s.rows()) * cols, 0.0f);
+  out.mask.assign(out.image.size(), kMaskValid);
+  const int source_bins = s.geometry.bins_per_side;
+  for (int row = 0; row < s.rows(); ++row) {
+    for (int bin = 0; bin < bins; ++bin) {
+      for (int side = 0; side < 2; ++side) {  // 0 port, 1 starboard
+        float sum = 0.0f;
+        uint8_t mask = kMaskValid;
+        for (int k = 0; k < factor; ++k) {
+          const int source_bin = bin * factor + k;
+          const int column = side == 0 ? source_bins - 1 - source_bin : source_bins + source_bin;
+          const size_t i = static_cast<size_t>(row) * s.cols() + column;
+          sum += s.image[i];
+          if (s.mask[i] != kMaskValid) mask = s.mask[i];
+        }
+        const int column = side == 0 ? bins - 1 - bin : bins + bin;
+        out.image[static_cast<size_t>(row) * cols + column] = sum / static_cast<float>(factor);
+        out.mask[static_cast<size_t>(row) * cols + column] = mask;
+      }
+    }
+  }
+  return out;
+}
+
 }  // namespace sss::subframe

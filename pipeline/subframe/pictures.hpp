@@ -2,6 +2,8 @@
 // PNG of a whole mission (OpenCV), for eyes and reports, not for the matcher.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <map>
 #include <optional>
@@ -58,5 +60,15 @@ bool writeMosaic(const std::vector<Subframe>& subframes,
                  const std::map<int64_t, std::vector<sss::core::Pose>>& poses_by_subframe, const std::string& path,
                  const PictureOptions& options, std::string& error,
                  const std::optional<sss::core::MissionOrigin>& origin = std::nullopt);
+
+// A copy of a subframe with `factor` bins averaged into one (masked if any is masked): mosaics
+// are drawn at ~0.5 m, so a long mission's mosaics need not keep full-resolution images. A subframe
+// without a consistent image gives one with no columns.
+Subframe decimateForMosaic(const Subframe& subframe, int factor);
+// The factor for a mosaic resolution: the renderer takes every other column, so factor x 2 bins
+// per cell at most.
+inline int mosaicDecimationFactor(const PictureOptions& options, double bin_size_m) {
+  return std::max(1, static_cast<int>(std::floor(options.mosaic_resolution_m / (2.0 * bin_size_m))));
+}
 
 }  // namespace sss::subframe

@@ -298,6 +298,17 @@ TEST_F(LiveChainTest, KeepsUpAtTwentyTimesRealTimeBeatsDeadReckoningAndReplaysTo
   ASSERT_TRUE(heightmap.ok) << heightmap.error;
   EXPECT_EQ(heightmap.epsg, 32634);
   EXPECT_EQ(heightmap.nodata, -9999.0);
+  // The mosaics, as sss-process draws them: 3 lines of 200 m, 50 m apart, 75 m range: ~250 x 200 m.
+  for (const char* name : {"mosaic_dr.tif", "mosaic_slam.tif"}) {
+    const auto mosaic = sss::test::readGeoTiff(products + name);
+    ASSERT_TRUE(mosaic.ok) << mosaic.error;
+    EXPECT_EQ(mosaic.epsg, 32634) << name;
+    EXPECT_EQ(mosaic.data_type, "Byte");
+    const double seen_m2 = 0.25 * static_cast<double>(std::count_if(mosaic.values.begin(), mosaic.values.end(),
+                                                                    [](double v) { return v != 0.0; }));
+    EXPECT_GT(seen_m2, 35000.0) << name;
+    EXPECT_LT(seen_m2, 80000.0) << name;
+  }
 
   // What lcm-logger recorded: sss-process reads the log (and writes a pose for every ping in it).
   // LCM udpm is lossy: with the machine busy the logger has missed a few messages (once 6 of

@@ -12,6 +12,7 @@
 
 #include "pipeline/core/geodesy.hpp"
 #include "products/geotiff.hpp"
+#include "products/mosaic_products.hpp"
 #include "products/survey_rasters.hpp"
 #include "tests/support/geotiff_read.hpp"
 
@@ -262,6 +263,43 @@ TEST(SurveyRasters, HeightmapCellCentresAndMosaicEdgesBecomeTheRightGeotransform
   EXPECT_DOUBLE_EQ(image.east_left_edge_m, -3.0);
   EXPECT_TRUE(std::isnan(image.values[0]));
   EXPECT_EQ(image.values[2], 255.0f);
+}
+
+// The store behind the mosaics keeps subframes at mosaic resolution and, past its bound, only the
+// newest (the vehicle's memory is bounded; the mosaics then show the newest part of the mission).
+TEST(MosaicStore, DecimatesToTheMosaicResolutionAndKeepsTheNewestWithinItsBound) {
+  sss::subframe::Subframe subframe;
+  subframe.geometry.bins_per_side = 1000;
+  subframe.geometry.bin_size_m = 0.05;  // 50 m per side
+  subframe.pings.resize(200);
+  subframe.image.assign(static_cast<size_t>(200) * 2000, 1.0f);
+  subframe.mask.assign(subframe.image.size(), sss::subframe::kMaskValid);
+  sss::subframe::PictureOptions pictures;  // 0.5 m: every other column of 0.25 m bins, 5 bins each
+  MosaicStore unbounded(pictures, std::numeric_limits<size_t>::max());
+  unbounded.add(subframe);
+  ASSERT_EQ(unbounded.subframes().size(), 1u);
+  EXPECT_EQ(unbounded.subframes().front().geometry.bins_per_side, 200);
+  EXPECT_DOUBLE_EQ(unbounded.subframes().front().geometry.bin_size_m, 0.25);
+  const size_t one = unbounded.bytes();
+  EXPECT_EQ(one, 200u * 400u * 5u + 200u * sizeof(sss::subframe::SubframePing)) << "float + mask: a fifth of the 1.6 MB image";
+
+  MosaicStore bounded(pictures, 3 * one + one / 2);
+  for (int64_t id = 0; id < 10; ++id) {
+    subframe.id = id;
+    bounded.add(subframe);
+  }
+  ASSERT_EQ(bounded.subframes().size(), 3u);
+  EXPECT_EQ(bounded.dropped(), 7u);
+  EXPECT_EQ(bounded.subframes().front().id, 7) << "the newest are kept";
+  EXPECT_LE(bounded.bytes(), 3 * one + one / 2);
+
+  // A subframe without its image (or with a wrong-sized one) has nothing to draw and is not kept.
+  sss::subframe::Subframe no_image = subframe;
+  no_image.image.clear();
+  unbounded.add(no_image);
+  no_image.image.assign(100, 1.0f);
+  unbounded.add(no_image);
+  EXPECT_EQ(unbounded.subframes().size(), 1u);
 }
 
 }  // namespace

@@ -40,6 +40,7 @@
 #include "pipeline/subframe/pictures.hpp"
 #include "products/corrected_copy.hpp"
 #include "products/geotiff.hpp"
+#include "products/mosaic_products.hpp"
 #include "products/navigation_products.hpp"
 #include "products/survey_rasters.hpp"
 #include "pipeline/subframe/subframe_buffer.hpp"
@@ -764,43 +765,6 @@ bool writeSummaryJson(const std::string& path, const OfflineRequest& request, co
   return true;
 }
 
-// A copy of a subframe with `factor` bins averaged into one (masked if any is masked): mosaics
-// are drawn at ~0.5 m, so a long mission's mosaics need not keep full-resolution images.
-sss::subframe::Subframe decimateForMosaic(const sss::subframe::Subframe& s, int factor) {
-  sss::subframe::Subframe out;
-  out.id = s.id;
-  out.line_id = s.line_id;
-  out.centre_ping_index = s.centre_ping_index;
-  out.pings = s.pings;
-  out.geometry = s.geometry;
-  const int bins = s.geometry.bins_per_side / factor;
-  out.geometry.bins_per_side = bins;
-  out.geometry.bin_size_m = s.geometry.bin_size_m * factor;
-  out.geometry.first_bin_range_m = s.geometry.first_bin_range_m + 0.5 * (factor - 1) * s.geometry.bin_size_m;
-  const int cols = out.geometry.columns();
-  out.image.assign(static_cast<size_t>(s.rows()) * cols, 0.0f);
-  out.mask.assign(out.image.size(), sss::subframe::kMaskValid);
-  const int source_bins = s.geometry.bins_per_side;
-  for (int row = 0; row < s.rows(); ++row) {
-    for (int bin = 0; bin < bins; ++bin) {
-      for (int side = 0; side < 2; ++side) {  // 0 port, 1 starboard
-        float sum = 0.0f;
-        uint8_t mask = sss::subframe::kMaskValid;
-        for (int k = 0; k < factor; ++k) {
-          const int source_bin = bin * factor + k;
-          const int column = side == 0 ? source_bins - 1 - source_bin : source_bins + source_bin;
-          const size_t i = static_cast<size_t>(row) * s.cols() + column;
-          sum += s.image[i];
-          if (s.mask[i] != sss::subframe::kMaskValid) mask = s.mask[i];
-        }
-        const int column = side == 0 ? bins - 1 - bin : bins + bin;
-        out.image[static_cast<size_t>(row) * cols + column] = sum / static_cast<float>(factor);
-        out.mask[static_cast<size_t>(row) * cols + column] = mask;
-      }
-    }
-  }
-  return out;
-}
 
 // ---- the run -----------------------------------------------------------------------------------
 
@@ -812,13 +776,12 @@ class Runner {
         buffer_(options.buffer),
         matcher_(options.matcher),
         optimiser_(options.optimiser),
+        mosaic_store_(options.pictures, std::numeric_limits<size_t>::max()),
         fix_aligner_(options.fix_aligner) {
     buffer_.setFusedPingObserver([this](const sss::subframe::FusedPing& fused) {
       dr_per_ping_.push_back({fused.ping.utime_us, fused.T_world_body});
       altitude_per_ping_.push_back({fused.ping.utime_us, fused.altitude_m, fused.altitude_source, fused.bottom_track_quality});
     });
-    mosaic_factor_ = std::max(1, static_cast<int>(std::floor(options.pictures.mosaic_resolution_m /
-                                                              (2.0 * options.buffer.canonical.bin_size_m))));
   }
 
   void addNav(const NavInput& nav) {
@@ -1036,7 +999,7 @@ class Runner {
       centres_.push_back({subframe.line_id, subframe.centre().T_world_body});
       footprints_.push_back(footprintOf(subframe));
       optimiser_.addSubframe(subframe);
-      if (request_.write_mosaics) mosaic_subframes_.push_back(decimateForMosaic(subframe, mosaic_factor_));
+      if (request_.write_mosaics) mosaic_store_.add(subframe);
       addOutcomes(timedMatch([&] { return matcher_.addSubframe(std::move(subframe)); }));
       update();
       if (addOutcomes(timedMatch([&] { return matcher_.updateTrajectory(optimiser_.trajectory()); }))) update();
@@ -1050,7 +1013,7 @@ class Runner {
   sss::matcher::MatcherEngine matcher_;
   sss::optimiser::OptimiserEngine optimiser_;
   std::vector<sss::subframe::Subframe> subframes_;  // reused
-  std::vector<sss::subframe::Subframe> mosaic_subframes_;
+  sss::products::MosaicStore mosaic_store_;  // every subframe at mosaic resolution (no bound offline)
   std::vector<std::pair<int, sss::core::Pose>> centres_;  // line id and DR centre pose of every subframe
   // Of every subframe: its id, line and a few pings along it (DR), for subframes.geojson.
   struct Footprint {
@@ -1075,7 +1038,6 @@ class Runner {
     double quality;
   };
   std::vector<PingAltitude> altitude_per_ping_;
-  int mosaic_factor_ = 1;
   OfflineSummary summary_;
   MatchCsvWriter match_writer_;  // open only with request_.write_matches
   int64_t first_ping_us_ = -1;
@@ -1375,29 +1337,18 @@ bool Runner::writeOutputs(std::string& error) {
     }
   }
 
-  if (request_.write_mosaics && !mosaic_subframes_.empty()) {
-    std::map<int64_t, std::vector<Pose>> slam_poses;
-    for (const auto& s : mosaic_subframes_) {
-      std::vector<Pose>& poses = slam_poses[s.id];
-      for (const auto& ping : s.pings) {
-        poses.push_back(optimiser_.correctionAt(ping.utime_us).T_corrected_dr * ping.T_world_body);
-      }
+  if (request_.write_mosaics) {
+    const std::optional<sss::products::RasterFrame> frame =
+        options_.write_geotiff ? rasterFrame() : std::optional<sss::products::RasterFrame>();
+    sss::products::GeoTiffInfo info;
+    const size_t before = summary_.geotiffs.size();
+    if (!sss::products::writeMosaicProducts(dir, mosaic_store_.subframes(), optimiser_, options_.pictures, origin_, frame,
+                                            "sss-process", summary_.geotiffs, info, error)) {
+      return false;
     }
-    const std::map<int64_t, std::vector<Pose>> dr_poses;  // none: each subframe's own DR poses
-    const struct {
-      const std::map<int64_t, std::vector<Pose>>& poses;
-      const char* name;
-      const char* description;
-    } mosaics[] = {{dr_poses, "mosaic_dr", "sss-process: side-scan mosaic geo-referenced with dead reckoning"},
-                   {slam_poses, "mosaic_slam", "sss-process: side-scan mosaic geo-referenced with the SLAM poses"}};
-    for (const auto& mosaic : mosaics) {
-      const auto raster = sss::subframe::renderMosaic(mosaic_subframes_, mosaic.poses, options_.pictures, error);
-      if (!raster || !sss::subframe::writeMosaic(*raster, dir + "/" + mosaic.name + ".png", error, origin_) ||
-          !writeRaster(dir, std::string(mosaic.name) + ".tif", sss::products::mosaicRaster(*raster, mosaic.description),
-                       error)) {
-        if (!raster) error += " " + dir + "/" + mosaic.name + ".png";
-        return false;
-      }
+    if (summary_.geotiffs.size() > before) {
+      summary_.geotiff_crs = info.crs_name;
+      summary_.geotiff_epsg = info.epsg;
     }
   }
   return true;
