@@ -5,7 +5,8 @@
 // delays a pose. The engine (graph, ping poses, correspondences) is checkpointed after every update
 // into the state directory and restored at start. On SIGTERM (end of mission) or SIGUSR1 (on request) it runs full smoothing and
 // writes the products: optimised trajectory (TUM), corrected navigation (navigation.csv, .nmea), tie report
-// (loop_closures.csv), bathymetry (PLY), heightmap (raster + PNG, GeoTIFF in the origin's UTM zone).
+// (loop_closures.csv), tracks and footprints (GeoJSON), coverage, mosaics, bathymetry (PLY) and heightmap,
+// the rasters also as GeoTIFF in the origin's UTM zone.
 //   sss-optimiser [--config FILE [--check-config]] [--lcm-url URL]
 #include <sys/eventfd.h>
 #include <unistd.h>
@@ -34,6 +35,8 @@
 #include "pipeline/optimiser/optimiser_engine.hpp"
 #include "pipeline/optimiser/correction_slew.hpp"
 #include "pipeline/optimiser/fix_message.hpp"
+#include "products/coverage.hpp"
+#include "products/footprints.hpp"
 #include "products/geotiff.hpp"
 #include "products/mosaic_products.hpp"
 #include "products/navigation_products.hpp"
@@ -89,6 +92,7 @@ struct Shared {
   std::condition_variable wake;
   std::deque<sss::subframe::Subframe> subframes;
   std::deque<sss::subframe::Subframe> mosaic_subframes;  // the same at mosaic resolution, for the products
+  std::vector<sss::products::SubframeFootprint> footprints;  // and their footprints (coverage, GeoJSON)
   std::deque<sss::matcher::LoopClosure> closures;
   std::deque<sss::optimiser::AbsoluteFix> fixes;  // SSS_FIX, in the navigation's frame
   bool products_requested = false;
@@ -106,7 +110,8 @@ struct Shared {
   std::vector<std::string> messages;  // log lines from the worker (logged by the loop)
 };
 
-bool writeProducts(OptimiserEngine& engine, const sss::products::MosaicStore& mosaics, const std::string& directory,
+bool writeProducts(OptimiserEngine& engine, const sss::products::MosaicStore& mosaics,
+                   const std::vector<sss::products::SubframeFootprint>& footprints, const std::string& directory,
                    const std::optional<sss::core::MissionOrigin>& origin, std::vector<std::string>& messages) {
   std::error_code ec;
   fs::create_directories(directory, ec);
@@ -141,6 +146,17 @@ bool writeProducts(OptimiserEngine& engine, const sss::products::MosaicStore& mo
     messages.push_back("products: the mosaics show the newest " + std::to_string(mosaics.subframes().size()) +
                        " subframes; " + std::to_string(mosaics.dropped()) +
                        " older ones went to stay within products_mosaic_max_mib");
+  }
+  // Tracks and subframe footprints for GIS, and how many lines saw each 5 m cell.
+  if (ok) ok = sss::products::writeGeoJsonFiles(directory, trajectory, engine.pingTrajectory(false), footprints, engine,
+                                                origin, error);
+  if (ok && !footprints.empty()) {
+    const sss::products::CoverageGrid coverage =
+        sss::products::computeCoverage(sss::products::slamStrips(footprints, engine), 5.0);
+    ok = sss::products::writeCoverageFiles(directory + "/coverage.yaml", coverage, error, origin);
+    if (ok && frame) {
+      ok = sss::products::writeGeoTiff(directory + "/coverage.tif", sss::products::coverageRaster(coverage), *frame, error);
+    }
   }
   if (ok && !points.empty() && frame) {
     ok = sss::products::writeGeoTiff(
@@ -220,6 +236,7 @@ int main(int argc, char** argv) {
   // restores the graph from its checkpoint, not the images).
   sss::products::MosaicStore mosaics(sss::subframe::PictureOptions{},
                                      static_cast<size_t>(options.products_mosaic_max_mib * 1024.0 * 1024.0));
+  std::vector<sss::products::SubframeFootprint> footprints;  // ~1 kB per subframe, kept all mission
   const std::string checkpoint_path =
       options.state_directory.empty() ? std::string() : options.state_directory + "/optimiser.checkpoint";
   if (!checkpoint_path.empty()) {
@@ -271,6 +288,8 @@ int main(int argc, char** argv) {
         if (shared.stop) return;
         subframes.swap(shared.subframes);
         mosaic_subframes.swap(shared.mosaic_subframes);
+        footprints.insert(footprints.end(), shared.footprints.begin(), shared.footprints.end());
+        shared.footprints.clear();
         closures.swap(shared.closures);
         fixes.swap(shared.fixes);
         products = shared.products_requested;
@@ -299,7 +318,7 @@ int main(int argc, char** argv) {
       bool updated = false;
       if (products) {
         engine.finish();
-        if (!options.products_directory.empty()) writeProducts(engine, mosaics, options.products_directory, origin, messages);
+        if (!options.products_directory.empty()) writeProducts(engine, mosaics, footprints, options.products_directory, origin, messages);
         updated = true;
       } else if (engine.hasNewInput() && now_s - last_update_monotonic_s >= options.update_period_s) {
         const auto report = engine.update();
@@ -459,9 +478,11 @@ int main(int argc, char** argv) {
     subframe.image.shrink_to_fit();
     subframe.mask.clear();
     subframe.mask.shrink_to_fit();
+    sss::products::SubframeFootprint footprint = sss::products::footprintOf(subframe);
     std::lock_guard<std::mutex> lock(shared.mutex);
     shared.subframes.push_back(std::move(subframe));
     shared.mosaic_subframes.push_back(std::move(for_mosaic));
+    shared.footprints.push_back(std::move(footprint));
     shared.wake.notify_one();
   });
   loop.bus().subscribe<sss_msgs::loop_closure_t>(options.loop_channel, [&](const sss_msgs::loop_closure_t& message) {
@@ -584,12 +605,13 @@ int main(int argc, char** argv) {
     if (!status.message.empty()) spdlog::info("subframe {}: {}", subframe.id, status.message);
   }
   for (const auto& subframe : shared.mosaic_subframes) mosaics.add(subframe);
+  footprints.insert(footprints.end(), shared.footprints.begin(), shared.footprints.end());
   for (const auto& closure : shared.closures) engine.addLoopClosure(closure);
   for (const auto& fix : shared.fixes) engine.addFix(fix);
   if (engine.graph().numNodes() > 0) {
     engine.finish();
     std::vector<std::string> messages;
-    if (!options.products_directory.empty()) writeProducts(engine, mosaics, options.products_directory, shared.origin, messages);
+    if (!options.products_directory.empty()) writeProducts(engine, mosaics, footprints, options.products_directory, shared.origin, messages);
     if (!checkpoint_path.empty()) {
       const auto saved = engine.saveCheckpoint(checkpoint_path);
       if (!saved.ok) messages.push_back("checkpoint: " + saved.message);

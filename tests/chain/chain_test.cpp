@@ -298,6 +298,13 @@ TEST_F(LiveChainTest, KeepsUpAtTwentyTimesRealTimeBeatsDeadReckoningAndReplaysTo
   ASSERT_TRUE(heightmap.ok) << heightmap.error;
   EXPECT_EQ(heightmap.epsg, 32634);
   EXPECT_EQ(heightmap.nodata, -9999.0);
+  // Coverage (3 lines: up to 3 per cell) and the GIS layers, as sss-process writes them.
+  const auto coverage = sss::test::readGeoTiff(products + "coverage.tif");
+  ASSERT_TRUE(coverage.ok) << coverage.error;
+  EXPECT_EQ(*std::max_element(coverage.values.begin(), coverage.values.end()), 3.0);
+  EXPECT_NE(readFile(products + "track.geojson").find("\"LineString\""), std::string::npos);
+  EXPECT_NE(readFile(products + "subframes.geojson").find("\"subframe_id\":5"), std::string::npos)
+      << "the 6 subframes' footprints";
   // The mosaics, as sss-process draws them: 3 lines of 200 m, 50 m apart, 75 m range: ~250 x 200 m.
   for (const char* name : {"mosaic_dr.tif", "mosaic_slam.tif"}) {
     const auto mosaic = sss::test::readGeoTiff(products + name);

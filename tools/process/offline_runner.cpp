@@ -46,7 +46,8 @@
 #include "pipeline/subframe/subframe_buffer.hpp"
 #include "pipeline/subframe/subframe_message.hpp"
 #include "tools/eval/json_writer.hpp"
-#include "tools/process/coverage.hpp"
+#include "products/coverage.hpp"
+#include "products/footprints.hpp"
 #include "tools/process/match_writer.hpp"
 
 namespace sss::offline {
@@ -71,28 +72,6 @@ double peakRssMib() {
 bool hasExtension(const std::string& path, const char* extension) {
   const size_t n = std::strlen(extension);
   return path.size() > n && strcasecmp(path.c_str() + path.size() - n, extension) == 0;
-}
-
-// The coverage grid (distinct lines per cell, centres at north_min_m + row * resolution_m) as an
-// 8-bit GeoTIFF raster, north up; cells no line saw are no data.
-sss::products::FrameRaster coverageRaster(const CoverageGrid& grid) {
-  sss::products::FrameRaster raster;
-  raster.rows = grid.rows;
-  raster.cols = grid.cols;
-  raster.resolution_m = grid.resolution_m;
-  raster.north_top_edge_m = grid.north_min_m + (grid.rows - 0.5) * grid.resolution_m;
-  raster.east_left_edge_m = grid.east_min_m - 0.5 * grid.resolution_m;
-  raster.type = sss::products::RasterType::kByte;
-  raster.categorical = true;
-  raster.description = "sss-process: survey lines that saw each cell (SLAM poses)";
-  raster.values.assign(grid.lines.size(), std::numeric_limits<float>::quiet_NaN());
-  for (int row = 0; row < grid.rows; ++row) {
-    for (int col = 0; col < grid.cols; ++col) {
-      const uint8_t lines = grid.lines[static_cast<size_t>(row) * grid.cols + col];
-      if (lines > 0) raster.values[static_cast<size_t>(grid.rows - 1 - row) * grid.cols + col] = lines;
-    }
-  }
-  return raster;
 }
 
 struct Options {
@@ -850,24 +829,6 @@ class Runner {
   // Writes dir/name as a GeoTIFF when the run has a frame on Earth and GeoTIFFs are on.
   bool writeRaster(const std::string& dir, const std::string& name, const sss::products::FrameRaster& raster,
                    std::string& error);
-  // Every subframe's swath edges under the SLAM poses (footprints_ order).
-  std::vector<FootprintStrip> slamStrips() const {
-    std::vector<FootprintStrip> strips;
-    for (const Footprint& f : footprints_) {
-      FootprintStrip strip;
-      strip.line_id = f.line_id;
-      for (const auto& ping : f.pings) {
-        const sss::core::Pose pose = optimiser_.correctionAt(ping.utime_us).T_corrected_dr * ping.T_world_body;
-        // The swath edges on the level seabed plane through the vehicle, across its heading.
-        const double heading = sss::core::eulerFromQuaternion(pose.rotation).heading_rad;
-        const Eigen::Vector2d across(-std::sin(heading), std::cos(heading));  // starboard, north/east
-        strip.port_ne_m.push_back(pose.translation.head<2>() - f.half_width_m * across);
-        strip.starboard_ne_m.push_back(pose.translation.head<2>() + f.half_width_m * across);
-      }
-      strips.push_back(std::move(strip));
-    }
-    return strips;
-  }
   bool writeAltitudeCsv(const std::string& path, std::string& error) const;
   OfflineSummary& summary() { return summary_; }
   const std::optional<sss::core::MissionOrigin>& origin() const { return origin_; }
@@ -997,7 +958,7 @@ class Runner {
     for (sss::subframe::Subframe& subframe : subframes_) {
       ++summary_.subframes;
       centres_.push_back({subframe.line_id, subframe.centre().T_world_body});
-      footprints_.push_back(footprintOf(subframe));
+      footprints_.push_back(sss::products::footprintOf(subframe));
       optimiser_.addSubframe(subframe);
       if (request_.write_mosaics) mosaic_store_.add(subframe);
       addOutcomes(timedMatch([&] { return matcher_.addSubframe(std::move(subframe)); }));
@@ -1015,20 +976,7 @@ class Runner {
   std::vector<sss::subframe::Subframe> subframes_;  // reused
   sss::products::MosaicStore mosaic_store_;  // every subframe at mosaic resolution (no bound offline)
   std::vector<std::pair<int, sss::core::Pose>> centres_;  // line id and DR centre pose of every subframe
-  // Of every subframe: its id, line and a few pings along it (DR), for subframes.geojson.
-  struct Footprint {
-    int64_t id = 0;
-    int line_id = 0;
-    double half_width_m = 0.0;  // the canonical swath per side
-    std::vector<sss::optimiser::StampedPose> pings;  // first, every 25th, last
-  };
-  static Footprint footprintOf(const sss::subframe::Subframe& s) {
-    Footprint f{s.id, s.line_id, s.geometry.bins_per_side * s.geometry.bin_size_m + s.geometry.first_bin_range_m, {}};
-    for (size_t i = 0; i < s.pings.size(); ++i)
-      if (i % 25 == 0 || i + 1 == s.pings.size()) f.pings.push_back({s.pings[i].utime_us, s.pings[i].T_world_body});
-    return f;
-  }
-  std::vector<Footprint> footprints_;
+  std::vector<sss::products::SubframeFootprint> footprints_;  // of every subframe, for GeoJSON and coverage
   std::vector<sss::optimiser::StampedPose> dr_per_ping_;
   sss::ins::FixAligner fix_aligner_;  // the request's fixes, tied to the navigation as it comes
   struct PingAltitude {
@@ -1203,53 +1151,7 @@ bool Runner::writeRaster(const std::string& dir, const std::string& name, const 
 
 bool Runner::writeGeoJson(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& slam,
                           std::string& error) const {
-  if (!origin_) return true;
-  const sss::core::LocalTangentPlane plane(origin_->latitude_deg, origin_->longitude_deg);
-  auto lonLat = [&](const Eigen::Vector3d& ned) {
-    const sss::core::GeodeticPosition g = plane.toGeodetic(ned);
-    // 1e-8 deg (~1 mm) is all a GIS needs and keeps the files small.
-    return nlohmann::json::array({std::round(g.longitude_deg * 1e8) / 1e8, std::round(g.latitude_deg * 1e8) / 1e8});
-  };
-  auto write = [&](const std::string& path, const nlohmann::json& json) {
-    std::ofstream out(path);
-    out << json.dump() << "\n";
-    if (!out) error = "cannot write " + path;
-    return static_cast<bool>(out);
-  };
-  nlohmann::json tracks = {{"type", "FeatureCollection"}, {"features", nlohmann::json::array()}};
-  for (const auto& [name, poses] : {std::pair<const char*, const std::vector<sss::optimiser::StampedPose>*>{"SLAM", &slam},
-                                    {"DR", &dr_per_ping_}}) {
-    nlohmann::json line = nlohmann::json::array();
-    for (size_t i = 0; i < poses->size(); ++i)
-      if (i % 4 == 0 || i + 1 == poses->size()) line.push_back(lonLat((*poses)[i].T_world_body.translation));
-    if (line.size() < 2) continue;
-    tracks["features"].push_back({{"type", "Feature"},
-                                  {"properties", {{"name", name},
-                                                  {"start_utc", sss::core::formatUtimeIso8601(poses->front().utime_us)},
-                                                  {"end_utc", sss::core::formatUtimeIso8601(poses->back().utime_us)}}},
-                                  {"geometry", {{"type", "LineString"}, {"coordinates", line}}}});
-  }
-  if (!write(dir + "/track.geojson", tracks)) return false;
-
-  nlohmann::json footprints = {{"type", "FeatureCollection"}, {"features", nlohmann::json::array()}};
-  const std::vector<FootprintStrip> strips = slamStrips();
-  for (size_t k = 0; k < footprints_.size(); ++k) {
-    const Footprint& f = footprints_[k];
-    const FootprintStrip& strip = strips[k];
-    if (strip.port_ne_m.size() < 2) continue;
-    nlohmann::json ring = nlohmann::json::array();
-    for (const auto& p : strip.port_ne_m) ring.push_back(lonLat(Eigen::Vector3d(p.x(), p.y(), 0.0)));
-    for (auto it = strip.starboard_ne_m.rbegin(); it != strip.starboard_ne_m.rend(); ++it)
-      ring.push_back(lonLat(Eigen::Vector3d(it->x(), it->y(), 0.0)));
-    ring.push_back(ring.front());  // closed
-    footprints["features"].push_back(
-        {{"type", "Feature"},
-         {"properties", {{"subframe_id", f.id}, {"line_id", f.line_id}, {"swath_m", f.half_width_m},
-                         {"start_utc", sss::core::formatUtimeIso8601(f.pings.front().utime_us)},
-                         {"end_utc", sss::core::formatUtimeIso8601(f.pings.back().utime_us)}}},
-         {"geometry", {{"type", "Polygon"}, {"coordinates", nlohmann::json::array({ring})}}}});
-  }
-  return write(dir + "/subframes.geojson", footprints);
+  return sss::products::writeGeoJsonFiles(dir, slam, dr_per_ping_, footprints_, optimiser_, origin_, error);
 }
 
 // altitude.csv: the altitude every ping was processed with and where it came from.
@@ -1293,11 +1195,12 @@ bool Runner::writeOutputs(std::string& error) {
   if (!writeGeoJson(dir, slam, error)) return false;
   if (!request_.corrected_dir.empty() && !writeCorrectedCopy(slam, error)) return false;
   if (!footprints_.empty()) {
-    const CoverageGrid coverage = computeCoverage(slamStrips(), 5.0);
+    const sss::products::CoverageGrid coverage =
+        sss::products::computeCoverage(sss::products::slamStrips(footprints_, optimiser_), 5.0);
     summary_.coverage_covered_m2 = coverage.covered_m2;
     summary_.coverage_seen_twice_m2 = coverage.seen_twice_m2;
-    if (!writeCoverageFiles(dir + "/coverage.yaml", coverage, error, origin_)) return false;
-    if (!writeRaster(dir, "coverage.tif", coverageRaster(coverage), error)) return false;
+    if (!sss::products::writeCoverageFiles(dir + "/coverage.yaml", coverage, error, origin_)) return false;
+    if (!writeRaster(dir, "coverage.tif", sss::products::coverageRaster(coverage), error)) return false;
   }
   if (!sss::products::writeTieReportCsv(dir + "/loop_closures.csv", optimiser_, error)) return false;
   if (!writeAltitudeCsv(dir + "/altitude.csv", error)) return false;

@@ -1,5 +1,5 @@
 // Coverage raster, see coverage.hpp.
-#include "tools/process/coverage.hpp"
+#include "products/coverage.hpp"
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -8,9 +8,10 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
-namespace sss::offline {
+namespace sss::products {
 
 namespace {
 
@@ -134,4 +135,24 @@ bool writeCoverageFiles(const std::string& yaml_path, const CoverageGrid& grid, 
   return true;
 }
 
-}  // namespace sss::offline
+FrameRaster coverageRaster(const CoverageGrid& grid) {
+  FrameRaster raster;
+  raster.rows = grid.rows;
+  raster.cols = grid.cols;
+  raster.resolution_m = grid.resolution_m;
+  raster.north_top_edge_m = grid.north_min_m + (grid.rows - 0.5) * grid.resolution_m;
+  raster.east_left_edge_m = grid.east_min_m - 0.5 * grid.resolution_m;
+  raster.type = RasterType::kByte;
+  raster.categorical = true;
+  raster.description = "sss-process: survey lines that saw each cell (SLAM poses)";
+  raster.values.assign(grid.lines.size(), std::numeric_limits<float>::quiet_NaN());
+  for (int row = 0; row < grid.rows; ++row) {
+    for (int col = 0; col < grid.cols; ++col) {
+      const uint8_t lines = grid.lines[static_cast<size_t>(row) * grid.cols + col];
+      if (lines > 0) raster.values[static_cast<size_t>(grid.rows - 1 - row) * grid.cols + col] = lines;
+    }
+  }
+  return raster;
+}
+
+}  // namespace sss::products

@@ -11,8 +11,9 @@
 #include <vector>
 
 #include "pipeline/core/mission_origin.hpp"
+#include "products/geotiff.hpp"
 
-namespace sss::offline {
+namespace sss::products {
 
 // One subframe's footprint: the swath edges at a few pings along it (same count on both sides).
 struct FootprintStrip {
@@ -38,4 +39,7 @@ CoverageGrid computeCoverage(const std::vector<FootprintStrip>& strips, double r
 bool writeCoverageFiles(const std::string& yaml_path, const CoverageGrid& grid, std::string& error,
                         const std::optional<sss::core::MissionOrigin>& origin);
 
-}  // namespace sss::offline
+// The grid as an 8-bit GeoTIFF raster, north up; cells no line saw are no data.
+FrameRaster coverageRaster(const CoverageGrid& grid);
+
+}  // namespace sss::products

@@ -3,9 +3,9 @@
 
 #include <filesystem>
 
-#include "tools/process/coverage.hpp"
+#include "products/coverage.hpp"
 
-namespace sss::offline {
+namespace sss::products {
 namespace {
 
 // A strip running north from 0 to length_m, between east_min_m and east_max_m.
@@ -61,4 +61,4 @@ TEST(Coverage, FilesAreWrittenAndNothingIsAnError) {
 }
 
 }  // namespace
-}  // namespace sss::offline
+}  // namespace sss::products
