@@ -166,6 +166,15 @@ bool addOverviews(GDALDatasetH dataset, const FrameRaster& raster, int& count, s
 
 }  // namespace
 
+bool isKnownCrs(const std::string& crs, std::string& error) {
+  registerGdalOnce();
+  QuietGdalErrors quiet;
+  Srs srs(OSRNewSpatialReference(nullptr));
+  if (OSRSetFromUserInput(static_cast<OGRSpatialReferenceH>(srs.get()), crs.c_str()) == OGRERR_NONE) return true;
+  error = "'" + crs + "' is not a CRS GDAL knows (" + QuietGdalErrors::last() + "); use e.g. EPSG:32633";
+  return false;
+}
+
 int utmEpsgCode(double latitude_deg, double longitude_deg) {
   const int zone = GeographicLib::UTMUPS::StandardZone(latitude_deg, longitude_deg);
   const bool north = latitude_deg >= 0.0;

@@ -56,6 +56,10 @@ struct GeoTiffInfo {
 // (Norway's and Svalbard's zone exceptions included).
 int utmEpsgCode(double latitude_deg, double longitude_deg);
 
+// True when GDAL knows the CRS text (what products.projected_crs takes: "EPSG:32633", a WKT, a PROJ
+// string); false with the reason otherwise, so that a configuration is refused before a run.
+bool isKnownCrs(const std::string& crs, std::string& error);
+
 // Rasters larger than this in either dimension get internal overviews (2x, 4x, ... down to ~256 px).
 constexpr int kOverviewMinSizePx = 1024;
 

@@ -1,5 +1,5 @@
 // SE(3) poses on Eigen: composition, inverse, interpolation, Euler angles and tangent-space maps.
-// Conventions (DESIGN.md): world = local NED, body = FRD; T_a_b maps b-frame coordinates into a.
+// Conventions (README: Architecture): world = local NED, body = FRD; T_a_b maps b-frame coordinates into a.
 #pragma once
 
 #include <Eigen/Core>

@@ -1,5 +1,5 @@
 // sss-bench-dense-matcher: dense matching speed and accuracy on simulated lawnmower subframe pairs
-// (issue 6 size: 200 pings x 2x1300 bins), parallel and anti-parallel; last line is one JSON object.
+// (the matcher's acceptance size: 200 pings x 2x1300 bins), parallel and anti-parallel; last line is one JSON object.
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>

@@ -460,7 +460,7 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
   // Comparing patches on A's grid puts both in a common orientation whatever the relative
   // heading: an anti-parallel line (rows reversed, port and starboard swapped) or a crossing
   // line is resampled so that its patches look like A's, which the reference implementation did
-  // not do (issue 6: 6% of its anti-parallel matches were within 2 px). The grid is padded by the
+  // not do (measured: 6 % of its anti-parallel matches were within 2 px). The grid is padded by the
   // search window so pixels at A's border can reach B content beyond A's footprint.
   stage = Clock::now();
   const cv::Vec2d spacing_m = pixelSpacing(a.position_ne_m);

@@ -1,4 +1,4 @@
-// The optimiser stage without middleware (DESIGN.md stage 5): subframes become pose-graph nodes
+// The optimiser stage without middleware (stage 5 of the chain, README: Architecture): subframes become pose-graph nodes
 // (centre DR pose, distance travelled), matcher loop closures become graph edges, each update
 // yields the optimised centre poses (SSS_TRAJECTORY for the matcher) and the correction of any DR
 // pose (SSS_POSE, DDS); at the end, full smoothing, the per-ping trajectory and the bathymetry.

@@ -1,4 +1,4 @@
-// Sliding-window pose graph over subframe-centre poses (DESIGN.md stage 5, paper Sec. "Pose Graph
+// Sliding-window pose graph over subframe-centre poses (stage 5 of the chain, README: Architecture; paper Sec. "Pose Graph
 // Optimization", eq. (6)): DR odometry chain plus loop closures with robust rejection (Cauchy loss,
 // chi-square gate, pairwise consistency), Schur-complement marginalisation, full smoothing,
 // corrections for any time and checkpoints. Pure C++ over Ceres: no LCM, DDS or systemd.

@@ -32,7 +32,7 @@ struct CanonicalTransformOptions {
   // every subframe of a mission has the same ground-range axis (the matcher needs that).
   // Off by default for now: on 3 randomised missions whose lines the 75 m swath cannot pair it
   // gave one +63 % and one -91 % (far-range closures over rock relief, up to 4 m off and accepted:
-  // the closures' covariance does not yet say how weak the far range is; issue 22).
+  // the closures' covariance does not yet say how weak the far range is).
   bool swath_from_range = false;
   int max_bins_per_side = 16384;
   // Lambertian correction: divide by cos^2 of the flat-seabed incidence angle, floored here so the

@@ -12,7 +12,7 @@
 namespace sss::subframe {
 
 // The seabed point of a ground-range pixel of one ping. The point lies in the sonar's fan plane
-// (perpendicular to the sonar x axis, DESIGN.md), on the horizontal seabed at depth = sonar depth
+// (perpendicular to the sonar x axis, the paper's Sec. on the canonical transform), on the horizontal seabed at depth = sonar depth
 // + altitude_m, at the pixel's canonical ground range g = sqrt(r^2 - h^2) from the sonar. With
 // pitch the fan plane meets that seabed off the nadir point; the along-track offset t of that
 // line is part of g (g^2 = t^2 + s^2, s the across-track distance). nullopt when the column lies

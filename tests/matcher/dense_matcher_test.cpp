@@ -65,7 +65,7 @@ TEST(DenseMatcher, ParallelAndAntiParallelMatchWithinTwoPixelsUnderDrErrorUpTo5m
       std::printf("%-13s DR error %.0f m: %ld matches, within 2 px %.3f, recall %.3f, %.3f s\n", name, dr_error_m,
                   e.matches, e.withinFraction(), e.recall(), timings.total_s);
       SCOPED_TRACE(std::string(name) + " at " + std::to_string(dr_error_m) + " m");
-      EXPECT_GE(e.withinFraction(), 0.8);  // issue 6 acceptance
+      EXPECT_GE(e.withinFraction(), 0.8);  // the matcher's acceptance
       // Patches straddling nadir, B's border or too little texture are rightly rejected; most of
       // the overlap must still be matched correctly.
       EXPECT_GE(e.recall(), 0.5);

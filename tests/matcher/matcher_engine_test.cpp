@@ -19,7 +19,7 @@ namespace {
 
 struct Check {
   int accepted = 0;
-  // Largest along- or across-track error (issue 6: "within 0.3 m in both directions") over
+  // Largest along- or across-track error (the matcher's acceptance: "within 0.3 m in both directions") over
   // closures between two full (200-ping) subframes.
   double max_horizontal_error_m = 0.0;
   double max_nees = 0.0;
@@ -81,7 +81,7 @@ TEST(MatcherEngine, SurveyClosuresAgreeWithTheTruthAndReassociationRunsOnOptimis
   const Check dr = checkAgainstTruth(outcomes, survey);
   // Lines 0-1, 1-2 (anti-parallel) and 0-2 (parallel) each overlap in their full subframes.
   EXPECT_GE(dr.accepted, 3);
-  // Issue 6: within 0.3 m for full subframe pairs. A line's 50-99 ping tail constrains heading,
+  // The matcher's acceptance: within 0.3 m for full subframe pairs. A line's 50-99 ping tail constrains heading,
   // and through it the along-track lever, less: up to ~1 m, which its covariance says (every
   // closure within the chi-square 2-dof 99.9 % bound, 13.8).
   EXPECT_LT(dr.max_horizontal_error_m, 0.3);

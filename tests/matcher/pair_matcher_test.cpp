@@ -48,7 +48,7 @@ void expectPairRecoversDrError(const PairCase& pair_case) {
               std::sqrt(match.pose.covariance(1, 1)), match.pose.num_inliers,
               match.accepted ? "accepted" : match.reason.c_str(), match.seconds, match.georeference_s,
               match.dense_timings.total_s, match.pose.seconds);
-  // Issue 6 acceptance: >= 80 % of the returned matches within 2 px of the true match.
+  // The matcher's acceptance: >= 80 % of the returned matches within 2 px of the true match.
   // The pairs overlap by 50 m along track; at stride 2 on 0.5 m pixels a few hundred matches is
   // what a textured stretch gives: 474 anti-parallel, 1576 parallel (recall 0.16-0.31) before the
   // aperture check (min_structure_ratio 0.2), which drops patches of one straight feature on
@@ -58,7 +58,7 @@ void expectPairRecoversDrError(const PairCase& pair_case) {
   EXPECT_GT(e.evaluated, 200);
   EXPECT_GE(e.withinFraction(), 0.8);
   EXPECT_GT(e.recall(), 0.08);
-  // Issue 6 acceptance: relative translation within 0.3 m of the truth along and across track.
+  // The matcher's acceptance: relative translation within 0.3 m of the truth along and across track.
   ASSERT_TRUE(match.accepted) << match.reason;
   // The error to remove is really there.
   EXPECT_GT(dr_error.head<2>().norm(), 0.9 * std::hypot(pair_case.dr_along_m, pair_case.dr_lateral_m));
@@ -85,7 +85,7 @@ TEST(PairMatcher, ParallelSimulatedPairRecovers3mAlongAnd2mLateralDrError) {
   expectPairRecoversDrError({"parallel (lines 0-2, 80 m)", 0, 2});
 }
 
-// Issue 6: the correspondence precision holds with DR error up to 5 m between the lines.
+// The correspondence precision holds with DR error up to 5 m between the lines.
 TEST(PairMatcher, ParallelSimulatedPairRecovers5mOfDrError) {
   expectPairRecoversDrError({"parallel (lines 0-2, 80 m), 5 m DR error", 0, 2, 4.0, 3.0});
 }

@@ -337,7 +337,7 @@ TEST_F(OfflineRunnerTest, WrittenMatchesAreEvaluatedAgainstTheTruth) {
 }
 
 TEST_F(OfflineRunnerTest, InjectedFalseClosuresAreAllRejectedAndSlamStillBeatsDr) {
-  // Issue 7: a share of the matched pairs get a relative pose 3-10 m and 2-10 deg wrong, with the
+  // The optimiser's defences: a share of the matched pairs get a relative pose 3-10 m and 2-10 deg wrong, with the
   // matcher's covariance left as it was; the optimiser's defences must keep every one of them out.
   auto r = request("false_closures");
   r.write_mosaics = false;
@@ -613,6 +613,17 @@ TEST_F(OfflineRunnerTest, XtfInProjectedMetresWithoutAltitudeIsProcessedInItsGri
   // With the grid's CRS named: GeoTIFFs in the file's grid, and a corrected copy of the XTF whose
   // pings hold slam.tum plus the grid offsets (f64 in XTF: the TUM file's 0.1 mm rounding).
   {
+    // A CRS GDAL does not know is refused before any processing, with the key named (exit 2).
+    const std::string bad_config = root_ + "/projected_bad_crs.yaml";
+    std::ofstream(bad_config) << "products:\n  projected_crs: EPSG:99999999\n";
+    sss::offline::OfflineRequest bad;
+    bad.sonar_path = path;
+    bad.out_dir = root_ + "/run_projected_bad_crs";
+    bad.config_path = bad_config;
+    const auto refused = sss::offline::runOffline(bad);
+    EXPECT_EQ(refused.exit_code, 2);
+    EXPECT_NE(refused.error.find("products.projected_crs"), std::string::npos) << refused.error;
+
     const std::string config_path = root_ + "/projected_products.yaml";
     std::ofstream(config_path) << "products:\n  projected_crs: EPSG:32633\n";
     sss::offline::OfflineRequest products;

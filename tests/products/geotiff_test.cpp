@@ -218,6 +218,11 @@ TEST_F(GeoTiffTest, ProblemsAreNamedNotCrashes) {
   EXPECT_FALSE(writeGeoTiff(dir_ + "/a.tif", raster, nowhere, error));
   EXPECT_NE(error.find("no origin on Earth"), std::string::npos) << error;
 
+  EXPECT_TRUE(isKnownCrs("EPSG:32633", error));
+  EXPECT_TRUE(isKnownCrs("+proj=utm +zone=33 +datum=WGS84", error));
+  EXPECT_FALSE(isKnownCrs("EPSG:not-a-code", error));
+  EXPECT_NE(error.find("use e.g. EPSG:32633"), std::string::npos) << error;
+
   RasterFrame bad_crs;
   bad_crs.projected = true;
   bad_crs.projected_crs = "EPSG:not-a-code";

@@ -1,6 +1,6 @@
 // Correspondence accuracy against the simulator's ray-cast truth: end-point error of every match
 // in pixels of the matching image and in metres, the fraction within 2 px, recall at 2 px, by pair
-// type (issue 9: matching). In process (sss-bench-matcher) or from sss-process's matches.csv (sss-eval).
+// type. In process (sss-bench-matcher) or from sss-process's matches.csv (sss-eval).
 #pragma once
 
 #include <cstdint>

@@ -131,6 +131,10 @@ bool readOptions(const std::string& path, Options& options, std::string& error) 
       products.optional("projected_crs", options.projected_crs);
       products.optional("geotiff", options.write_geotiff);
       products.rejectUnknownKeys();
+      std::string crs_problem;
+      if (!options.projected_crs.empty() && !sss::products::isKnownCrs(options.projected_crs, crs_problem)) {
+        products.addProblem("projected_crs", options.projected_crs, crs_problem);
+      }
     }
     if (!config.ok()) {
       error = "invalid configuration " + path + ": " + config.problemReport();

@@ -41,7 +41,7 @@ struct OfflineRequest {
   // Also write out_dir/matches.csv: every dense match, subframe row and recall probe of every pair the
   // matcher tried (for sss-eval --matches; format in match_writer.hpp).
   bool write_matches = false;
-  // Evaluation of the optimiser's defences (issue 7): this fraction of the matched pairs, drawn
+  // Evaluation of the optimiser's defences: this fraction of the matched pairs, drawn
   // with false_closure_seed, get a wrong relative pose (3-10 m and 2-10 deg off, the same for
   // every association round of the pair) with the matcher's covariance and costs left as they
   // were, as a matcher fooled by repetitive seabed would send. 0: the closures as matched.
