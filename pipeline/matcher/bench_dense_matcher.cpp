@@ -1,5 +1,9 @@
 // sss-bench-dense-matcher: dense matching speed and accuracy on simulated lawnmower subframe pairs
 // (the matcher's acceptance size: 200 pings x 2x1300 bins), parallel and anti-parallel; last line is one JSON object.
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -88,11 +92,20 @@ int main(int argc, char** argv) {
     }
   }
   const double n = pairs > 0 ? pairs : 1;
-  std::printf("{\"seconds_per_pair\": %.4f, \"within_2px\": %.4f, \"recall\": %.4f, \"pairs\": %d, "
-              "\"kd_tree_s\": %.4f, \"initialisation_s\": %.4f, \"patch_match_s\": %.4f, \"consistency_s\": %.4f, "
-              "\"matches_per_pair\": %.0f, \"dr_error_m\": %.2f, \"threads\": %d, \"stride\": %d}\n",
-              seconds / n, matches ? double(within) / matches : 0.0, matchable ? double(within) / matchable : 0.0,
-              pairs, kd_tree / n, initialisation / n, patch_match / n, consistency / n, matches / n, dr_error_m,
-              options.threads, options.stride);
+  // The machine-readable last line (nlohmann: a figure that is not finite is null, never an invalid nan).
+  nlohmann::ordered_json figures;
+  figures["seconds_per_pair"] = seconds / n;
+  figures["within_2px"] = matches ? double(within) / matches : 0.0;
+  figures["recall"] = matchable ? double(within) / matchable : 0.0;
+  figures["pairs"] = pairs;
+  figures["kd_tree_s"] = kd_tree / n;
+  figures["initialisation_s"] = initialisation / n;
+  figures["patch_match_s"] = patch_match / n;
+  figures["consistency_s"] = consistency / n;
+  figures["matches_per_pair"] = std::round(matches / n);
+  figures["dr_error_m"] = dr_error_m;
+  figures["threads"] = options.threads;
+  figures["stride"] = options.stride;
+  std::printf("%s\n", figures.dump().c_str());
   return 0;
 }

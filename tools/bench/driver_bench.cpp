@@ -2,6 +2,8 @@
 // at EdgeTech 2205 rates and prints (1) the latency from a ping's last byte leaving the emulator's
 // socket to its SSS_PING arriving on LCM (p50/p99/max) and (2) the CPU use of each process.
 //   sss-bench-drivers [--seconds 30] [--ping-rate-hz 10] [--samples 20000] [--ins-rate-hz 20]
+#include <nlohmann/json.hpp>
+
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -176,9 +178,16 @@ int main(int argc, char** argv) {
               received_us.size(), pings, navs, epochs);
   std::printf("latency last byte -> SSS_PING: p50 %.2f ms, p99 %.2f ms, max %.2f ms\n", p50, p99, max);
   std::printf("CPU: sss-sonar-driver %.1f %%, sss-ins-bridge %.1f %% of one core\n", 100 * driver_cpu, 100 * bridge_cpu);
-  std::printf("{\"pings\": %d, \"pings_received\": %zu, \"latency_p50_ms\": %.3f, \"latency_p99_ms\": %.3f, "
-              "\"latency_max_ms\": %.3f, \"driver_cpu_percent\": %.2f, \"ins_bridge_cpu_percent\": %.2f, "
-              "\"navs_received\": %d}\n",
-              pings, received_us.size(), p50, p99, max, 100 * driver_cpu, 100 * bridge_cpu, navs);
+  // The machine-readable last line (nlohmann: a figure that is not finite is null, never an invalid nan).
+  nlohmann::ordered_json figures;
+  figures["pings"] = pings;
+  figures["pings_received"] = received_us.size();
+  figures["latency_p50_ms"] = p50;
+  figures["latency_p99_ms"] = p99;
+  figures["latency_max_ms"] = max;
+  figures["driver_cpu_percent"] = 100 * driver_cpu;
+  figures["ins_bridge_cpu_percent"] = 100 * bridge_cpu;
+  figures["navs_received"] = navs;
+  std::printf("%s\n", figures.dump().c_str());
   return 0;
 }

@@ -11,6 +11,8 @@
 // as the INS bridge and a navigation computer would run them; the subframe/closure feeder, which
 // stands for the matcher, stays ordinary. Needs CAP_SYS_NICE.
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"  // lcm-gen decode() false positive at -O3
+#include <nlohmann/json.hpp>
+
 #include <pthread.h>
 #include <sched.h>
 #include <signal.h>
@@ -592,27 +594,33 @@ int main(int argc, char** argv) {
   if (!clean) std::fprintf(stderr, "sss-bench-latency: sss-optimiser did not exit cleanly on SIGTERM\n");
   cleanup(0);
 
-  auto num = [](double v) {
-    char text[32];
-    if (!std::isfinite(v)) return std::string("null");
-    std::snprintf(text, sizeof text, "%.3f", v);
-    return std::string(text);
-  };
-  std::printf("{\"lcm_p50_ms\":%s,\"lcm_p95_ms\":%s,\"lcm_p99_ms\":%s,\"lcm_max_ms\":%s,"
-              "\"dds_p50_ms\":%s,\"dds_p95_ms\":%s,\"dds_p99_ms\":%s,\"dds_max_ms\":%s,"
-              "\"dds_write_to_read_p50_ms\":%s,\"dds_write_to_read_p99_ms\":%s,"
-              "\"loaded_lcm_p50_ms\":%s,\"loaded_lcm_p99_ms\":%s,\"loaded_lcm_max_ms\":%s,"
-              "\"loaded_dds_p50_ms\":%s,\"loaded_dds_p99_ms\":%s,\"loaded_dds_write_to_read_p99_ms\":%s,"
-              "\"loaded_updates\":%.0f,\"samples\":%d,\"rate_hz\":%.1f,\"dds_rate_hz\":%.1f,\"dds_samples\":%zu,"
-              "\"missing\":%d,\"load_average\":%.2f,\"scheduling\":\"%s\"}\n",
-              num(idle.lcm_ms.p50).c_str(), num(idle.lcm_ms.p95).c_str(), num(idle.lcm_ms.p99).c_str(),
-              num(idle.lcm_ms.max).c_str(), num(idle.dds_nav_ms.p50).c_str(), num(idle.dds_nav_ms.p95).c_str(),
-              num(idle.dds_nav_ms.p99).c_str(), num(idle.dds_nav_ms.max).c_str(), num(idle.dds_write_ms.p50).c_str(),
-              num(idle.dds_write_ms.p99).c_str(), num(load ? loaded.lcm_ms.p50 : NAN).c_str(),
-              num(load ? loaded.lcm_ms.p99 : NAN).c_str(), num(load ? loaded.lcm_ms.max : NAN).c_str(),
-              num(load ? loaded.dds_nav_ms.p50 : NAN).c_str(), num(load ? loaded.dds_nav_ms.p99 : NAN).c_str(),
-              num(load ? loaded.dds_write_ms.p99 : NAN).c_str(), load ? loaded.updates : 0.0, samples, rate_hz,
-              dds_rate_hz, idle.dds_samples, idle.missing_poses + loaded.missing_poses,
-              std::max(load_before, load_after), realtime ? "fifo" : "normal");
+  // The machine-readable last line (nlohmann: a figure that is not finite, or not measured, is null).
+  auto num = [](double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); };
+  nlohmann::ordered_json figures;
+  figures["lcm_p50_ms"] = num(idle.lcm_ms.p50);
+  figures["lcm_p95_ms"] = num(idle.lcm_ms.p95);
+  figures["lcm_p99_ms"] = num(idle.lcm_ms.p99);
+  figures["lcm_max_ms"] = num(idle.lcm_ms.max);
+  figures["dds_p50_ms"] = num(idle.dds_nav_ms.p50);
+  figures["dds_p95_ms"] = num(idle.dds_nav_ms.p95);
+  figures["dds_p99_ms"] = num(idle.dds_nav_ms.p99);
+  figures["dds_max_ms"] = num(idle.dds_nav_ms.max);
+  figures["dds_write_to_read_p50_ms"] = num(idle.dds_write_ms.p50);
+  figures["dds_write_to_read_p99_ms"] = num(idle.dds_write_ms.p99);
+  figures["loaded_lcm_p50_ms"] = num(load ? loaded.lcm_ms.p50 : NAN);
+  figures["loaded_lcm_p99_ms"] = num(load ? loaded.lcm_ms.p99 : NAN);
+  figures["loaded_lcm_max_ms"] = num(load ? loaded.lcm_ms.max : NAN);
+  figures["loaded_dds_p50_ms"] = num(load ? loaded.dds_nav_ms.p50 : NAN);
+  figures["loaded_dds_p99_ms"] = num(load ? loaded.dds_nav_ms.p99 : NAN);
+  figures["loaded_dds_write_to_read_p99_ms"] = num(load ? loaded.dds_write_ms.p99 : NAN);
+  figures["loaded_updates"] = load ? loaded.updates : 0.0;
+  figures["samples"] = samples;
+  figures["rate_hz"] = rate_hz;
+  figures["dds_rate_hz"] = dds_rate_hz;
+  figures["dds_samples"] = idle.dds_samples;
+  figures["missing"] = idle.missing_poses + loaded.missing_poses;
+  figures["load_average"] = std::max(load_before, load_after);
+  figures["scheduling"] = realtime ? "fifo" : "normal";
+  std::printf("%s\n", figures.dump().c_str());
   return idle.missing_poses + loaded.missing_poses > 0 || !clean ? 1 : 0;
 }

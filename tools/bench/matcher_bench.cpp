@@ -8,6 +8,8 @@
 // section (as sss-matcher reads them) instead of the built-in defaults.
 //   sss-bench-matcher [--pattern lawnmower|cross] [--lines N] [--line-length-m M] [--line-spacing-m M]
 //                     [--repeat K] [--config FILE] [--dr-error-m ALONG,LATERAL]
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -166,33 +168,41 @@ int main(int argc, char** argv) {
               mean(georef), mean(kd), mean(init), mean(patchmatch), mean(consistency), mean(pose),
               total.withinFraction(), total.recall(), total.meanErrorPx(), percentile(along_err, 0.95),
               percentile(lateral_err, 0.95));
-  std::string per_type_json;
+  // The machine-readable last line (nlohmann: a figure that is not finite is null, never an invalid nan).
+  nlohmann::ordered_json figures;
+  figures["seconds_per_pair"] = mean(seconds);
+  figures["seconds_p95"] = percentile(seconds, 0.95);
+  figures["within_2px"] = total.withinFraction();
+  figures["recall"] = total.recall();
+  figures["mean_error_px"] = total.meanErrorPx();
+  figures["pairs"] = pairs;
+  figures["parallel_pairs"] = parallel_pairs;
+  figures["anti_parallel_pairs"] = anti_pairs;
+  figures["crossing_pairs"] = crossing_pairs;
+  figures["accepted"] = accepted;
+  figures["georeference_s"] = mean(georef);
+  figures["kd_tree_s"] = mean(kd);
+  figures["initialisation_s"] = mean(init);
+  figures["patch_match_s"] = mean(patchmatch);
+  figures["consistency_s"] = mean(consistency);
+  figures["relative_pose_s"] = mean(pose);
+  figures["along_error_p95_m"] = percentile(along_err, 0.95);
+  figures["lateral_error_p95_m"] = percentile(lateral_err, 0.95);
+  figures["matches_per_pair"] = total.matches / pairs;
   for (int t = 0; t < sss::eval::kPairTypes; ++t) {
     const auto& e = by_type[t];
-    const char* name = sss::eval::pairTypeName(static_cast<PairType>(t));
+    const std::string name = sss::eval::pairTypeName(static_cast<PairType>(t));
     if (pairs_by_type[t] > 0) {
-      std::printf("  %-13s %3ld pairs: %ld matches, within 2 px %.3f, recall %.3f, EPE %.2f px (%.3f m)\n", name,
+      std::printf("  %-13s %3ld pairs: %ld matches, within 2 px %.3f, recall %.3f, EPE %.2f px (%.3f m)\n", name.c_str(),
                   pairs_by_type[t], e.matches, e.withinFraction(), e.recall(), e.meanErrorPx(), e.meanErrorM());
     }
-    char text[256];
-    if (pairs_by_type[t] > 0) {
-      std::snprintf(text, sizeof text, ", \"within_2px_%s\": %.4f, \"recall_%s\": %.4f, \"mean_error_px_%s\": %.4f",
-                    name, e.withinFraction(), name, e.recall(), name, e.meanErrorPx());
-    } else {  // no pair of this type: null, not a misleading 0
-      std::snprintf(text, sizeof text, ", \"within_2px_%s\": null, \"recall_%s\": null, \"mean_error_px_%s\": null",
-                    name, name, name);
-    }
-    per_type_json += text;
+    const bool seen = pairs_by_type[t] > 0;  // no pair of this type: null, not a misleading 0
+    figures["within_2px_" + name] = seen ? nlohmann::ordered_json(e.withinFraction()) : nlohmann::ordered_json();
+    figures["recall_" + name] = seen ? nlohmann::ordered_json(e.recall()) : nlohmann::ordered_json();
+    figures["mean_error_px_" + name] = seen ? nlohmann::ordered_json(e.meanErrorPx()) : nlohmann::ordered_json();
   }
-  std::printf("{\"seconds_per_pair\": %.4f, \"seconds_p95\": %.4f, \"within_2px\": %.4f, \"recall\": %.4f, "
-              "\"mean_error_px\": %.4f, \"pairs\": %ld, \"parallel_pairs\": %ld, \"anti_parallel_pairs\": %ld, "
-              "\"crossing_pairs\": %ld, \"accepted\": %ld, "
-              "\"georeference_s\": %.4f, \"kd_tree_s\": %.4f, \"initialisation_s\": %.4f, \"patch_match_s\": %.4f, "
-              "\"consistency_s\": %.4f, \"relative_pose_s\": %.4f, \"along_error_p95_m\": %.4f, "
-              "\"lateral_error_p95_m\": %.4f, \"matches_per_pair\": %ld%s, \"pattern\": \"%s\", \"dr_error_m\": [%.2f, %.2f]}\n",
-              mean(seconds), percentile(seconds, 0.95), total.withinFraction(), total.recall(), total.meanErrorPx(), pairs,
-              parallel_pairs, anti_pairs, crossing_pairs, accepted, mean(georef), mean(kd), mean(init), mean(patchmatch),
-              mean(consistency), mean(pose), percentile(along_err, 0.95), percentile(lateral_err, 0.95),
-              total.matches / pairs, per_type_json.c_str(), pattern.c_str(), dr_along_m, dr_lateral_m);
+  figures["pattern"] = pattern;
+  figures["dr_error_m"] = {dr_along_m, dr_lateral_m};
+  std::printf("%s\n", figures.dump().c_str());
   return 0;
 }
