@@ -35,12 +35,9 @@
 #include "pipeline/optimiser/optimiser_engine.hpp"
 #include "pipeline/optimiser/correction_slew.hpp"
 #include "pipeline/optimiser/fix_message.hpp"
-#include "products/coverage.hpp"
 #include "products/footprints.hpp"
-#include "products/geotiff.hpp"
+#include "products/live_products.hpp"
 #include "products/mosaic_products.hpp"
-#include "products/navigation_products.hpp"
-#include "products/survey_rasters.hpp"
 #include "pipeline/optimiser/pose_message.hpp"
 #include "pipeline/subframe/subframe_message.hpp"
 #include "pipeline/transport/dds.hpp"
@@ -109,67 +106,6 @@ struct Shared {
   size_t memory_bytes = 0;
   std::vector<std::string> messages;  // log lines from the worker (logged by the loop)
 };
-
-bool writeProducts(OptimiserEngine& engine, const sss::products::MosaicStore& mosaics,
-                   const std::vector<sss::products::SubframeFootprint>& footprints, const std::string& directory,
-                   const std::optional<sss::core::MissionOrigin>& origin, std::vector<std::string>& messages) {
-  std::error_code ec;
-  fs::create_directories(directory, ec);
-  std::string error;
-  const auto trajectory = engine.pingTrajectory(true);
-  if (!sss::optimiser::writeTum(directory + "/slam.tum", trajectory,
-                                "sss-optimiser: optimised pose of every ping of the subframes", error, origin)) {
-    messages.push_back(error);
-    return false;
-  }
-  const auto points = engine.seabedPoints(false);
-  bool ok = sss::optimiser::writeSeabedPly(directory + "/bathymetry.ply", points, error, origin);
-  if (ok && !points.empty()) {
-    ok = sss::optimiser::writeHeightmapFiles(directory + "/heightmap.yaml",
-                                             sss::optimiser::gridSeabedPoints(points, engine.options().bathymetry),
-                                             "sss-optimiser: seabed re-triangulated with the optimised poses", error,
-                                             origin);
-  }
-  // The survey products sss-process writes: the corrected navigation, the tie report, the mosaics
-  // (DR and SLAM) and the heightmap, with GeoTIFFs in the origin's UTM zone.
-  if (ok) ok = sss::products::writeNavigationFiles(directory, trajectory, engine, origin, {}, error);
-  if (ok) ok = sss::products::writeTieReportCsv(directory + "/loop_closures.csv", engine, error);
-  std::optional<sss::products::RasterFrame> frame;
-  if (origin) frame = sss::products::RasterFrame{origin, false, 0.0, 0.0, ""};
-  std::vector<std::string> geotiffs;
-  sss::products::GeoTiffInfo info;
-  if (ok) {
-    ok = sss::products::writeMosaicProducts(directory, mosaics.subframes(), engine, sss::subframe::PictureOptions{}, origin,
-                                            frame, "sss-optimiser", geotiffs, info, error);
-  }
-  if (ok && mosaics.dropped() > 0) {
-    messages.push_back("products: the mosaics show the newest " + std::to_string(mosaics.subframes().size()) +
-                       " subframes; " + std::to_string(mosaics.dropped()) +
-                       " older ones went to stay within products_mosaic_max_mib");
-  }
-  // Tracks and subframe footprints for GIS, and how many lines saw each 5 m cell.
-  if (ok) ok = sss::products::writeGeoJsonFiles(directory, trajectory, engine.pingTrajectory(false), footprints, engine,
-                                                origin, error);
-  if (ok && !footprints.empty()) {
-    const sss::products::CoverageGrid coverage =
-        sss::products::computeCoverage(sss::products::slamStrips(footprints, engine), 5.0);
-    ok = sss::products::writeCoverageFiles(directory + "/coverage.yaml", coverage, error, origin);
-    if (ok && frame) {
-      ok = sss::products::writeGeoTiff(directory + "/coverage.tif", sss::products::coverageRaster(coverage), *frame, error);
-    }
-  }
-  if (ok && !points.empty() && frame) {
-    ok = sss::products::writeGeoTiff(
-        directory + "/heightmap.tif",
-        sss::products::heightmapRaster(sss::optimiser::gridSeabedPoints(points, engine.options().bathymetry),
-                                       "sss-optimiser: seabed re-triangulated with the optimised poses (depth m, down)"),
-        *frame, error);
-  }
-  messages.push_back(ok ? "products written to " + directory + ": " + std::to_string(trajectory.size()) +
-                              " poses, " + std::to_string(points.size()) + " seabed points"
-                        : "products: " + error);
-  return ok;
-}
 
 }  // namespace
 
@@ -318,7 +254,7 @@ int main(int argc, char** argv) {
       bool updated = false;
       if (products) {
         engine.finish();
-        if (!options.products_directory.empty()) writeProducts(engine, mosaics, footprints, options.products_directory, origin, messages);
+        if (!options.products_directory.empty()) sss::products::writeLiveProducts(engine, mosaics, footprints, options.products_directory, origin, messages);
         updated = true;
       } else if (engine.hasNewInput() && now_s - last_update_monotonic_s >= options.update_period_s) {
         const auto report = engine.update();
@@ -611,7 +547,7 @@ int main(int argc, char** argv) {
   if (engine.graph().numNodes() > 0) {
     engine.finish();
     std::vector<std::string> messages;
-    if (!options.products_directory.empty()) writeProducts(engine, mosaics, footprints, options.products_directory, shared.origin, messages);
+    if (!options.products_directory.empty()) sss::products::writeLiveProducts(engine, mosaics, footprints, options.products_directory, shared.origin, messages);
     if (!checkpoint_path.empty()) {
       const auto saved = engine.saveCheckpoint(checkpoint_path);
       if (!saved.ok) messages.push_back("checkpoint: " + saved.message);

@@ -1,0 +1,77 @@
+// The products sss-optimiser writes at the end of a mission, see live_products.hpp.
+#include "products/live_products.hpp"
+
+#include <filesystem>
+
+#include "pipeline/optimiser/bathymetry.hpp"
+#include "products/coverage.hpp"
+#include "products/geotiff.hpp"
+#include "products/navigation_products.hpp"
+#include "products/survey_rasters.hpp"
+
+namespace fs = std::filesystem;
+
+namespace sss::products {
+
+bool writeLiveProducts(const sss::optimiser::OptimiserEngine& engine, const MosaicStore& mosaics,
+                       const std::vector<SubframeFootprint>& footprints, const std::string& directory,
+                       const std::optional<sss::core::MissionOrigin>& origin, std::vector<std::string>& messages) {
+  std::error_code ec;
+  fs::create_directories(directory, ec);
+  std::string error;
+  const auto trajectory = engine.pingTrajectory(true);
+  if (!sss::optimiser::writeTum(directory + "/slam.tum", trajectory,
+                                "sss-optimiser: optimised pose of every ping of the subframes", error, origin)) {
+    messages.push_back(error);
+    return false;
+  }
+  const auto points = engine.seabedPoints(false);
+  bool ok = sss::optimiser::writeSeabedPly(directory + "/bathymetry.ply", points, error, origin);
+  if (ok && !points.empty()) {
+    ok = sss::optimiser::writeHeightmapFiles(directory + "/heightmap.yaml",
+                                             sss::optimiser::gridSeabedPoints(points, engine.options().bathymetry),
+                                             "sss-optimiser: seabed re-triangulated with the optimised poses", error,
+                                             origin);
+  }
+  // The survey products sss-process writes: the corrected navigation, the tie report, the mosaics
+  // (DR and SLAM) and the heightmap, with GeoTIFFs in the origin's UTM zone.
+  if (ok) ok = writeNavigationFiles(directory, trajectory, engine, origin, {}, error);
+  if (ok) ok = writeTieReportCsv(directory + "/loop_closures.csv", engine, error);
+  std::optional<RasterFrame> frame;
+  if (origin) frame = RasterFrame{origin, false, 0.0, 0.0, ""};
+  std::vector<std::string> geotiffs;
+  GeoTiffInfo info;
+  if (ok) {
+    ok = writeMosaicProducts(directory, mosaics.subframes(), engine, sss::subframe::PictureOptions{}, origin,
+                                            frame, "sss-optimiser", geotiffs, info, error);
+  }
+  if (ok && mosaics.dropped() > 0) {
+    messages.push_back("products: the mosaics show the newest " + std::to_string(mosaics.subframes().size()) +
+                       " subframes; " + std::to_string(mosaics.dropped()) +
+                       " older ones went to stay within products_mosaic_max_mib");
+  }
+  // Tracks and subframe footprints for GIS, and how many lines saw each 5 m cell.
+  if (ok) ok = writeGeoJsonFiles(directory, trajectory, engine.pingTrajectory(false), footprints, engine,
+                                                origin, error);
+  if (ok && !footprints.empty()) {
+    const CoverageGrid coverage =
+        computeCoverage(slamStrips(footprints, engine), 5.0);
+    ok = writeCoverageFiles(directory + "/coverage.yaml", coverage, error, origin);
+    if (ok && frame) {
+      ok = writeGeoTiff(directory + "/coverage.tif", coverageRaster(coverage), *frame, error);
+    }
+  }
+  if (ok && !points.empty() && frame) {
+    ok = writeGeoTiff(
+        directory + "/heightmap.tif",
+        heightmapRaster(sss::optimiser::gridSeabedPoints(points, engine.options().bathymetry),
+                                       "sss-optimiser: seabed re-triangulated with the optimised poses (depth m, down)"),
+        *frame, error);
+  }
+  messages.push_back(ok ? "products written to " + directory + ": " + std::to_string(trajectory.size()) +
+                              " poses, " + std::to_string(points.size()) + " seabed points"
+                        : "products: " + error);
+  return ok;
+}
+
+}  // namespace sss::products
