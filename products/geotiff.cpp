@@ -246,7 +246,7 @@ bool writeGeoTiff(const std::string& path, const FrameRaster& raster, const Rast
     Argv argv;
     argv.add("-of").add("GTiff").add("-t_srs").add("EPSG:" + std::to_string(epsg));
     argv.add("-tr").add(number(raster.resolution_m)).add(number(raster.resolution_m)).add("-tap");
-    argv.add("-r").add("near").add("-et").add("0").add("-srcnodata").add(nodata).add("-dstnodata").add(nodata);
+    argv.add("-r").add("near").add("-et").add("0.01").add("-srcnodata").add(nodata).add("-dstnodata").add(nodata);
     argv.add("-overwrite");
     addCreationOptions(argv, raster);
     GDALWarpAppOptions* options = GDALWarpAppOptionsNew(argv.get(), nullptr);

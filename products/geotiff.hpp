@@ -12,7 +12,8 @@ namespace sss::products {
 
 // Where the mission frame lies on Earth.
 // - Geographic: the local NED tangent plane at a WGS-84 origin (every INS and most sonar files).
-//   The raster is warped (nearest neighbour, exact transform) into the origin's UTM zone.
+//   The raster is warped (nearest neighbour; the transform approximated within 0.01 pixel) into
+//   the origin's UTM zone.
 // - Projected: the input gave positions in projected metres (XTF NavUnits 0); frame (north, east)
 //   plus the offsets is the file's grid. XTF does not name that grid's CRS, so the user does
 //   (`products.projected_crs`, any string GDAL takes: "EPSG:32633"); without one the GeoTIFF has

@@ -31,42 +31,57 @@ std::string readText(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
+// One engine for both tests: a full smoothing is seconds under the sanitizers.
 class LiveProductsTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = (fs::temp_directory_path() / ("sss_live_products_test_" + std::to_string(getpid()))).string();
+  static void SetUpTestSuite() {
+    engine_ = new sss::optimiser::OptimiserEngine(sss::optimiser::OptimiserEngineOptions{});
+    mosaics_ = new MosaicStore(sss::subframe::PictureOptions{}, std::numeric_limits<size_t>::max());
     const synthetic::Mission mission = synthetic::makeLawnmowerMission(sss::optimiser::test_helpers::missionOptions(3));
     synthetic::SubframeOptions options;
-    options.correspondences_per_closure = 100;
+    options.correspondences_per_closure = 20;  // enough for seabed points
+    options.pings_per_subframe = 50;  // 100 m subframes of 2 m pings: the mosaics are drawn in seconds under ASan
+    options.ping_spacing_m = 2.0;
     std::vector<std::vector<sss::core::Pose>> truth;
     std::vector<sss::subframe::Subframe> subframes = synthetic::makeSubframes(mission, options, &truth);
     for (auto& s : subframes) {
-      // The synthetic subframes carry no image: give each a plain 50 m swath for the mosaics.
-      s.geometry.bins_per_side = 500;
-      s.geometry.bin_size_m = 0.1;
+      // The synthetic subframes carry no image: give each a plain 60 m swath at the mosaic's 0.5 m
+      // (lines 100 m apart: a 20 m strip between two lines is seen twice).
+      s.geometry.bins_per_side = 120;
+      s.geometry.bin_size_m = 0.5;
       s.geometry.first_bin_range_m = 0.0;
       s.image.assign(static_cast<size_t>(s.rows()) * s.cols(), 1.0f);
       s.mask.assign(s.image.size(), sss::subframe::kMaskValid);
-      ASSERT_TRUE(engine_.addSubframe(s).ok);
-      mosaics_.add(s);
+      ASSERT_TRUE(engine_->addSubframe(s).ok);
+      mosaics_->add(s);
       footprints_.push_back(footprintOf(s));
     }
     for (size_t c = 0; c < mission.closures.size(); ++c) {
-      ASSERT_TRUE(engine_.addLoopClosure(synthetic::makeMatcherClosure(mission, c, truth, options)).ok);
+      ASSERT_TRUE(engine_->addLoopClosure(synthetic::makeMatcherClosure(mission, c, truth, options)).ok);
     }
-    engine_.finish();
+    engine_->finish();
+  }
+  static void TearDownTestSuite() {
+    delete engine_;
+    delete mosaics_;
+  }
+  void SetUp() override {
+    dir_ = (fs::temp_directory_path() / ("sss_live_products_test_" + std::to_string(getpid()))).string();
   }
   void TearDown() override { fs::remove_all(dir_); }
 
   std::string dir_;
-  sss::optimiser::OptimiserEngine engine_{sss::optimiser::OptimiserEngineOptions{}};
-  MosaicStore mosaics_{sss::subframe::PictureOptions{}, std::numeric_limits<size_t>::max()};
-  std::vector<SubframeFootprint> footprints_;
+  static sss::optimiser::OptimiserEngine* engine_;
+  static MosaicStore* mosaics_;
+  static std::vector<SubframeFootprint> footprints_;
 };
+sss::optimiser::OptimiserEngine* LiveProductsTest::engine_ = nullptr;
+MosaicStore* LiveProductsTest::mosaics_ = nullptr;
+std::vector<SubframeFootprint> LiveProductsTest::footprints_;
 
 TEST_F(LiveProductsTest, EveryProductIsWrittenAndTheRastersLandInTheOriginsUtmZone) {
   std::vector<std::string> messages;
-  ASSERT_TRUE(writeLiveProducts(engine_, mosaics_, footprints_, dir_, sss::core::MissionOrigin{59.35, 18.07}, messages))
+  ASSERT_TRUE(writeLiveProducts(*engine_, *mosaics_, footprints_, dir_, sss::core::MissionOrigin{59.35, 18.07}, messages))
       << (messages.empty() ? "" : messages.back());
   ASSERT_FALSE(messages.empty());
   EXPECT_NE(messages.back().find("products written to " + dir_), std::string::npos) << messages.back();
@@ -80,7 +95,7 @@ TEST_F(LiveProductsTest, EveryProductIsWrittenAndTheRastersLandInTheOriginsUtmZo
   const std::string navigation = readText(dir_ + "/navigation.csv");
   size_t rows = 0;
   for (size_t at = navigation.find("\n2"); at != std::string::npos; at = navigation.find("\n2", at + 1)) ++rows;
-  EXPECT_EQ(rows, engine_.pingTrajectory(true).size());
+  EXPECT_EQ(rows, engine_->pingTrajectory(true).size());
   EXPECT_NE(readText(dir_ + "/loop_closures.csv").find(",accepted,"), std::string::npos);
   const std::string polygons = readText(dir_ + "/subframes.geojson");
   size_t features = 0;
@@ -99,7 +114,7 @@ TEST_F(LiveProductsTest, EveryProductIsWrittenAndTheRastersLandInTheOriginsUtmZo
 
 TEST_F(LiveProductsTest, WithoutAnOriginTheFilesThatNeedOneAreLeftOut) {
   std::vector<std::string> messages;
-  ASSERT_TRUE(writeLiveProducts(engine_, mosaics_, footprints_, dir_, std::nullopt, messages));
+  ASSERT_TRUE(writeLiveProducts(*engine_, *mosaics_, footprints_, dir_, std::nullopt, messages));
   for (const char* file : {"slam.tum", "navigation.csv", "loop_closures.csv", "coverage.yaml", "mosaic_slam.png"}) {
     EXPECT_TRUE(fs::is_regular_file(dir_ + "/" + file)) << file;
   }
