@@ -136,20 +136,15 @@ bool writeCoverageFiles(const std::string& yaml_path, const CoverageGrid& grid, 
 }
 
 FrameRaster coverageRaster(const CoverageGrid& grid) {
-  FrameRaster raster;
-  raster.rows = grid.rows;
-  raster.cols = grid.cols;
-  raster.resolution_m = grid.resolution_m;
-  raster.north_top_edge_m = grid.north_min_m + (grid.rows - 0.5) * grid.resolution_m;
-  raster.east_left_edge_m = grid.east_min_m - 0.5 * grid.resolution_m;
+  FrameRaster raster =
+      rasterOverCentredGrid(grid.rows, grid.cols, grid.resolution_m, grid.north_min_m, grid.east_min_m);
   raster.type = RasterType::kByte;
   raster.categorical = true;
   raster.description = "sss-process: survey lines that saw each cell (SLAM poses)";
-  raster.values.assign(grid.lines.size(), std::numeric_limits<float>::quiet_NaN());
   for (int row = 0; row < grid.rows; ++row) {
     for (int col = 0; col < grid.cols; ++col) {
       const uint8_t lines = grid.lines[static_cast<size_t>(row) * grid.cols + col];
-      if (lines > 0) raster.values[static_cast<size_t>(grid.rows - 1 - row) * grid.cols + col] = lines;
+      if (lines > 0) raster.values[northUpIndex(raster, row, col)] = lines;
     }
   }
   return raster;

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <memory>
 #include <mutex>
 
@@ -165,6 +166,18 @@ bool addOverviews(GDALDatasetH dataset, const FrameRaster& raster, int& count, s
 }
 
 }  // namespace
+
+FrameRaster rasterOverCentredGrid(int rows, int cols, double resolution_m, double north_min_m, double east_min_m) {
+  FrameRaster raster;
+  raster.rows = rows;
+  raster.cols = cols;
+  raster.resolution_m = resolution_m;
+  raster.north_top_edge_m = north_min_m + (rows - 0.5) * resolution_m;
+  raster.east_left_edge_m = east_min_m - 0.5 * resolution_m;
+  raster.values.assign(static_cast<size_t>(std::max(rows, 0)) * static_cast<size_t>(std::max(cols, 0)),
+                       std::numeric_limits<float>::quiet_NaN());
+  return raster;
+}
 
 bool isKnownCrs(const std::string& crs, std::string& error) {
   registerGdalOnce();

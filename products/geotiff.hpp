@@ -2,6 +2,7 @@
 // software places on the map: the UTM zone of the mission origin (WGS 84), or the file's own grid.
 #pragma once
 
+#include <cstddef>
 #include <optional>
 #include <string>
 #include <vector>
@@ -44,6 +45,14 @@ struct FrameRaster {
   bool categorical = false;       // overviews by nearest neighbour (counts), else by average
   std::string description;        // TIFFTAG_IMAGEDESCRIPTION
 };
+
+// The raster over a grid whose rows grow northwards with cell centres at north_min_m + row *
+// resolution_m, east_min_m + col * resolution_m (the layout of the heightmap and coverage grids):
+// its edges set, every value no data. Grid cell (row, col) goes to values[northUpIndex(...)].
+FrameRaster rasterOverCentredGrid(int rows, int cols, double resolution_m, double north_min_m, double east_min_m);
+inline size_t northUpIndex(const FrameRaster& raster, int grid_row, int col) {
+  return static_cast<size_t>(raster.rows - 1 - grid_row) * static_cast<size_t>(raster.cols) + static_cast<size_t>(col);
+}
 
 // What was written, for logs and tests.
 struct GeoTiffInfo {

@@ -26,10 +26,10 @@ bool writeLiveProducts(const sss::optimiser::OptimiserEngine& engine, const Mosa
     return false;
   }
   const auto points = engine.seabedPoints(false);
+  const sss::optimiser::HeightmapGrid heightmap = sss::optimiser::gridSeabedPoints(points, engine.options().bathymetry);
   bool ok = sss::optimiser::writeSeabedPly(directory + "/bathymetry.ply", points, error, origin);
   if (ok && !points.empty()) {
-    ok = sss::optimiser::writeHeightmapFiles(directory + "/heightmap.yaml",
-                                             sss::optimiser::gridSeabedPoints(points, engine.options().bathymetry),
+    ok = sss::optimiser::writeHeightmapFiles(directory + "/heightmap.yaml", heightmap,
                                              "sss-optimiser: seabed re-triangulated with the optimised poses", error,
                                              origin);
   }
@@ -64,8 +64,7 @@ bool writeLiveProducts(const sss::optimiser::OptimiserEngine& engine, const Mosa
   if (ok && !points.empty() && frame) {
     ok = writeGeoTiff(
         directory + "/heightmap.tif",
-        heightmapRaster(sss::optimiser::gridSeabedPoints(points, engine.options().bathymetry),
-                                       "sss-optimiser: seabed re-triangulated with the optimised poses (depth m, down)"),
+        heightmapRaster(heightmap, "sss-optimiser: seabed re-triangulated with the optimised poses (depth m, down)"),
         *frame, error);
   }
   messages.push_back(ok ? "products written to " + directory + ": " + std::to_string(trajectory.size()) +

@@ -22,23 +22,25 @@ void MosaicStore::add(const sss::subframe::Subframe& subframe) {
   if (reduced.cols() <= 0 || reduced.rows() < 2) return;  // no image to draw
   subframes_.push_back(std::move(reduced));
   bytes_ += imageBytes(subframes_.back());
-  while (bytes_ > max_bytes_ && subframes_.size() > 1) {
-    bytes_ -= imageBytes(subframes_.front());
-    subframes_.pop_front();
-    ++dropped_;
+  // Past the bound, drop the oldest (moves of a few hundred subframes at most, once per subframe).
+  size_t drop = 0;
+  while (bytes_ > max_bytes_ && drop + 1 < subframes_.size()) {
+    bytes_ -= imageBytes(subframes_[drop]);
+    ++drop;
   }
+  subframes_.erase(subframes_.begin(), subframes_.begin() + static_cast<std::ptrdiff_t>(drop));
+  dropped_ += drop;
 }
 
-bool writeMosaicProducts(const std::string& dir, const std::deque<sss::subframe::Subframe>& subframes,
+bool writeMosaicProducts(const std::string& dir, const std::vector<sss::subframe::Subframe>& subframes,
                          const sss::optimiser::OptimiserEngine& engine, const sss::subframe::PictureOptions& pictures,
                          const std::optional<sss::core::MissionOrigin>& origin,
                          const std::optional<RasterFrame>& frame, const std::string& tool,
                          std::vector<std::string>& geotiffs, GeoTiffInfo& geotiff_info, std::string& error) {
   if (subframes.empty()) return true;
-  const std::vector<sss::subframe::Subframe> all(subframes.begin(), subframes.end());
   // The SLAM pose of every ping: the optimiser's correction at its time applied to its DR pose.
   std::map<int64_t, std::vector<sss::core::Pose>> slam_poses;
-  for (const auto& s : all) {
+  for (const auto& s : subframes) {
     std::vector<sss::core::Pose>& poses = slam_poses[s.id];
     for (const auto& ping : s.pings) {
       poses.push_back(engine.correctionAt(ping.utime_us).T_corrected_dr * ping.T_world_body);
@@ -53,7 +55,7 @@ bool writeMosaicProducts(const std::string& dir, const std::deque<sss::subframe:
                  {slam_poses, "mosaic_slam", "side-scan mosaic geo-referenced with the SLAM poses"}};
   for (const auto& mosaic : mosaics) {
     const std::string png = dir + "/" + mosaic.name + ".png";
-    const auto raster = sss::subframe::renderMosaic(all, mosaic.poses, pictures, error);
+    const auto raster = sss::subframe::renderMosaic(subframes, mosaic.poses, pictures, error);
     if (!raster) {
       error += " " + png;
       return false;

@@ -5,7 +5,6 @@
 #pragma once
 
 #include <cstdint>
-#include <deque>
 #include <optional>
 #include <string>
 #include <vector>
@@ -23,7 +22,7 @@ class MosaicStore {
  public:
   MosaicStore(sss::subframe::PictureOptions pictures, size_t max_bytes);
   void add(const sss::subframe::Subframe& subframe);
-  const std::deque<sss::subframe::Subframe>& subframes() const { return subframes_; }
+  const std::vector<sss::subframe::Subframe>& subframes() const { return subframes_; }
   size_t bytes() const { return bytes_; }
   uint64_t dropped() const { return dropped_; }
 
@@ -32,13 +31,13 @@ class MosaicStore {
   size_t max_bytes_;
   size_t bytes_ = 0;
   uint64_t dropped_ = 0;
-  std::deque<sss::subframe::Subframe> subframes_;
+  std::vector<sss::subframe::Subframe> subframes_;  // oldest first
 };
 
 // Writes dir/mosaic_dr.{png,yaml} and dir/mosaic_slam.{png,yaml}, and their GeoTIFFs when frame
 // is given; `tool` names the writer in the descriptions. The names of the GeoTIFFs written are
 // appended to geotiffs (with the last one's info in geotiff_info).
-bool writeMosaicProducts(const std::string& dir, const std::deque<sss::subframe::Subframe>& subframes,
+bool writeMosaicProducts(const std::string& dir, const std::vector<sss::subframe::Subframe>& subframes,
                          const sss::optimiser::OptimiserEngine& engine, const sss::subframe::PictureOptions& pictures,
                          const std::optional<sss::core::MissionOrigin>& origin,
                          const std::optional<RasterFrame>& frame, const std::string& tool,

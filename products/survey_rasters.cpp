@@ -6,21 +6,14 @@
 namespace sss::products {
 
 FrameRaster heightmapRaster(const sss::optimiser::HeightmapGrid& grid, const std::string& description) {
-  FrameRaster raster;
-  raster.rows = grid.rows;
-  raster.cols = grid.cols;
-  raster.resolution_m = grid.resolution_m;
-  // Grid rows grow northwards with cell centres at north_min_m + row * resolution_m.
-  raster.north_top_edge_m = grid.north_min_m + (grid.rows - 0.5) * grid.resolution_m;
-  raster.east_left_edge_m = grid.east_min_m - 0.5 * grid.resolution_m;
+  FrameRaster raster =
+      rasterOverCentredGrid(grid.rows, grid.cols, grid.resolution_m, grid.north_min_m, grid.east_min_m);
   raster.type = RasterType::kFloat32;
   raster.nodata_value = -9999.0;
   raster.description = description;
-  raster.values.assign(grid.depth_m.size(), std::numeric_limits<float>::quiet_NaN());
   for (int row = 0; row < grid.rows; ++row) {
     for (int col = 0; col < grid.cols; ++col) {
-      raster.values[static_cast<size_t>(grid.rows - 1 - row) * grid.cols + col] =
-          grid.depth_m[static_cast<size_t>(row) * grid.cols + col];
+      raster.values[northUpIndex(raster, row, col)] = grid.depth_m[static_cast<size_t>(row) * grid.cols + col];
     }
   }
   return raster;

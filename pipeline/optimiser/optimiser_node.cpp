@@ -88,8 +88,6 @@ struct Shared {
   std::mutex mutex;
   std::condition_variable wake;
   std::deque<sss::subframe::Subframe> subframes;
-  std::deque<sss::subframe::Subframe> mosaic_subframes;  // the same at mosaic resolution, for the products
-  std::vector<sss::products::SubframeFootprint> footprints;  // and their footprints (coverage, GeoJSON)
   std::deque<sss::matcher::LoopClosure> closures;
   std::deque<sss::optimiser::AbsoluteFix> fixes;  // SSS_FIX, in the navigation's frame
   bool products_requested = false;
@@ -173,6 +171,10 @@ int main(int argc, char** argv) {
   sss::products::MosaicStore mosaics(sss::subframe::PictureOptions{},
                                      static_cast<size_t>(options.products_mosaic_max_mib * 1024.0 * 1024.0));
   std::vector<sss::products::SubframeFootprint> footprints;  // ~1 kB per subframe, kept all mission
+  auto keepForProducts = [&](const sss::subframe::Subframe& subframe) {
+    mosaics.add(subframe);  // decimated: ~1/5 of the image
+    footprints.push_back(sss::products::footprintOf(subframe));
+  };
   const std::string checkpoint_path =
       options.state_directory.empty() ? std::string() : options.state_directory + "/optimiser.checkpoint";
   if (!checkpoint_path.empty()) {
@@ -210,7 +212,7 @@ int main(int argc, char** argv) {
   std::thread worker([&] {
     double last_update_monotonic_s = -1e9;
     for (;;) {
-      std::deque<sss::subframe::Subframe> subframes, mosaic_subframes;
+      std::deque<sss::subframe::Subframe> subframes;
       std::deque<sss::matcher::LoopClosure> closures;
       std::deque<sss::optimiser::AbsoluteFix> fixes;
       bool products = false;
@@ -223,9 +225,6 @@ int main(int argc, char** argv) {
         });
         if (shared.stop) return;
         subframes.swap(shared.subframes);
-        mosaic_subframes.swap(shared.mosaic_subframes);
-        footprints.insert(footprints.end(), shared.footprints.begin(), shared.footprints.end());
-        shared.footprints.clear();
         closures.swap(shared.closures);
         fixes.swap(shared.fixes);
         products = shared.products_requested;
@@ -237,8 +236,8 @@ int main(int argc, char** argv) {
         const auto status = engine.addSubframe(subframe);
         if (!status.ok) messages.push_back("subframe " + std::to_string(subframe.id) + " refused: " + status.message);
         else if (!status.message.empty()) messages.push_back(status.message);  // an odometer reset
+        if (status.ok) keepForProducts(subframe);
       }
-      for (const auto& subframe : mosaic_subframes) mosaics.add(subframe);
       for (const auto& closure : closures) {
         const auto status = engine.addLoopClosure(closure);
         if (!status.ok) {
@@ -407,18 +406,10 @@ int main(int argc, char** argv) {
         spdlog::warn("subframe {} rejected: {}; further ones are counted in SSS_STATUS", message.subframe_id, error);
       return;
     }
-    // The graph keeps poses only; the products' mosaics a copy at mosaic resolution (~1/5 of it).
-    sss::subframe::Subframe for_mosaic = sss::subframe::decimateForMosaic(
-        subframe, sss::subframe::mosaicDecimationFactor(sss::subframe::PictureOptions{}, subframe.geometry.bin_size_m));
-    subframe.image.clear();
-    subframe.image.shrink_to_fit();
-    subframe.mask.clear();
-    subframe.mask.shrink_to_fit();
-    sss::products::SubframeFootprint footprint = sss::products::footprintOf(subframe);
+    // The image travels to the worker, which keeps it for the products at mosaic resolution (off this
+    // loop, which answers every nav sample); the graph keeps poses only.
     std::lock_guard<std::mutex> lock(shared.mutex);
     shared.subframes.push_back(std::move(subframe));
-    shared.mosaic_subframes.push_back(std::move(for_mosaic));
-    shared.footprints.push_back(std::move(footprint));
     shared.wake.notify_one();
   });
   loop.bus().subscribe<sss_msgs::loop_closure_t>(options.loop_channel, [&](const sss_msgs::loop_closure_t& message) {
@@ -539,9 +530,8 @@ int main(int argc, char** argv) {
   for (const auto& subframe : shared.subframes) {
     const auto status = engine.addSubframe(subframe);
     if (!status.message.empty()) spdlog::info("subframe {}: {}", subframe.id, status.message);
+    if (status.ok) keepForProducts(subframe);
   }
-  for (const auto& subframe : shared.mosaic_subframes) mosaics.add(subframe);
-  footprints.insert(footprints.end(), shared.footprints.begin(), shared.footprints.end());
   for (const auto& closure : shared.closures) engine.addLoopClosure(closure);
   for (const auto& fix : shared.fixes) engine.addFix(fix);
   if (engine.graph().numNodes() > 0) {
