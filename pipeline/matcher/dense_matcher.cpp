@@ -97,6 +97,20 @@ void positionJacobian(const cv::Mat2f& position, int r, int c, cv::Vec2f& d_row,
   d_col = position.cols > 1 ? position(r, c0 + 1) - position(r, c0) : cv::Vec2f(0, 0);
 }
 
+// Whether A's pixel (ra, ca) and B's pixel (rb, cb) see their seabed point from opposite sides,
+// within 45 degrees: the look direction of a column is away from nadir (port columns are the left
+// half, starboard the right), along the geo-reference's column axis.
+bool opposedLooks(const GeoImage& a, int ra, int ca, const GeoImage& b, int rb, int cb) {
+  cv::Vec2f d_row, col_a, col_b;
+  positionJacobian(a.position_ne_m, ra, ca, d_row, col_a);
+  positionJacobian(b.position_ne_m, rb, cb, d_row, col_b);
+  const float side_a = 2 * ca >= a.intensity.cols ? 1.0f : -1.0f;
+  const float side_b = 2 * cb >= b.intensity.cols ? 1.0f : -1.0f;
+  const float norms = static_cast<float>(cv::norm(col_a) * cv::norm(col_b));
+  if (!(norms > 0.0f)) return false;
+  return side_a * side_b * col_a.dot(col_b) < -0.70710678f * norms;
+}
+
 // Valid geo-referenced pixels of B as a nanoflann point cloud (positions relative to an origin,
 // so float keeps millimetres far from the mission origin).
 struct PointCloud {
@@ -247,6 +261,20 @@ class PatchScorer {
   float min_count_;
   float min_variance_;
 };
+
+// The best ZNCC of A's patch at (sr, sc) with B's patch at (tr, tc) mirrored along the columns
+// (the look direction on A's grid) about any point of it, in half-pixel steps: a raised feature's
+// two views are mirror images about the feature, which need not be the patch centre
+// (DenseMatcherOptions::reject_mirrored_relief). `score_mirrored` scores A against B's grid
+// flipped left-right, where B mirrored about column m is the plain patch at column cols - 1 - m.
+float bestMirroredScore(const PatchScorer& score_mirrored, int sr, int sc, int tr, int tc, int half, int grid_cols) {
+  float best = kNoScore;
+  for (int m = tc - 2 * half; m <= tc + 2 * half; ++m) {  // mirror point (tc + m) / 2
+    if (m - half < 0 || m + half >= grid_cols) continue;
+    best = std::max(best, score_mirrored(sr, sc, tr, grid_cols - 1 - m));
+  }
+  return best;
+}
 
 // A nearest-neighbour field over a lattice of source pixels (every stride-th grid pixel from
 // (row0, col0)): offset to the best target pixel found so far and its ZNCC.
@@ -409,6 +437,7 @@ void readDenseMatcherOptions(sss::core::ConfigSection& section, DenseMatcherOpti
   section.optional("forward_backward_check", options.forward_backward_check);
   section.optional("max_fb_error_px", options.max_fb_error_px, {atLeast(0.0)});
   section.optional("subpixel", options.subpixel);
+  section.optional("reject_mirrored_relief", options.reject_mirrored_relief);
   section.optional("min_coherent_neighbours", options.min_coherent_neighbours, {inRange(0, 8)});
   section.optional("min_structure_ratio", options.min_structure_ratio, {inRange(0.0, 1.0)});
   section.optional("random_search_ratio", options.random_search_ratio,
@@ -531,6 +560,12 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
   });
   computePatchStatistics(grid_a, half, o.min_patch_stddev);
   computePatchStatistics(grid_b, half, o.min_patch_stddev);
+  GridImage grid_b_mirrored;  // B's grid flipped left-right, for the mirror test
+  if (o.reject_mirrored_relief) {
+    cv::flip(grid_b.value, grid_b_mirrored.value, 1);
+    cv::flip(grid_b.weight, grid_b_mirrored.weight, 1);
+    computePatchStatistics(grid_b_mirrored, half, o.min_patch_stddev);
+  }
   const cv::Mat1f structure_ratio_a =
       o.min_structure_ratio > 0.0 ? structureRatio(grid_a.value, 2 * half + 1) : cv::Mat1f();
 
@@ -564,6 +599,8 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
   // ---- PatchMatch A -> B ---------------------------------------------------------------------
   stage = Clock::now();
   const PatchScorer score_ab(grid_a, grid_b, half, o.min_valid_fraction, o.min_patch_stddev);
+  const PatchScorer score_mirrored(grid_a, o.reject_mirrored_relief ? grid_b_mirrored : grid_b, half,
+                                   o.min_valid_fraction, o.min_patch_stddev);
   runPatchMatch(forward, score_ab, window, grid_rows, grid_cols, half, o, 0x5A5A0001ULL);
   t.patch_match_s = secondsSince(stage);
 
@@ -606,6 +643,7 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
 
   std::vector<Correspondence> matches;
   matches.reserve(static_cast<std::size_t>(t.overlapping_pixels));
+  std::vector<std::pair<int, int>> match_nodes, mirrored_nodes;  // forward lattice (i, j)
   const float max_fb_sq = static_cast<float>(o.max_fb_error_px * o.max_fb_error_px);
   for (int i = 0; i < forward.rows; ++i) {
     for (int j = 0; j < forward.cols; ++j) {
@@ -656,6 +694,12 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
       if (nearest_r < 0 || nearest_c < 0 || nearest_r >= b.valid.rows || nearest_c >= b.valid.cols ||
           !b.valid(nearest_r, nearest_c))
         continue;
+      if (o.reject_mirrored_relief &&
+          opposedLooks(a, sr - pad_r, sc - pad_c, b, nearest_r, nearest_c) &&
+          bestMirroredScore(score_mirrored, sr, sc, tr, tc, half, grid_cols) > forward.score[k]) {
+        mirrored_nodes.push_back({i, j});
+        continue;
+      }
       Correspondence match;
       match.row_a = static_cast<float>(sr - pad_r);
       match.col_a = static_cast<float>(sc - pad_c);
@@ -663,7 +707,24 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
       match.col_b = m[1];
       match.zncc = forward.score[k];
       matches.push_back(match);
+      match_nodes.push_back({i, j});
     }
+  }
+  if (!mirrored_nodes.empty()) {
+    // A raised feature biases every patch it dominates, not only the one centred where the mirror
+    // test caught it: matches whose patch overlaps a mirrored one's centre go too.
+    const int reach = half / o.stride;
+    cv::Mat1b near_mirrored = cv::Mat1b::zeros(forward.rows, forward.cols);
+    for (const auto& [i, j] : mirrored_nodes) {
+      const cv::Rect box(j - reach, i - reach, 2 * reach + 1, 2 * reach + 1);
+      near_mirrored(box & cv::Rect(0, 0, forward.cols, forward.rows)).setTo(1);
+    }
+    std::vector<Correspondence> kept;
+    kept.reserve(matches.size());
+    for (std::size_t m = 0; m < matches.size(); ++m)
+      if (!near_mirrored(match_nodes[m].first, match_nodes[m].second)) kept.push_back(matches[m]);
+    t.mirrored_relief_rejected = static_cast<long>(mirrored_nodes.size() + matches.size() - kept.size());
+    matches.swap(kept);
   }
   t.consistency_s = secondsSince(stage);
   t.matches = static_cast<long>(matches.size());

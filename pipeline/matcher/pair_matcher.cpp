@@ -106,6 +106,7 @@ void addTimings(MatchTimings& total, const MatchTimings& pass) {
   total.consistency_s += pass.consistency_s;
   total.total_s += pass.total_s;
   total.overlapping_pixels = std::max(total.overlapping_pixels, pass.overlapping_pixels);
+  total.mirrored_relief_rejected += pass.mirrored_relief_rejected;
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // tests and benchmark: a procedural seabed seen from two straight survey lines with DR error.
 #include "pipeline/matcher/synthetic_pair.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace sss::matcher::synthetic {
@@ -46,7 +47,43 @@ double Seabed::reflectivity(double north_m, double east_m) const {
   double cell_m = 0.4;
   for (int octave = 0; octave < 6; ++octave, cell_m *= 2.0)
     sum += std::pow(cell_m, 0.5) * valueNoise(seed + static_cast<std::uint64_t>(octave) * 7919, north_m, east_m, cell_m);
-  return std::exp(0.5 * sum);
+  return std::exp(0.5 * texture_contrast * sum);
+}
+
+double Seabed::backscatter(const Eigen::Vector2d& point_ne_m, const Eigen::Vector2d& sonar_ne_m,
+                           double altitude_m) const {
+  double value = reflectivity(point_ne_m.x(), point_ne_m.y());
+  if (boulders.empty()) return value;
+  const Eigen::Vector2d to_point = point_ne_m - sonar_ne_m;
+  const double range_m = to_point.norm();
+  if (!(range_m > 0.0)) return value;
+  const Eigen::Vector2d look = to_point / range_m;
+  for (const Boulder& boulder : boulders) {
+    const Eigen::Vector2d d = point_ne_m - boulder.centre_ne_m;
+    const double along = d.dot(look);                            // away from the sonar
+    const double across = std::abs(d.x() * look.y() - d.y() * look.x());
+    if (across >= boulder.radius_m) continue;
+    if (d.norm() < boulder.radius_m) return along < 0.0 ? 4.0 * value : 0.3 * value;  // lit face / far face
+    const double shadow_m = boulder.height_m * range_m / std::max(altitude_m - boulder.height_m, 0.1);
+    if (along > 0.0 && along < boulder.radius_m + shadow_m) return 0.05 * value;
+  }
+  return value;
+}
+
+std::vector<Boulder> scatterBoulders(std::uint64_t seed, const Eigen::Vector2d& min_ne_m, const Eigen::Vector2d& max_ne_m,
+                                     double spacing_m, double min_radius_m, double max_radius_m) {
+  std::vector<Boulder> boulders;
+  const Eigen::Vector2d size = max_ne_m - min_ne_m;
+  const int count = static_cast<int>(std::lround(size.x() * size.y() / (spacing_m * spacing_m)));
+  for (int i = 0; i < count; ++i) {
+    const std::uint64_t h = mix(seed ^ mix(static_cast<std::uint64_t>(i) + 0x5151ULL));
+    Boulder boulder;
+    boulder.centre_ne_m = min_ne_m + Eigen::Vector2d(unit(mix(h)) * size.x(), unit(mix(h + 1)) * size.y());
+    boulder.radius_m = min_radius_m + unit(mix(h + 2)) * (max_radius_m - min_radius_m);
+    boulder.height_m = boulder.radius_m;
+    boulders.push_back(boulder);
+  }
+  return boulders;
 }
 
 Eigen::Vector2d SurveyLine::position(double row, double column) const {
@@ -70,13 +107,15 @@ GeoImage render(const Seabed& seabed, const SurveyLine& line, const RenderOption
   image.position_ne_m.create(line.rows, cols);
   image.heading_rad = cv::Mat1f(line.rows, 1, static_cast<float>(line.heading_rad));
   const int samples = std::max(1, options.footprint_samples);
+  const double nadir_column = line.columns_per_side - 0.5;
   for (int r = 0; r < line.rows; ++r) {
     for (int c = 0; c < cols; ++c) {
       double sum = 0.0;
       for (int s = 0; s < samples; ++s) {
         // The beam footprint spans about one ping spacing along track.
-        const Eigen::Vector2d p = line.position(r + (s + 0.5) / samples - 0.5, c);
-        sum += seabed.reflectivity(p.x(), p.y());
+        const double row = r + (s + 0.5) / samples - 0.5;
+        const Eigen::Vector2d p = line.position(row, c);
+        sum += seabed.backscatter(p, line.position(row, nadir_column), options.altitude_m);
       }
       const std::uint64_t h = mix(options.speckle_seed ^ mix(static_cast<std::uint64_t>(r) * 100003ULL + c));
       const double speckle = std::max(0.05, 1.0 + options.speckle_stddev * gaussian(h));

@@ -11,13 +11,32 @@
 
 namespace sss::matcher::synthetic {
 
-// Seabed reflectivity: multi-scale value noise (0.4 m to 12.8 m cells), deterministic per seed.
-// flat = true gives a texture-free seabed of constant reflectivity.
+// A raised feature (boulder) on the seabed: seen from a sonar, the half facing it is bright, the
+// far half dark, and it casts a shadow away from the sonar (length height x range / (altitude -
+// height)). Two lines on opposite sides therefore see mirror images of it.
+struct Boulder {
+  Eigen::Vector2d centre_ne_m = Eigen::Vector2d::Zero();
+  double radius_m = 1.0;
+  double height_m = 1.0;
+};
+
+// Seabed reflectivity: multi-scale value noise (0.4 m to 12.8 m cells), deterministic per seed,
+// with texture_contrast scaling its log-amplitude; flat = true gives a texture-free seabed of
+// constant reflectivity. Boulders add relief whose appearance depends on where the sonar is.
 struct Seabed {
   std::uint64_t seed = 1;
   bool flat = false;
+  double texture_contrast = 1.0;
+  std::vector<Boulder> boulders;
   double reflectivity(double north_m, double east_m) const;
+  // Backscatter of the seabed point seen from a sonar at sonar_ne_m, altitude_m above the seabed.
+  double backscatter(const Eigen::Vector2d& point_ne_m, const Eigen::Vector2d& sonar_ne_m, double altitude_m) const;
 };
+
+// Boulders of radius [min_radius_m, max_radius_m] (height = radius) at random positions in the
+// north/east box, about one per spacing_m x spacing_m, deterministic per seed.
+std::vector<Boulder> scatterBoulders(std::uint64_t seed, const Eigen::Vector2d& min_ne_m, const Eigen::Vector2d& max_ne_m,
+                                     double spacing_m, double min_radius_m, double max_radius_m);
 
 // A straight survey line: row = ping along heading, column = ground-range bin, port mirrored
 // left of nadir (columns [0, columns_per_side) port, the rest starboard).
@@ -40,6 +59,7 @@ struct RenderOptions {
   double speckle_stddev = 0.25;  // multiplicative, independent per image
   double gain = 1.0;             // overall gain (ZNCC must not care)
   int footprint_samples = 4;     // along-track sub-samples averaged per pixel (beam footprint)
+  double altitude_m = 10.0;      // of the sonar above the seabed (boulder shadows)
 };
 
 // Renders the seabed as seen from the line, geo-referenced with the TRUE positions.
