@@ -643,7 +643,7 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
 
   std::vector<Correspondence> matches;
   matches.reserve(static_cast<std::size_t>(t.overlapping_pixels));
-  std::vector<std::pair<int, int>> match_nodes, mirrored_nodes;  // forward lattice (i, j)
+  std::vector<std::pair<int, int>> mirrored_nodes;  // forward lattice (i, j) of the mirror test's rejects
   const float max_fb_sq = static_cast<float>(o.max_fb_error_px * o.max_fb_error_px);
   for (int i = 0; i < forward.rows; ++i) {
     for (int j = 0; j < forward.cols; ++j) {
@@ -707,7 +707,6 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
       match.col_b = m[1];
       match.zncc = forward.score[k];
       matches.push_back(match);
-      match_nodes.push_back({i, j});
     }
   }
   if (!mirrored_nodes.empty()) {
@@ -719,12 +718,15 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
       const cv::Rect box(j - reach, i - reach, 2 * reach + 1, 2 * reach + 1);
       near_mirrored(box & cv::Rect(0, 0, forward.cols, forward.rows)).setTo(1);
     }
-    std::vector<Correspondence> kept;
-    kept.reserve(matches.size());
-    for (std::size_t m = 0; m < matches.size(); ++m)
-      if (!near_mirrored(match_nodes[m].first, match_nodes[m].second)) kept.push_back(matches[m]);
-    t.mirrored_relief_rejected = static_cast<long>(mirrored_nodes.size() + matches.size() - kept.size());
-    matches.swap(kept);
+    // A match's A pixel is its lattice node times the stride (the lattice starts at A's origin).
+    const std::size_t before = matches.size();
+    matches.erase(std::remove_if(matches.begin(), matches.end(),
+                                 [&](const Correspondence& m) {
+                                   return near_mirrored(static_cast<int>(m.row_a) / o.stride,
+                                                        static_cast<int>(m.col_a) / o.stride) != 0;
+                                 }),
+                  matches.end());
+    t.mirrored_relief_rejected = static_cast<long>(mirrored_nodes.size() + before - matches.size());
   }
   t.consistency_s = secondsSince(stage);
   t.matches = static_cast<long>(matches.size());

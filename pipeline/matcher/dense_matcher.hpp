@@ -48,14 +48,15 @@ struct DenseMatcherOptions {
   // cannot tell (the whole field slides along it). Such patches are not matched: the ratio of the
   // small to the large eigenvalue of A's patch structure tensor must reach this (0: no check).
   double min_structure_ratio = 0.0;
-  // Raised relief seen from opposite sides: a boulder or rock shows each line the face turned
-  // towards it and casts its shadow away from it, so the two views of it are mirror images along
-  // the look direction. Their best ZNCC pairs the two bright faces, an offset of the feature's
-  // width plus its layover (h x altitude / ground range, from each side), which shortens every
-  // closure between anti-parallel lines alike. A match between two views that look in opposite
-  // directions is dropped when A's patch correlates better with B's patch mirrored along the
-  // look direction than with B's patch as it is: what survives is seabed texture that looks the
-  // same from both sides (reflectivity, sediment), which carries no such bias.
+  // Raised relief seen from opposite sides (any two lines with their overlap between them): a
+  // boulder or rock shows each line the face turned towards it and casts its shadow away from it,
+  // so the two views of it are mirror images along the look direction. Their best ZNCC pairs the
+  // two lit faces (the lines come out closer) or the two shadows (farther), and every closure
+  // between the two lines is shifted alike. A match between views whose look directions are more
+  // than 135 deg apart is dropped when A's patch correlates better with B's patch mirrored along
+  // the look direction, about any point of it, than with B's patch as it is; so are the matches
+  // whose patch overlaps such a centre. What survives is seabed texture that looks the same from
+  // both sides (reflectivity, sediment), which carries no such bias.
   bool reject_mirrored_relief = false;
   bool subpixel = true;              // parabola fit of ZNCC around the integer optimum
   double random_search_ratio = 0.5;  // Barnes et al.: window shrinks by this factor per sample

@@ -52,7 +52,7 @@ double Seabed::reflectivity(double north_m, double east_m) const {
 
 double Seabed::backscatter(const Eigen::Vector2d& point_ne_m, const Eigen::Vector2d& sonar_ne_m,
                            double altitude_m) const {
-  double value = reflectivity(point_ne_m.x(), point_ne_m.y());
+  const double value = reflectivity(point_ne_m.x(), point_ne_m.y());
   if (boulders.empty()) return value;
   const Eigen::Vector2d to_point = point_ne_m - sonar_ne_m;
   const double range_m = to_point.norm();

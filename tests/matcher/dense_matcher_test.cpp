@@ -177,12 +177,8 @@ TEST(DenseMatcher, SameMatchesForOneAndTwoThreads) {
 // A boulder field seen from two lines: 0.5 m pixels, 65 m per side, lines 60 m apart, 10 m altitude,
 // boulders of 0.6-1.4 m radius (as high), about one per 12 x 12 m (70 per hectare, as the simulator's
 // boulder fields) over the overlap, on faint texture.
-struct ReliefPair {
-  synthetic::SurveyLine line_a, line_b;
-  GeoImage a, b;
-};
-ReliefPair boulderPair(double line_spacing_m, double boulders_east_min_m) {
-  ReliefPair pair;
+Pair boulderPair(double line_spacing_m, double boulders_east_min_m) {
+  Pair pair;
   pair.line_a.rows = 160;
   pair.line_a.columns_per_side = 130;
   pair.line_a.bin_size_m = 0.5;
@@ -203,7 +199,7 @@ ReliefPair boulderPair(double line_spacing_m, double boulders_east_min_m) {
 
 // Mean error of the matches' B points along A's starboard axis (towards B): what a closure's
 // lateral offset inherits; positive = B's point lies beyond A's, the lines come out closer.
-double meanAcrossTrackError(const std::vector<Correspondence>& matches, const ReliefPair& pair) {
+double meanAcrossTrackError(const std::vector<Correspondence>& matches, const Pair& pair) {
   const Eigen::Vector2d starboard(-std::sin(pair.line_a.heading_rad), std::cos(pair.line_a.heading_rad));
   double sum = 0.0;
   for (const Correspondence& m : matches)
@@ -217,7 +213,7 @@ TEST(DenseMatcher, BouldersSeenFromOppositeSidesAreNotPairedFaceToFace) {
   // the same way. Rejecting what correlates better mirrored leaves matches without that bias.
   DenseMatcherOptions options;
   options.patch_size = 13;
-  const ReliefPair opposite = boulderPair(60.0, 0.0);
+  const Pair opposite = boulderPair(60.0, 0.0);
   MatchTimings plain_timings, rejecting_timings;
   const std::vector<Correspondence> plain = DenseMatcher(options).match(opposite.a, opposite.b, &plain_timings);
   options.reject_mirrored_relief = true;
@@ -242,7 +238,7 @@ TEST(DenseMatcher, BouldersSeenFromOppositeSidesAreNotPairedFaceToFace) {
 
   // Lines 25 m apart over boulders beyond the second line: both see them from the west, nothing is
   // mirrored and (almost) nothing dropped.
-  const ReliefPair same_side = boulderPair(25.0, 30.0);
+  const Pair same_side = boulderPair(25.0, 30.0);
   options.reject_mirrored_relief = false;
   const std::vector<Correspondence> same_side_plain = DenseMatcher(options).match(same_side.a, same_side.b);
   options.reject_mirrored_relief = true;
