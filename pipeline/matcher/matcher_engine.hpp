@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "pipeline/core/closure_types.hpp"
 #include "pipeline/core/config.hpp"
 #include "pipeline/core/pose.hpp"
 #include "pipeline/matcher/matcher_state.hpp"
@@ -42,40 +43,10 @@ struct MatcherEngineOptions {
 void readMatcherEngineOptions(sss::core::ConfigSection& section, MatcherEngineOptions& options);
 std::vector<std::string> validateMatcherEngineOptions(const MatcherEngineOptions& options);
 
-// An optimised subframe-centre pose (SSS_TRAJECTORY).
-struct TrajectoryNode {
-  int64_t subframe_id = 0;
-  int64_t utime_us = 0;
-  sss::core::Pose T_world_body;
-};
-
-// An inlier correspondence of a closure (for the bathymetric point cloud).
-struct ClosureCorrespondence {
-  int ping_index_a = 0;
-  int column_a = 0;
-  int ping_index_b = 0;
-  int column_b = 0;
-  float slant_range_a_m = 0.0f;
-  float slant_range_b_m = 0.0f;
-  Eigen::Vector3f landmark_a_m = Eigen::Vector3f::Zero();  // in A's centre-ping body frame
-};
-
-struct LoopClosure {
-  int64_t subframe_id_a = 0;  // the older subframe
-  int64_t subframe_id_b = 0;
-  int64_t centre_utime_a_us = 0;
-  int64_t centre_utime_b_us = 0;
-  sss::core::Pose T_a_b;                                         // B's centre body frame in A's
-  sss::core::Matrix6d covariance = sss::core::Matrix6d::Zero();  // [dt, dr] at T_a_b
-  int association_round = 0;                                     // 0 = DR poses
-  int num_matches = 0;
-  int num_inliers = 0;
-  double range_cost = 0.0;
-  double plane_cost = 0.0;
-  double total_cost = 0.0;
-  float mean_zncc = 0.0f;
-  std::vector<ClosureCorrespondence> correspondences;
-};
+// The closure and trajectory types are the stages' shared domain types (pipeline/core).
+using sss::core::ClosureCorrespondence;
+using sss::core::LoopClosure;
+using sss::core::TrajectoryNode;
 
 // What happened to one pair: a closure when accepted, the reason when not.
 struct PairOutcome {

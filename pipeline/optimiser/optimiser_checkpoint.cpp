@@ -189,7 +189,7 @@ Status OptimiserEngine::saveCheckpoint(const std::string& path) {
     w.put(static_cast<int32_t>(c.association_round));
     w.put(c.mean_zncc);
     w.put(static_cast<uint32_t>(c.correspondences.size()));
-    for (const sss::matcher::ClosureCorrespondence& k : c.correspondences) {
+    for (const sss::core::ClosureCorrespondence& k : c.correspondences) {
       for (int32_t v : {k.ping_index_a, k.column_a, k.ping_index_b, k.column_b}) w.put(v);
       for (float v : {k.slant_range_a_m, k.slant_range_b_m, k.landmark_a_m.x(), k.landmark_a_m.y(), k.landmark_a_m.z()})
         w.put(v);
@@ -241,7 +241,7 @@ Status OptimiserEngine::saveCheckpoint(const std::string& path) {
   w.word("waiting");
   w.integer(static_cast<int64_t>(waiting_.size()));
   w.endLine();
-  for (const sss::matcher::LoopClosure& c : waiting_) {
+  for (const sss::core::LoopClosure& c : waiting_) {
     // Raw values (a waiting closure has not been validated yet: the graph does that on arrival).
     w.word("closure");
     for (int64_t v : {c.subframe_id_a, c.subframe_id_b, c.centre_utime_a_us, c.centre_utime_b_us}) w.integer(v);
@@ -252,7 +252,7 @@ Status OptimiserEngine::saveCheckpoint(const std::string& path) {
     for (int i = 0; i < 36; ++i) w.real(c.covariance(i / 6, i % 6));
     w.integer(static_cast<int64_t>(c.correspondences.size()));
     w.endLine();
-    for (const sss::matcher::ClosureCorrespondence& m : c.correspondences) {
+    for (const sss::core::ClosureCorrespondence& m : c.correspondences) {
       w.word("c");
       for (int v : {m.ping_index_a, m.column_a, m.ping_index_b, m.column_b}) w.integer(v);
       for (float v : {m.slant_range_a_m, m.slant_range_b_m, m.landmark_a_m.x(), m.landmark_a_m.y(), m.landmark_a_m.z()})
@@ -319,9 +319,9 @@ Status OptimiserEngine::loadCheckpoint(const std::string& path) {
   if (!r.expect("waiting") || !r.integer(num_waiting) || num_waiting < 0 ||
       static_cast<uint64_t>(num_waiting) > r.remainingRecords(60))
     return fail("bad waiting record");
-  std::deque<sss::matcher::LoopClosure> waiting;
+  std::deque<sss::core::LoopClosure> waiting;
   for (int64_t i = 0; i < num_waiting; ++i) {
-    sss::matcher::LoopClosure c;
+    sss::core::LoopClosure c;
     const std::string bad = "bad waiting closure " + std::to_string(i);
     constexpr int64_t kIntMin = std::numeric_limits<int>::min(), kIntMax = std::numeric_limits<int>::max();
     if (!r.expect("closure") || !r.integer(c.subframe_id_a) || !r.integer(c.subframe_id_b) ||
@@ -339,7 +339,7 @@ Status OptimiserEngine::loadCheckpoint(const std::string& path) {
     int64_t count = 0;
     if (!r.integer(count) || count < 0 || static_cast<uint64_t>(count) > r.remainingRecords(10)) return fail(bad);
     c.correspondences.resize(static_cast<size_t>(count));
-    for (sss::matcher::ClosureCorrespondence& m : c.correspondences) {
+    for (sss::core::ClosureCorrespondence& m : c.correspondences) {
       if (!r.expect("c") || !r.boundedInt(m.ping_index_a, kIntMin, kIntMax) || !r.boundedInt(m.column_a, kIntMin, kIntMax) ||
           !r.boundedInt(m.ping_index_b, kIntMin, kIntMax) || !r.boundedInt(m.column_b, kIntMin, kIntMax) ||
           !r.single(m.slant_range_a_m) || !r.single(m.slant_range_b_m) || !r.single(m.landmark_a_m.x()) ||
@@ -417,7 +417,7 @@ Status OptimiserEngine::loadCheckpoint(const std::string& path) {
         return journalFail(where + ": malformed correspondence record");
       c.association_round = round;
       c.correspondences.resize(count);
-      for (sss::matcher::ClosureCorrespondence& m : c.correspondences) {
+      for (sss::core::ClosureCorrespondence& m : c.correspondences) {
         b.get(m.ping_index_a);
         b.get(m.column_a);
         b.get(m.ping_index_b);

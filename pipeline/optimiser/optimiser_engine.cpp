@@ -17,11 +17,11 @@ namespace {
 std::pair<int64_t, int64_t> pairKey(int64_t a, int64_t b) { return {std::min(a, b), std::max(a, b)}; }
 
 // At most `limit` correspondences, evenly spread (idempotent: a thinned list is kept as it is).
-std::vector<sss::matcher::ClosureCorrespondence> thinned(const std::vector<sss::matcher::ClosureCorrespondence>& all,
+std::vector<sss::core::ClosureCorrespondence> thinned(const std::vector<sss::core::ClosureCorrespondence>& all,
                                                          int limit) {
   const size_t count = all.size();
   const size_t keep = std::min(count, static_cast<size_t>(std::max(limit, 0)));
-  std::vector<sss::matcher::ClosureCorrespondence> out;
+  std::vector<sss::core::ClosureCorrespondence> out;
   out.reserve(keep);
   for (size_t k = 0; k < keep; ++k) out.push_back(all[k * count / keep]);
   return out;
@@ -139,8 +139,8 @@ Status OptimiserEngine::addSubframe(const sss::subframe::Subframe& subframe) {
   new_input_ = true;
 
   // Closures that were waiting for this subframe.
-  std::deque<sss::matcher::LoopClosure> still_waiting;
-  for (sss::matcher::LoopClosure& closure : waiting_) {
+  std::deque<sss::core::LoopClosure> still_waiting;
+  for (sss::core::LoopClosure& closure : waiting_) {
     const bool known = graph_.estimate(closure.subframe_id_a) && graph_.estimate(closure.subframe_id_b);
     if (known) {
       addToGraph(closure);
@@ -156,7 +156,7 @@ Status OptimiserEngine::addSubframe(const sss::subframe::Subframe& subframe) {
   return result;
 }
 
-Status OptimiserEngine::addLoopClosure(const sss::matcher::LoopClosure& closure) {
+Status OptimiserEngine::addLoopClosure(const sss::core::LoopClosure& closure) {
   ++counters_.closures_in;
   const bool known = graph_.estimate(closure.subframe_id_a) && graph_.estimate(closure.subframe_id_b);
   if (!known && std::max(closure.subframe_id_a, closure.subframe_id_b) > newest_subframe_id_ &&
@@ -180,7 +180,7 @@ Status OptimiserEngine::addFix(AbsoluteFix fix) {
   return added;
 }
 
-Status OptimiserEngine::addToGraph(const sss::matcher::LoopClosure& closure) {
+Status OptimiserEngine::addToGraph(const sss::core::LoopClosure& closure) {
   LoopClosure edge;
   edge.subframe_id_a = closure.subframe_id_a;
   edge.subframe_id_b = closure.subframe_id_b;
@@ -232,12 +232,12 @@ UpdateReport OptimiserEngine::finish() {
   return graph_.fullSmoothing();
 }
 
-std::vector<sss::matcher::TrajectoryNode> OptimiserEngine::trajectory() const {
+std::vector<sss::core::TrajectoryNode> OptimiserEngine::trajectory() const {
   const std::vector<NodeState> nodes = graph_.nodes();
   const size_t first = nodes.size() > static_cast<size_t>(options_.max_trajectory_nodes)
                            ? nodes.size() - static_cast<size_t>(options_.max_trajectory_nodes)
                            : 0;
-  std::vector<sss::matcher::TrajectoryNode> out;
+  std::vector<sss::core::TrajectoryNode> out;
   out.reserve(nodes.size() - first);
   for (size_t i = first; i < nodes.size(); ++i) {
     out.push_back({nodes[i].subframe_id, nodes[i].utime_us, nodes[i].T_world_body});
@@ -281,7 +281,7 @@ std::vector<SeabedPoint> OptimiserEngine::seabedPoints(bool use_dr) const {
     const Pose correction_a = subframeCorrection(key.first, a->second, use_dr);
     const Pose correction_b = subframeCorrection(key.second, b->second, use_dr);
     const Pose centre_a = correction_a * a->second.dr[static_cast<size_t>(a->second.centre_index)];
-    for (const sss::matcher::ClosureCorrespondence& c : stored.correspondences) {
+    for (const sss::core::ClosureCorrespondence& c : stored.correspondences) {
       if (c.ping_index_a < 0 || c.ping_index_b < 0 || c.ping_index_a >= static_cast<int>(a->second.dr.size()) ||
           c.ping_index_b >= static_cast<int>(b->second.dr.size())) {
         continue;
@@ -331,7 +331,7 @@ size_t OptimiserEngine::memoryBytes() const {
   size_t bytes = 0;
   for (const auto& [id, stored] : stored_) bytes += stored.dr.size() * (sizeof(Pose) + sizeof(int64_t));
   for (const auto& [key, stored] : correspondences_) {
-    bytes += stored.correspondences.size() * sizeof(sss::matcher::ClosureCorrespondence);
+    bytes += stored.correspondences.size() * sizeof(sss::core::ClosureCorrespondence);
   }
   return bytes + graph_.numNodes() * 1024;  // graph: ~1 kB per node (estimates, covariances, factors)
 }

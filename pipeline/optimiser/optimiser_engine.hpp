@@ -17,7 +17,7 @@
 #include "pipeline/core/config.hpp"
 #include "pipeline/core/mission_origin.hpp"
 #include "pipeline/core/pose.hpp"
-#include "pipeline/matcher/matcher_engine.hpp"
+#include "pipeline/core/closure_types.hpp"
 #include "pipeline/optimiser/bathymetry.hpp"
 #include "pipeline/optimiser/pose_graph.hpp"
 #include "pipeline/subframe/subframe_builder.hpp"
@@ -90,7 +90,7 @@ class OptimiserEngine {
   // in the Status message (for the log) and counted in odometer_resets.
   Status addSubframe(const sss::subframe::Subframe& subframe);
   // A closure from the matcher. One naming a subframe not seen yet waits (bounded) for it.
-  Status addLoopClosure(const sss::matcher::LoopClosure& closure);
+  Status addLoopClosure(const sss::core::LoopClosure& closure);
 
   // An absolute position fix (GNSS, USBL) with the DR position and distance at its time, in the
   // navigation's own distance (the odometer offset is added here, as for subframes).
@@ -104,7 +104,7 @@ class OptimiserEngine {
   bool hasNewInput() const { return new_input_; }
 
   // Optimised centre poses of the newest max_trajectory_nodes nodes (for the matcher).
-  std::vector<sss::matcher::TrajectoryNode> trajectory() const;
+  std::vector<sss::core::TrajectoryNode> trajectory() const;
   // Correction of a DR pose at utime_us: corrected = T_corrected_dr * DR.
   Correction correctionAt(int64_t utime_us) const { return graph_.correctionAt(utime_us); }
 
@@ -149,7 +149,7 @@ class OptimiserEngine {
   struct StoredCorrespondences {
     int association_round = 0;
     float mean_zncc = 0.0f;
-    std::vector<sss::matcher::ClosureCorrespondence> correspondences;
+    std::vector<sss::core::ClosureCorrespondence> correspondences;
   };
 
   // The journal that the checkpoint at `path` uses, and the records not appended to it yet.
@@ -161,7 +161,7 @@ class OptimiserEngine {
     uint64_t correspondence_records = 0;
   };
 
-  Status addToGraph(const sss::matcher::LoopClosure& closure);
+  Status addToGraph(const sss::core::LoopClosure& closure);
   // World-frame correction of a stored subframe's pings (rigid, as the matcher applies it).
   sss::core::Pose subframeCorrection(int64_t id, const StoredSubframe& stored, bool use_dr) const;
 
@@ -169,7 +169,7 @@ class OptimiserEngine {
   SlidingWindowPoseGraph graph_;
   std::map<int64_t, StoredSubframe> stored_;
   std::map<std::pair<int64_t, int64_t>, StoredCorrespondences> correspondences_;
-  std::deque<sss::matcher::LoopClosure> waiting_;
+  std::deque<sss::core::LoopClosure> waiting_;
   int64_t newest_subframe_id_ = -1;
   bool new_input_ = false;
   OptimiserEngineCounters counters_;

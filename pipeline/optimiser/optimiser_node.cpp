@@ -88,14 +88,14 @@ struct Shared {
   std::mutex mutex;
   std::condition_variable wake;
   std::deque<sss::subframe::Subframe> subframes;
-  std::deque<sss::matcher::LoopClosure> closures;
+  std::deque<sss::core::LoopClosure> closures;
   std::deque<sss::optimiser::AbsoluteFix> fixes;  // SSS_FIX, in the navigation's frame
   bool products_requested = false;
   bool stop = false;
   std::optional<sss::core::MissionOrigin> origin;  // of the navigation (SSS_NAV), for the products
   // Results.
   std::shared_ptr<const SlidingWindowPoseGraph> snapshot;  // newest solved graph (for corrections)
-  std::optional<std::vector<sss::matcher::TrajectoryNode>> trajectory;  // to publish
+  std::optional<std::vector<sss::core::TrajectoryNode>> trajectory;  // to publish
   sss::optimiser::PoseGraphCounters graph_counters;
   sss::optimiser::OptimiserEngineCounters engine_counters;
   sss::optimiser::FixCounters fix_counters;
@@ -213,7 +213,7 @@ int main(int argc, char** argv) {
     double last_update_monotonic_s = -1e9;
     for (;;) {
       std::deque<sss::subframe::Subframe> subframes;
-      std::deque<sss::matcher::LoopClosure> closures;
+      std::deque<sss::core::LoopClosure> closures;
       std::deque<sss::optimiser::AbsoluteFix> fixes;
       bool products = false;
       std::optional<sss::core::MissionOrigin> origin;
@@ -413,7 +413,7 @@ int main(int argc, char** argv) {
     shared.wake.notify_one();
   });
   loop.bus().subscribe<sss_msgs::loop_closure_t>(options.loop_channel, [&](const sss_msgs::loop_closure_t& message) {
-    sss::matcher::LoopClosure closure;
+    sss::core::LoopClosure closure;
     std::string error;
     if (!sss::matcher::fromLoopClosureMessage(message, closure, error)) {
       if (health.recordError("bad_loop_closure", error, sss::core::nowUtime()))
@@ -448,7 +448,7 @@ int main(int argc, char** argv) {
   loop.addFileDescriptor(results_fd, [&] {
     uint64_t count = 0;
     if (read(results_fd, &count, sizeof count) < 0) return;
-    std::optional<std::vector<sss::matcher::TrajectoryNode>> trajectory;
+    std::optional<std::vector<sss::core::TrajectoryNode>> trajectory;
     std::vector<std::string> messages;
     sss::optimiser::PoseGraphCounters graph_counters;
     sss::optimiser::OptimiserEngineCounters engine_counters;

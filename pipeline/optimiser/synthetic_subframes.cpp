@@ -48,7 +48,7 @@ std::vector<sss::subframe::Subframe> makeSubframes(const Mission& mission, const
   return out;
 }
 
-sss::matcher::LoopClosure makeMatcherClosure(const Mission& mission, size_t index,
+sss::core::LoopClosure makeMatcherClosure(const Mission& mission, size_t index,
                                              const std::vector<std::vector<Pose>>& truth_pings,
                                              const SubframeOptions& options, int association_round) {
   const Closure& source = mission.closures[index];
@@ -56,7 +56,7 @@ sss::matcher::LoopClosure makeMatcherClosure(const Mission& mission, size_t inde
   for (size_t i = 0; i < mission.nodes.size(); ++i) node_of[mission.nodes[i].subframe_id] = i;
   const size_t a = node_of.at(source.closure.subframe_id_a), b = node_of.at(source.closure.subframe_id_b);
 
-  sss::matcher::LoopClosure closure;
+  sss::core::LoopClosure closure;
   closure.subframe_id_a = source.closure.subframe_id_a;
   closure.subframe_id_b = source.closure.subframe_id_b;
   closure.centre_utime_a_us = mission.nodes[a].utime_us;
@@ -87,7 +87,7 @@ sss::matcher::LoopClosure makeMatcherClosure(const Mission& mission, size_t inde
     const int ping_b = centre + static_cast<int>(std::lround(along_b_m / options.ping_spacing_m));
     if (ping_b < 0 || ping_b >= n) continue;
     const Pose sonar_b = truth_pings[b][ping_b] * options.T_body_sonar;
-    sss::matcher::ClosureCorrespondence c;
+    sss::core::ClosureCorrespondence c;
     c.ping_index_a = ping_a;
     c.ping_index_b = ping_b;
     c.column_a = 1000 + static_cast<int>(std::lround((sonar_a.inverse() * point).y() / 0.5));

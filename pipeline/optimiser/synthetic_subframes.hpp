@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "pipeline/matcher/matcher_engine.hpp"
+#include "pipeline/core/closure_types.hpp"
 #include "pipeline/optimiser/synthetic_mission.hpp"
 #include "pipeline/subframe/subframe_builder.hpp"
 
@@ -26,7 +26,7 @@ std::vector<sss::subframe::Subframe> makeSubframes(const Mission& mission, const
 // The matcher's closure for mission.closures[index]: its relative pose and covariance, and
 // correspondences of seabed points between the two lines, seen from both subframes' true pings
 // (slant ranges exact, the point in A's fan plane, within half a ping spacing of B's).
-sss::matcher::LoopClosure makeMatcherClosure(const Mission& mission, size_t index,
+sss::core::LoopClosure makeMatcherClosure(const Mission& mission, size_t index,
                                              const std::vector<std::vector<sss::core::Pose>>& truth_pings,
                                              const SubframeOptions& options, int association_round = 0);
 

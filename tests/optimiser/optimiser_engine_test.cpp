@@ -57,7 +57,7 @@ struct Scenario {
   synthetic::Mission mission;
   synthetic::SubframeOptions subframe_options;
   std::vector<sss::subframe::Subframe> subframes;
-  std::vector<std::vector<sss::matcher::LoopClosure>> closures_at;  // per step, after the subframe
+  std::vector<std::vector<sss::core::LoopClosure>> closures_at;  // per step, after the subframe
 };
 
 Scenario makeScenario(int early) {
@@ -81,7 +81,7 @@ void runSteps(OptimiserEngine& engine, const Scenario& s, size_t begin, size_t e
   for (size_t i = begin; i < end; ++i) {
     const Status added = engine.addSubframe(s.subframes[i]);
     ASSERT_TRUE(added.ok) << added.message;
-    for (const sss::matcher::LoopClosure& c : s.closures_at[i]) engine.addLoopClosure(c);
+    for (const sss::core::LoopClosure& c : s.closures_at[i]) engine.addLoopClosure(c);
     ASSERT_TRUE(engine.update().ok);
   }
 }
@@ -326,7 +326,7 @@ TEST(OptimiserEngineOdometer, ResetIsAcceptedWithTheStraightLineDistanceAndClosu
     } else {
       EXPECT_TRUE(added.message.empty()) << added.message;
     }
-    for (const sss::matcher::LoopClosure& c : s.closures_at[i]) engine.addLoopClosure(c);
+    for (const sss::core::LoopClosure& c : s.closures_at[i]) engine.addLoopClosure(c);
     ASSERT_TRUE(engine.update().ok);
   }
   EXPECT_EQ(engine.counters().odometer_resets, 1u);

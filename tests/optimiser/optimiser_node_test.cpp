@@ -122,8 +122,8 @@ sss::subframe::Subframe makeSubframe(int line, int j) {
 }
 
 // The closure of A's subframe j with B's subframe 5 - j: the TRUE relative pose of the centres.
-sss::matcher::LoopClosure makeClosure(int j) {
-  sss::matcher::LoopClosure c;
+sss::core::LoopClosure makeClosure(int j) {
+  sss::core::LoopClosure c;
   c.subframe_id_a = subframeId(0, j);
   c.subframe_id_b = subframeId(1, kSubframesPerLine - 1 - j);
   c.centre_utime_a_us = centreUtime(0, j);
@@ -478,7 +478,7 @@ TEST(OptimiserNode, NavToPoseClosuresCorrectDdsCheckpointRestartAndBadInput) {
     for (double& v : zero_quaternion.rotation_ab_wxyz) v = 0.0;
     bus.publish("SSS_LOOP", zero_quaternion);
     // Decodes, but its covariance is not positive definite: the graph refuses it.
-    sss::matcher::LoopClosure singular = makeClosure(4);
+    sss::core::LoopClosure singular = makeClosure(4);
     singular.covariance.setZero();
     bus.publish("SSS_LOOP", sss::matcher::toLoopClosureMessage(singular, sss::core::nowUtime()));
     // A subframe whose image is shorter than its size says, and one whose centre pose is not finite
