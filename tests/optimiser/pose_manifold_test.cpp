@@ -2,6 +2,7 @@
 // project's boxPlus/boxMinus convention.
 #include "pipeline/optimiser/pose_manifold.hpp"
 
+#include <ceres/manifold_test_utils.h>
 #include <gtest/gtest.h>
 
 #include <random>
@@ -35,6 +36,31 @@ TEST(PoseManifold, PlusAndMinusAreBoxPlusAndBoxMinus) {
     Vector6d back;
     ASSERT_TRUE(manifold.Minus(moved.data(), px.data(), back.data()));
     EXPECT_NEAR((back - delta).norm(), 0.0, 1e-10);
+  }
+}
+
+// Ceres' own manifold invariants (Hertzberg et al.): Plus(x, 0) = x, Minus(x, x) = 0,
+// Minus(Plus(x, d), x) = d, Plus(x, Minus(y, x)) = y, both Jacobians against numeric derivatives,
+// MinusJacobian x PlusJacobian = I and RightMultiplyByPlusJacobian, at random poses. y is a
+// perturbation of x so that both name the rotation by quaternions of the same sign.
+TEST(PoseManifold, SatisfiesCeresManifoldInvariants) {
+  using namespace ceres;  // the invariant macro names ceres' Vector and matchers unqualified
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  const PoseManifold manifold;
+  for (int trial = 0; trial < 10; ++trial) {
+    const PoseParameters px = toParameters(randomPose(rng));
+    Vector delta(6), step(6);
+    for (int i = 0; i < 6; ++i) {
+      delta(i) = 0.3 * normal(rng);
+      step(i) = 0.3 * normal(rng);
+    }
+    PoseParameters py;
+    ASSERT_TRUE(manifold.Plus(px.data(), step.data(), py.data()));
+    const Vector x = Eigen::Map<const Eigen::Matrix<double, 7, 1>>(px.data());
+    const Vector y = Eigen::Map<const Eigen::Matrix<double, 7, 1>>(py.data());
+    const double tolerance = 1e-6;
+    EXPECT_THAT_MANIFOLD_INVARIANTS_HOLD(manifold, x, delta, y, tolerance);
   }
 }
 
