@@ -19,7 +19,7 @@
 
 #include "pipeline/core/state_file.hpp"
 #include "pipeline/core/time.hpp"
-#include "pipeline/matcher/loop_closure_message.hpp"
+#include "pipeline/messages/closure_messages.hpp"
 #include "pipeline/matcher/matcher_engine.hpp"
 #include "pipeline/subframe/subframe_message.hpp"
 #include "pipeline/transport/logging.hpp"
@@ -202,7 +202,7 @@ int main(int argc, char** argv) {
   loop.bus().subscribe<sss_msgs::trajectory_t>(options.trajectory_channel, [&](const sss_msgs::trajectory_t& message) {
     std::vector<sss::matcher::TrajectoryNode> nodes;
     std::string error;
-    if (!sss::matcher::fromTrajectoryMessage(message, nodes, error)) {
+    if (!sss::messages::fromTrajectoryMessage(message, nodes, error)) {
       ++rejected_messages;
       if (health.recordError("bad_trajectory", error, sss::core::nowUtime()))
         spdlog::warn("trajectory rejected: {}; further ones are counted in SSS_STATUS", error);
@@ -224,7 +224,7 @@ int main(int argc, char** argv) {
     for (const auto& [outcome, arrival] : outcomes) {
       if (outcome.accepted) {
         loop.bus().publish(options.loop_channel,
-                           sss::matcher::toLoopClosureMessage(outcome.closure, sss::core::nowUtime()), arrival);
+                           sss::messages::toLoopClosureMessage(outcome.closure, sss::core::nowUtime()), arrival);
         spdlog::info("loop closure {}-{} (round {}): {} inliers of {} matches, t = [{:.2f} {:.2f} {:.2f}] m, {:.2f} s",
                      outcome.subframe_id_a, outcome.subframe_id_b, outcome.association_round,
                      outcome.closure.num_inliers, outcome.closure.num_matches, outcome.closure.T_a_b.translation.x(),

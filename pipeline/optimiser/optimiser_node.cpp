@@ -31,7 +31,7 @@
 #include "pipeline/core/mission_origin.hpp"
 #include "pipeline/core/state_file.hpp"
 #include "pipeline/core/time.hpp"
-#include "pipeline/matcher/loop_closure_message.hpp"
+#include "pipeline/messages/closure_messages.hpp"
 #include "pipeline/optimiser/optimiser_engine.hpp"
 #include "pipeline/optimiser/correction_slew.hpp"
 #include "pipeline/optimiser/fix_message.hpp"
@@ -415,7 +415,7 @@ int main(int argc, char** argv) {
   loop.bus().subscribe<sss_msgs::loop_closure_t>(options.loop_channel, [&](const sss_msgs::loop_closure_t& message) {
     sss::core::LoopClosure closure;
     std::string error;
-    if (!sss::matcher::fromLoopClosureMessage(message, closure, error)) {
+    if (!sss::messages::fromLoopClosureMessage(message, closure, error)) {
       if (health.recordError("bad_loop_closure", error, sss::core::nowUtime()))
         spdlog::warn("loop closure rejected: {}; further ones are counted in SSS_STATUS", error);
       return;
@@ -467,7 +467,7 @@ int main(int argc, char** argv) {
     }
     for (const auto& m : messages) spdlog::info("{}", m);
     if (trajectory && !trajectory->empty()) {
-      loop.bus().publish(options.trajectory_channel, sss::matcher::toTrajectoryMessage(*trajectory, sss::core::nowUtime()));
+      loop.bus().publish(options.trajectory_channel, sss::messages::toTrajectoryMessage(*trajectory, sss::core::nowUtime()));
     }
     health.setCounter("nodes", static_cast<double>(graph_counters.nodes_added));
     health.setCounter("nodes_marginalised", static_cast<double>(graph_counters.nodes_marginalised));

@@ -18,7 +18,7 @@
 #include <thread>
 
 #include "pipeline/core/time.hpp"
-#include "pipeline/matcher/loop_closure_message.hpp"
+#include "pipeline/messages/closure_messages.hpp"
 #include "pipeline/subframe/subframe_message.hpp"
 #include "pipeline/transport/lcm_bus.hpp"
 #include "tests/support/spawn_process.hpp"
@@ -27,6 +27,11 @@
 
 namespace sss::matcher {
 namespace {
+
+using sss::messages::fromLoopClosureMessage;
+using sss::messages::toTrajectoryMessage;
+using sss::core::LoopClosure;
+using sss::core::TrajectoryNode;
 
 TEST(MatcherNode, SubframesInLoopClosuresOutBadMessagesCounted) {
   const auto& survey = test::threeLineSurvey();

@@ -29,7 +29,7 @@
 #include "pipeline/core/geodesy.hpp"
 #include "pipeline/core/pose.hpp"
 #include "pipeline/core/time.hpp"
-#include "pipeline/matcher/loop_closure_message.hpp"
+#include "pipeline/messages/closure_messages.hpp"
 #include "pipeline/subframe/subframe_message.hpp"
 #include "pipeline/transport/dds.hpp"
 #include "pipeline/transport/lcm_bus.hpp"
@@ -380,7 +380,7 @@ TEST(OptimiserNode, NavToPoseClosuresCorrectDdsCheckpointRestartAndBadInput) {
 
   // ---- 2. closures (true relative poses) -> corrected poses and trajectory ------------------------------
   for (int j = 0; j < kSubframesPerLine; ++j) {
-    bus.publish("SSS_LOOP", sss::matcher::toLoopClosureMessage(makeClosure(j), sss::core::nowUtime()));
+    bus.publish("SSS_LOOP", sss::messages::toLoopClosureMessage(makeClosure(j), sss::core::nowUtime()));
     pumpFor(0.005);
   }
   // An update with the closures: line B's nodes move onto the truth.
@@ -471,16 +471,16 @@ TEST(OptimiserNode, NavToPoseClosuresCorrectDdsCheckpointRestartAndBadInput) {
 
   // ---- 5. bad input: counted, not fatal -----------------------------------------------------------------
   {
-    sss_msgs::loop_closure_t nan_translation = sss::matcher::toLoopClosureMessage(makeClosure(2), sss::core::nowUtime());
+    sss_msgs::loop_closure_t nan_translation = sss::messages::toLoopClosureMessage(makeClosure(2), sss::core::nowUtime());
     nan_translation.translation_ab_m[1] = std::nan("");
     bus.publish("SSS_LOOP", nan_translation);
-    sss_msgs::loop_closure_t zero_quaternion = sss::matcher::toLoopClosureMessage(makeClosure(3), sss::core::nowUtime());
+    sss_msgs::loop_closure_t zero_quaternion = sss::messages::toLoopClosureMessage(makeClosure(3), sss::core::nowUtime());
     for (double& v : zero_quaternion.rotation_ab_wxyz) v = 0.0;
     bus.publish("SSS_LOOP", zero_quaternion);
     // Decodes, but its covariance is not positive definite: the graph refuses it.
     sss::core::LoopClosure singular = makeClosure(4);
     singular.covariance.setZero();
-    bus.publish("SSS_LOOP", sss::matcher::toLoopClosureMessage(singular, sss::core::nowUtime()));
+    bus.publish("SSS_LOOP", sss::messages::toLoopClosureMessage(singular, sss::core::nowUtime()));
     // A subframe whose image is shorter than its size says, and one whose centre pose is not finite
     // (decodes, refused by the graph).
     sss_msgs::subframe_t short_image = sss::subframe::toSubframeMessage(makeSubframe(1, 0), 16, 16.0);

@@ -42,7 +42,7 @@
 #include "pipeline/core/geodesy.hpp"
 #include "pipeline/core/pose.hpp"
 #include "pipeline/core/time.hpp"
-#include "pipeline/matcher/loop_closure_message.hpp"
+#include "pipeline/messages/closure_messages.hpp"
 #include "pipeline/optimiser/synthetic_mission.hpp"
 #include "pipeline/subframe/subframe_message.hpp"
 #include "pipeline/transport/dds.hpp"
@@ -141,8 +141,8 @@ sss::subframe::Subframe subframeAround(const synthetic::Node& node, int bins_per
   return sf;
 }
 
-sss::matcher::LoopClosure matcherClosure(const synthetic::Closure& c, const std::map<int64_t, int64_t>& centre_utime) {
-  sss::matcher::LoopClosure m;
+sss::core::LoopClosure matcherClosure(const synthetic::Closure& c, const std::map<int64_t, int64_t>& centre_utime) {
+  sss::core::LoopClosure m;
   m.subframe_id_a = c.closure.subframe_id_a;
   m.subframe_id_b = c.closure.subframe_id_b;
   m.centre_utime_a_us = centre_utime.at(m.subframe_id_a);
@@ -452,7 +452,7 @@ int main(int argc, char** argv) {
     ++subframes_sent;
     while (next_closure < mission.closures.size() &&
            mission.closures[next_closure].newer_node == static_cast<int>(index)) {
-      feed_bus.publish("SSS_LOOP", sss::matcher::toLoopClosureMessage(
+      feed_bus.publish("SSS_LOOP", sss::messages::toLoopClosureMessage(
                                        matcherClosure(mission.closures[next_closure++], centre_utime), sss::core::nowUtime()));
       ++closures_sent;
     }

@@ -3,15 +3,17 @@
 // lcm-gen's decode() reads its hash through an out-parameter GCC 12 cannot follow when inlined
 // into a test body at -O3: a false positive in generated code.
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#include "pipeline/matcher/loop_closure_message.hpp"
+#include "pipeline/messages/closure_messages.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
 
-namespace sss::matcher {
+namespace sss::messages {
 namespace {
+
+using sss::core::ClosureCorrespondence;
 
 LoopClosure sampleClosure() {
   LoopClosure c;
@@ -116,4 +118,4 @@ TEST(TrajectoryMessage, RoundTripsAndRejectsBadNodes) {
 }
 
 }  // namespace
-}  // namespace sss::matcher
+}  // namespace sss::messages

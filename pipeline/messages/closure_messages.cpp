@@ -1,9 +1,12 @@
-// Translation between the matcher's types and the LCM messages SSS_LOOP and SSS_TRAJECTORY.
-#include "pipeline/matcher/loop_closure_message.hpp"
+// Translation between the shared closure types and the LCM messages SSS_LOOP and SSS_TRAJECTORY.
+#include "pipeline/messages/closure_messages.hpp"
 
 #include <cmath>
 
-namespace sss::matcher {
+namespace sss::messages {
+
+using sss::core::ClosureCorrespondence;
+
 namespace {
 
 bool finite(const double* values, int count) {
@@ -164,4 +167,4 @@ bool fromTrajectoryMessage(const sss_msgs::trajectory_t& m, std::vector<Trajecto
   return true;
 }
 
-}  // namespace sss::matcher
+}  // namespace sss::messages

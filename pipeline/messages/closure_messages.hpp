@@ -1,15 +1,18 @@
-// Translation between the matcher's types and the LCM messages SSS_LOOP and SSS_TRAJECTORY. The
-// only matcher file that knows the LCM types (the optimiser uses it too).
+// Translation between the shared closure types (pipeline/core/closure_types.hpp) and the LCM
+// messages SSS_LOOP and SSS_TRAJECTORY, for the matcher and optimiser processes alike.
 #pragma once
 
 #include <string>
 #include <vector>
 
-#include "pipeline/matcher/matcher_engine.hpp"
+#include "pipeline/core/closure_types.hpp"
 #include "sss_msgs/loop_closure_t.hpp"
 #include "sss_msgs/trajectory_t.hpp"
 
-namespace sss::matcher {
+namespace sss::messages {
+
+using sss::core::LoopClosure;
+using sss::core::TrajectoryNode;
 
 sss_msgs::loop_closure_t toLoopClosureMessage(const LoopClosure& closure, int64_t utime_us);
 // False with a reason when the message is inconsistent (sizes, non-finite numbers, a zero quaternion).
@@ -19,4 +22,4 @@ sss_msgs::trajectory_t toTrajectoryMessage(const std::vector<TrajectoryNode>& no
 bool fromTrajectoryMessage(const sss_msgs::trajectory_t& message, std::vector<TrajectoryNode>& nodes,
                            std::string& error);
 
-}  // namespace sss::matcher
+}  // namespace sss::messages
