@@ -4,9 +4,6 @@
 #include <cmath>
 
 namespace sss::messages {
-
-using sss::core::ClosureCorrespondence;
-
 namespace {
 
 bool finite(const double* values, int count) {

@@ -11,6 +11,7 @@
 
 namespace sss::messages {
 
+using sss::core::ClosureCorrespondence;
 using sss::core::LoopClosure;
 using sss::core::TrajectoryNode;
 

@@ -37,17 +37,8 @@
 
 #include "pipeline/optimiser/pose_graph_internal.hpp"
 #include "pipeline/optimiser/pose_manifold.hpp"
-#include "pipeline/optimiser/variance_components.hpp"
 
 namespace sss::optimiser {
-
-using sss::core::Matrix6d;
-using sss::core::Pose;
-using sss::core::Vector6d;
-using internal::finitePose;
-using internal::firstNodeSqrtInformation;
-using internal::insAbsoluteWeights;
-using internal::normalisedPose;
 
 namespace {
 

@@ -2,24 +2,15 @@
 // estimate, pairwise consistency on DR cycles and the largest consistent set (consistent_set.hpp).
 #include "pipeline/optimiser/pose_graph.hpp"
 
-#include <ceres/ceres.h>
-
 #include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
-#include <memory>
-#include <sstream>
 
 #include "pipeline/optimiser/consistent_set.hpp"
 #include "pipeline/optimiser/pose_graph_internal.hpp"
 #include "pipeline/optimiser/pose_manifold.hpp"
 
 namespace sss::optimiser {
-
-using sss::core::Matrix6d;
-using sss::core::Pose;
-using sss::core::Vector6d;
 
 // ---- closure decisions ------------------------------------------------------------------------
 

@@ -1,16 +1,19 @@
 // Helpers the pose graph's translation units share (pose_graph.cpp, pose_graph_solve.cpp,
-// pose_graph_closures.cpp, pose_graph_options.cpp); not part of the public interface.
+// pose_graph_closures.cpp); not part of the public interface.
 #pragma once
 
 #include <cmath>
 
 #include "pipeline/optimiser/pose_graph.hpp"
 
-namespace sss::optimiser::internal {
+namespace sss::optimiser {
 
+// The names every pose-graph file uses (these files only include this header).
 using sss::core::Matrix6d;
 using sss::core::Pose;
 using sss::core::Vector6d;
+
+namespace internal {
 
 // Whitening of the first node's anchor.
 inline Matrix6d firstNodeSqrtInformation(const PoseGraphOptions& o) {
@@ -38,4 +41,11 @@ inline Pose normalisedPose(const Pose& pose) {
   return out;
 }
 
-}  // namespace sss::optimiser::internal
+}  // namespace internal
+
+using internal::finitePose;
+using internal::firstNodeSqrtInformation;
+using internal::insAbsoluteWeights;
+using internal::normalisedPose;
+
+}  // namespace sss::optimiser

@@ -1,22 +1,11 @@
 // Options of the sliding-window pose graph: validation and reading from the configuration.
 #include "pipeline/optimiser/pose_graph.hpp"
 
-#include <ceres/ceres.h>
-
-#include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
-#include <algorithm>
 #include <cmath>
-#include <memory>
-#include <sstream>
-
-#include "pipeline/optimiser/pose_graph_internal.hpp"
+#include <string>
+#include <vector>
 
 namespace sss::optimiser {
-
-using sss::core::Matrix6d;
-using sss::core::Pose;
-using sss::core::Vector6d;
 
 // ---- options ----------------------------------------------------------------------------------
 

@@ -10,8 +10,8 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <memory>
 #include <limits>
+#include <memory>
 #include <sstream>
 
 #include "pipeline/optimiser/pose_graph_internal.hpp"
@@ -20,13 +20,6 @@
 
 namespace sss::optimiser {
 
-using sss::core::Matrix6d;
-using sss::core::Pose;
-using sss::core::Vector6d;
-using internal::finitePose;
-using internal::firstNodeSqrtInformation;
-using internal::insAbsoluteWeights;
-using internal::normalisedPose;
 using Clock = std::chrono::steady_clock;
 
 namespace {

@@ -13,8 +13,6 @@
 namespace sss::messages {
 namespace {
 
-using sss::core::ClosureCorrespondence;
-
 LoopClosure sampleClosure() {
   LoopClosure c;
   c.subframe_id_a = 3;
