@@ -12,7 +12,7 @@ namespace {
 
 using sss::core::Pose;
 
-bool wellFormed(const sss::subframe::Subframe& s) {
+bool wellFormed(const sss::core::Subframe& s) {
   const size_t pixels = static_cast<size_t>(s.rows()) * static_cast<size_t>(s.cols());
   return s.rows() > 1 && s.cols() > 0 && s.image.size() == pixels && s.mask.size() == pixels &&
          s.centre_ping_index >= 0 && s.centre_ping_index < s.rows();
@@ -128,7 +128,7 @@ PairOutcome MatcherEngine::matchStored(const PairKey& key, int round) {
   return outcome;
 }
 
-std::vector<PairOutcome> MatcherEngine::addSubframe(sss::subframe::Subframe subframe) {
+std::vector<PairOutcome> MatcherEngine::addSubframe(sss::core::Subframe subframe) {
   ++counters_.subframes_in;
   std::vector<PairOutcome> outcomes;
   if (!wellFormed(subframe) || stored_.count(subframe.id)) {
@@ -237,7 +237,7 @@ RestoreReport MatcherEngine::restore(MatcherStateStore& store) {
 
   std::vector<int64_t> without_state;
   for (const int64_t id : store.subframeIds()) {  // ascending: a missing correction is inherited as when it came
-    sss::subframe::Subframe subframe;
+    sss::core::Subframe subframe;
     const StateFileStatus status = store.readSubframe(id, subframe, error);
     if (status == StateFileStatus::kMissing) continue;
     if (status == StateFileStatus::kCorrupt) {

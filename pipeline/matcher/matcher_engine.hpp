@@ -19,7 +19,7 @@
 #include "pipeline/matcher/matcher_state.hpp"
 #include "pipeline/matcher/overlap.hpp"
 #include "pipeline/matcher/pair_matcher.hpp"
-#include "pipeline/subframe/subframe_builder.hpp"
+#include "pipeline/core/subframe_types.hpp"
 
 namespace sss::matcher {
 
@@ -91,7 +91,7 @@ struct RestoreReport {
 
 // Sees every pair the engine matches (the two subframes, the association round, the dense matches
 // and their decimation), accepted or not; for evaluation tools (sss-process --write-matches).
-using PairMatchObserver = std::function<void(const sss::subframe::Subframe& a, const sss::subframe::Subframe& b,
+using PairMatchObserver = std::function<void(const sss::core::Subframe& a, const sss::core::Subframe& b,
                                              int association_round, const PairMatch& match)>;
 
 class MatcherEngine {
@@ -103,7 +103,7 @@ class MatcherEngine {
 
   // Stores the subframe and matches it against the stored subframes it overlaps under the latest
   // corrections (largest overlap first, at most overlap.max_candidates).
-  std::vector<PairOutcome> addSubframe(sss::subframe::Subframe subframe);
+  std::vector<PairOutcome> addSubframe(sss::core::Subframe subframe);
 
   // Optimised centre poses: each named subframe's correction (optimised * DR^-1 at its centre) is
   // applied to all its pings. Pairs whose relative pose moved beyond the thresholds are re-matched
@@ -132,7 +132,7 @@ class MatcherEngine {
 
  private:
   struct Stored {
-    sss::subframe::Subframe subframe;
+    sss::core::Subframe subframe;
     sss::core::Pose correction;  // world-frame: corrected = correction * DR
     std::vector<sss::core::Pose> poses;
     Footprint footprint;

@@ -21,7 +21,7 @@
 #include "pipeline/core/time.hpp"
 #include "pipeline/messages/closure_messages.hpp"
 #include "pipeline/matcher/matcher_engine.hpp"
-#include "pipeline/subframe/subframe_message.hpp"
+#include "pipeline/messages/subframe_messages.hpp"
 #include "pipeline/transport/logging.hpp"
 #include "pipeline/transport/process_loop.hpp"
 #include "pipeline/transport/process_options.hpp"
@@ -47,7 +47,7 @@ struct NodeOptions {
 struct WorkQueue {
   std::mutex mutex;
   std::condition_variable wake;
-  std::deque<std::pair<sss::subframe::Subframe, int64_t>> subframes;  // with arrival monotonic time
+  std::deque<std::pair<sss::core::Subframe, int64_t>> subframes;  // with arrival monotonic time
   std::optional<std::vector<sss::matcher::TrajectoryNode>> trajectory;
   bool stop = false;
   uint64_t dropped_subframes = 0;
@@ -153,7 +153,7 @@ int main(int argc, char** argv) {
       handOver(std::move(report.outcomes), sss::core::monotonicUtime());
     }
     for (;;) {
-      std::optional<std::pair<sss::subframe::Subframe, int64_t>> subframe;
+      std::optional<std::pair<sss::core::Subframe, int64_t>> subframe;
       std::optional<std::vector<sss::matcher::TrajectoryNode>> trajectory;
       {
         std::unique_lock<std::mutex> lock(work.mutex);
@@ -181,9 +181,9 @@ int main(int argc, char** argv) {
 
   uint64_t rejected_messages = 0;
   loop.bus().subscribe<sss_msgs::subframe_t>(options.subframe_channel, [&](const sss_msgs::subframe_t& message) {
-    sss::subframe::Subframe subframe;
+    sss::core::Subframe subframe;
     std::string error;
-    if (!sss::subframe::fromSubframeMessage(message, subframe, error)) {
+    if (!sss::messages::fromSubframeMessage(message, subframe, error)) {
       ++rejected_messages;
       if (health.recordError("bad_subframe", error, sss::core::nowUtime()))
         spdlog::warn("subframe {} rejected: {}; further ones are counted in SSS_STATUS", message.subframe_id, error);

@@ -144,7 +144,7 @@ class BinaryReader {
 };
 
 bool parseSubframeFile(const std::string& contents, const std::string& path, int64_t expected_id,
-                       sss::subframe::Subframe& subframe, std::string& error) {
+                       sss::core::Subframe& subframe, std::string& error) {
   const size_t size = contents.size();
   if (size < sizeof kSubframeMagic + kHeaderBytes + kChecksumBytes ||
       std::memcmp(contents.data(), kSubframeMagic, sizeof kSubframeMagic) != 0) {
@@ -152,7 +152,7 @@ bool parseSubframeFile(const std::string& contents, const std::string& path, int
     return false;
   }
   BinaryReader in(contents.data() + sizeof kSubframeMagic, size - sizeof kSubframeMagic);
-  subframe = sss::subframe::Subframe{};
+  subframe = sss::core::Subframe{};
   subframe.id = in.value<int64_t>();
   subframe.line_id = in.value<int32_t>();
   subframe.centre_ping_index = in.value<int32_t>();
@@ -190,7 +190,7 @@ bool parseSubframeFile(const std::string& contents, const std::string& path, int
     return false;
   }
   subframe.pings.resize(static_cast<size_t>(rows));
-  for (sss::subframe::SubframePing& ping : subframe.pings) {
+  for (sss::core::SubframePing& ping : subframe.pings) {
     ping.utime_us = in.value<int64_t>();
     ping.ping_number = in.value<int64_t>();
     ping.T_world_body = in.pose();
@@ -248,7 +248,7 @@ bool MatcherStateStore::open(std::string& error) {
   return true;
 }
 
-bool MatcherStateStore::writeSubframe(const sss::subframe::Subframe& s, std::string& error) {
+bool MatcherStateStore::writeSubframe(const sss::core::Subframe& s, std::string& error) {
   return sss::core::writeFileAtomically(
       subframePath(s.id),
       [&](FILE* file) {
@@ -262,7 +262,7 @@ bool MatcherStateStore::writeSubframe(const sss::subframe::Subframe& s, std::str
         out.value<double>(s.geometry.bin_size_m);
         out.value<double>(s.geometry.first_bin_range_m);
         out.pose(s.geometry.T_body_sonar);
-        for (const sss::subframe::SubframePing& ping : s.pings) {
+        for (const sss::core::SubframePing& ping : s.pings) {
           out.value<int64_t>(ping.utime_us);
           out.value<int64_t>(ping.ping_number);
           out.pose(ping.T_world_body);
@@ -326,7 +326,7 @@ std::vector<int64_t> MatcherStateStore::subframeIds() const {
   return ids;
 }
 
-StateFileStatus MatcherStateStore::readSubframe(int64_t subframe_id, sss::subframe::Subframe& subframe,
+StateFileStatus MatcherStateStore::readSubframe(int64_t subframe_id, sss::core::Subframe& subframe,
                                                 std::string& error) const {
   const std::string path = subframePath(subframe_id);
   std::error_code ec;

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "pipeline/core/pose.hpp"
-#include "pipeline/subframe/subframe_builder.hpp"
+#include "pipeline/core/subframe_types.hpp"
 
 namespace sss::matcher {
 
@@ -45,13 +45,13 @@ class MatcherStateStore {
   // Creates the directories and removes the temporary files a kill mid-write left behind.
   bool open(std::string& error);
 
-  bool writeSubframe(const sss::subframe::Subframe& subframe, std::string& error);
+  bool writeSubframe(const sss::core::Subframe& subframe, std::string& error);
   bool removeSubframe(int64_t subframe_id, std::string& error);
   bool writeState(const MatcherState& state, std::string& error);
 
   // Ids of the subframe files, ascending (other names are ignored).
   std::vector<int64_t> subframeIds() const;
-  StateFileStatus readSubframe(int64_t subframe_id, sss::subframe::Subframe& subframe, std::string& error) const;
+  StateFileStatus readSubframe(int64_t subframe_id, sss::core::Subframe& subframe, std::string& error) const;
   StateFileStatus readState(MatcherState& state, std::string& error) const;
 
  private:

@@ -7,8 +7,7 @@
 #include <cmath>
 #include <string>
 
-#include "pipeline/subframe/canonical_transform.hpp"
-#include "pipeline/subframe/georeference.hpp"
+#include "pipeline/core/georeference.hpp"
 
 namespace sss::matcher {
 namespace {
@@ -56,7 +55,7 @@ std::vector<std::string> validateOverlapOptions(const OverlapOptions& o) {
   return problems;
 }
 
-Footprint computeFootprint(const sss::subframe::Subframe& subframe, const std::vector<sss::core::Pose>& T_world_body,
+Footprint computeFootprint(const sss::core::Subframe& subframe, const std::vector<sss::core::Pose>& T_world_body,
                            const OverlapOptions& options) {
   Footprint footprint;
   footprint.subframe_id = subframe.id;
@@ -66,7 +65,7 @@ Footprint computeFootprint(const sss::subframe::Subframe& subframe, const std::v
   if (rows == 0 || cols == 0 || subframe.mask.size() < static_cast<size_t>(rows) * cols) return footprint;
   std::vector<cv::Point2d> port, starboard;
   auto add = [&](std::vector<cv::Point2d>& points, int row, int column) {
-    const auto p = sss::subframe::georeferencePixel(subframe.geometry, T_world_body[row], subframe.pings[row].altitude_m,
+    const auto p = sss::core::georeferencePixel(subframe.geometry, T_world_body[row], subframe.pings[row].altitude_m,
                                                     column);
     if (p) points.emplace_back(p->x(), p->y());
   };
@@ -79,12 +78,12 @@ Footprint computeFootprint(const sss::subframe::Subframe& subframe, const std::v
     // Port: columns [0, per_side), outermost first; starboard: [per_side, cols), innermost first.
     int port_outer = -1, port_inner = -1, starboard_inner = -1, starboard_outer = -1;
     for (int c = 0; c < per_side; ++c) {
-      if (mask[c] != sss::subframe::kMaskValid) continue;
+      if (mask[c] != sss::core::kMaskValid) continue;
       if (port_outer < 0) port_outer = c;
       port_inner = c;
     }
     for (int c = per_side; c < cols; ++c) {
-      if (mask[c] != sss::subframe::kMaskValid) continue;
+      if (mask[c] != sss::core::kMaskValid) continue;
       if (starboard_inner < 0) starboard_inner = c;
       starboard_outer = c;
     }

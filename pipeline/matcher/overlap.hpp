@@ -9,7 +9,7 @@
 
 #include "pipeline/core/config.hpp"
 #include "pipeline/core/pose.hpp"
-#include "pipeline/subframe/subframe_builder.hpp"
+#include "pipeline/core/subframe_types.hpp"
 
 namespace sss::matcher {
 
@@ -37,7 +37,7 @@ struct Footprint {
   cv::Rect2d bounds_ne_m;  // of both polygons (a quick rejection test)
 };
 
-Footprint computeFootprint(const sss::subframe::Subframe& subframe, const std::vector<sss::core::Pose>& T_world_body,
+Footprint computeFootprint(const sss::core::Subframe& subframe, const std::vector<sss::core::Pose>& T_world_body,
                            const OverlapOptions& options);
 
 // Area imaged by both footprints (every side of one against every side of the other).

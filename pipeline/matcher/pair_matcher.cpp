@@ -9,8 +9,7 @@
 #include <map>
 #include <sstream>
 
-#include "pipeline/subframe/canonical_transform.hpp"
-#include "pipeline/subframe/georeference.hpp"
+#include "pipeline/core/georeference.hpp"
 
 namespace sss::matcher {
 namespace {
@@ -71,13 +70,13 @@ sss::core::Matrix6d drRelativeCovariance(double distance_m, const PairMatcherOpt
   return covariance;
 }
 
-int columnDecimation(const sss::subframe::SubframeGeometry& geometry, const PairMatcherOptions& options) {
+int columnDecimation(const sss::core::SubframeGeometry& geometry, const PairMatcherOptions& options) {
   if (!(geometry.bin_size_m > 0.0)) return 1;
   const int decimation = static_cast<int>(std::lround(options.matching_bin_size_m / geometry.bin_size_m));
   return std::clamp(decimation, 1, std::max(1, geometry.bins_per_side / 16));
 }
 
-double fullResolutionColumn(const sss::subframe::SubframeGeometry& geometry, int decimation, double k) {
+double fullResolutionColumn(const sss::core::SubframeGeometry& geometry, int decimation, double k) {
   // Port matching column k < per covers bins [B - per*f + k*f, ... + f); starboard k >= per covers
   // [B + (k - per)*f, ... + f); the outermost B - per*f bins of each side are dropped.
   const int per = geometry.bins_per_side / decimation;
@@ -137,7 +136,7 @@ std::vector<Correspondence> mergeMatches(const std::vector<Correspondence>& raw,
   return merged;
 }
 
-GeoImage toGeoImage(const sss::subframe::Subframe& subframe, const std::vector<sss::core::Pose>& T_world_body,
+GeoImage toGeoImage(const sss::core::Subframe& subframe, const std::vector<sss::core::Pose>& T_world_body,
                     int decimation, double smoothing_sigma_px) {
   decimation = std::max(1, decimation);
   const int per_side = subframe.geometry.bins_per_side / decimation;
@@ -162,11 +161,11 @@ GeoImage toGeoImage(const sss::subframe::Subframe& subframe, const std::vector<s
       bool valid = true;
       for (int c = first; c < first + decimation; ++c) {
         sum += subframe.image[offset + c];
-        valid = valid && subframe.mask[offset + c] == sss::subframe::kMaskValid;
+        valid = valid && subframe.mask[offset + c] == sss::core::kMaskValid;
       }
       image.intensity(r, k) = sum / static_cast<float>(decimation);
       const auto p =
-          sss::subframe::georeferencePixel(subframe.geometry, T_world_body[r], subframe.pings[r].altitude_m, centre);
+          sss::core::georeferencePixel(subframe.geometry, T_world_body[r], subframe.pings[r].altitude_m, centre);
       if (!p) continue;
       image.position_ne_m(r, k) = cv::Vec2f(static_cast<float>(p->x()), static_cast<float>(p->y()));
       if (valid) image.valid(r, k) = 255;
@@ -184,8 +183,8 @@ GeoImage toGeoImage(const sss::subframe::Subframe& subframe, const std::vector<s
   return image;
 }
 
-PairMatch matchPair(const sss::subframe::Subframe& a, const std::vector<sss::core::Pose>& poses_a,
-                    const sss::subframe::Subframe& b, const std::vector<sss::core::Pose>& poses_b,
+PairMatch matchPair(const sss::core::Subframe& a, const std::vector<sss::core::Pose>& poses_a,
+                    const sss::core::Subframe& b, const std::vector<sss::core::Pose>& poses_b,
                     const DenseMatcher& dense, const PairMatcherOptions& options) {
   const auto start = Clock::now();
   PairMatch result;

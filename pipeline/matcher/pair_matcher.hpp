@@ -9,7 +9,7 @@
 #include "pipeline/core/pose.hpp"
 #include "pipeline/matcher/dense_matcher.hpp"
 #include "pipeline/matcher/relative_pose.hpp"
-#include "pipeline/subframe/subframe_builder.hpp"
+#include "pipeline/core/subframe_types.hpp"
 
 namespace sss::matcher {
 
@@ -96,14 +96,14 @@ std::vector<std::string> validatePairMatcherOptions(const PairMatcherOptions& op
 sss::core::Matrix6d drRelativeCovariance(double distance_m, const PairMatcherOptions& options);
 
 // Bins averaged per matching pixel for a subframe's ground-range axis (>= 1).
-int columnDecimation(const sss::subframe::SubframeGeometry& geometry, const PairMatcherOptions& options);
+int columnDecimation(const sss::core::SubframeGeometry& geometry, const PairMatcherOptions& options);
 // Full-resolution (fractional) column of the centre of matching column k.
-double fullResolutionColumn(const sss::subframe::SubframeGeometry& geometry, int decimation, double k);
+double fullResolutionColumn(const sss::core::SubframeGeometry& geometry, int decimation, double k);
 
 // The subframe's image at the matching resolution (columns averaged by `decimation`, a pixel
 // valid only when all its bins are; smoothed within the mask), every pixel geo-referenced under
 // the given per-row poses. decimation 1 and smoothing 0: the image as it is.
-GeoImage toGeoImage(const sss::subframe::Subframe& subframe, const std::vector<sss::core::Pose>& T_world_body,
+GeoImage toGeoImage(const sss::core::Subframe& subframe, const std::vector<sss::core::Pose>& T_world_body,
                     int decimation = 1, double smoothing_sigma_px = 0.0);
 
 // The image with its intensity replaced by the rectified contrast |I - masked Gaussian mean of
@@ -130,8 +130,8 @@ struct PairMatch {
 
 // Matches B against A with the given poses (one per row; DR or optimised) and estimates the
 // relative pose of B's centre ping in A's. Never throws for field data.
-PairMatch matchPair(const sss::subframe::Subframe& a, const std::vector<sss::core::Pose>& poses_a,
-                    const sss::subframe::Subframe& b, const std::vector<sss::core::Pose>& poses_b,
+PairMatch matchPair(const sss::core::Subframe& a, const std::vector<sss::core::Pose>& poses_a,
+                    const sss::core::Subframe& b, const std::vector<sss::core::Pose>& poses_b,
                     const DenseMatcher& dense, const PairMatcherOptions& options);
 
 }  // namespace sss::matcher

@@ -2,7 +2,7 @@
 // Ceres problem over T_a_b and one landmark per correspondence, inside a RANSAC loop.
 #include "pipeline/matcher/relative_pose.hpp"
 
-#include "pipeline/subframe/georeference.hpp"
+#include "pipeline/core/georeference.hpp"
 
 #include <ceres/ceres.h>
 #include <ceres/rotation.h>
@@ -558,7 +558,7 @@ RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const Re
     m.b.T_centre_sonar = T_world_bc.inverse() * ping_b->first * input.geometry.T_body_sonar;
     m.b.slant_range_m = std::sqrt(g_b * g_b + h_b * h_b);
     m.b.side = g_b < 0.0 ? -1 : 1;
-    const auto seabed = sss::subframe::georeferencePixel(input.geometry, ping_a->first, h_a, c.col_a);
+    const auto seabed = sss::core::georeferencePixel(input.geometry, ping_a->first, h_a, c.col_a);
     if (!seabed) continue;
     m.landmark_init_a = T_a_world * *seabed;
     m.down_a = down_a;

@@ -10,7 +10,7 @@
 
 #include "pipeline/core/config.hpp"
 #include "pipeline/core/pose.hpp"
-#include "pipeline/subframe/subframe_builder.hpp"
+#include "pipeline/core/subframe_types.hpp"
 #include "pipeline/matcher/dense_matcher.hpp"
 
 namespace sss::matcher {
@@ -80,7 +80,7 @@ struct RelativePoseInput {
   int centre_b = 0;
   // Ground-range axis and sonar mounting of both subframes (same vehicle and transform):
   // columns map to ground range through it, pixels to seabed points through georeferencePixel.
-  sss::subframe::SubframeGeometry geometry;
+  sss::core::SubframeGeometry geometry;
   std::vector<Correspondence> matches;
   // Of the DR relative pose between the centre poses, tangent [dt, dr] (grows with distance).
   sss::core::Matrix6d dr_covariance_ab = sss::core::Matrix6d::Identity();

@@ -80,13 +80,13 @@ bool writeTum(const std::string& path, const std::vector<StampedPose>& poses, co
 
 OptimiserEngine::OptimiserEngine(const OptimiserEngineOptions& options) : options_(options), graph_(options.graph) {}
 
-Status OptimiserEngine::addSubframe(const sss::subframe::Subframe& subframe) {
+Status OptimiserEngine::addSubframe(const sss::core::Subframe& subframe) {
   ++counters_.subframes_in;
   if (subframe.pings.empty() || subframe.centre_ping_index < 0 || subframe.centre_ping_index >= subframe.rows()) {
     ++counters_.subframes_refused;
     return Status::error("subframe " + std::to_string(subframe.id) + " has no centre ping");
   }
-  const sss::subframe::SubframePing& centre = subframe.centre();
+  const sss::core::SubframePing& centre = subframe.centre();
   const double input_m = centre.distance_travelled_m;
   if (!std::isfinite(input_m)) {
     ++counters_.subframes_refused;
@@ -126,7 +126,7 @@ Status OptimiserEngine::addSubframe(const sss::subframe::Subframe& subframe) {
   StoredSubframe& stored = stored_[subframe.id];
   stored.T_body_sonar = subframe.geometry.T_body_sonar;
   stored.centre_index = subframe.centre_ping_index;
-  for (const sss::subframe::SubframePing& ping : subframe.pings) {
+  for (const sss::core::SubframePing& ping : subframe.pings) {
     stored.utime_us.push_back(ping.utime_us);
     stored.dr.push_back(ping.T_world_body);
   }

@@ -20,7 +20,7 @@
 #include "pipeline/core/closure_types.hpp"
 #include "pipeline/optimiser/bathymetry.hpp"
 #include "pipeline/optimiser/pose_graph.hpp"
-#include "pipeline/subframe/subframe_builder.hpp"
+#include "pipeline/core/subframe_types.hpp"
 
 namespace sss::optimiser {
 
@@ -88,7 +88,7 @@ class OptimiserEngine {
   // restarted), the distance from the previous node is the horizontal straight line between their
   // DR positions, and the offset carries on from there. Such a subframe is accepted with a notice
   // in the Status message (for the log) and counted in odometer_resets.
-  Status addSubframe(const sss::subframe::Subframe& subframe);
+  Status addSubframe(const sss::core::Subframe& subframe);
   // A closure from the matcher. One naming a subframe not seen yet waits (bounded) for it.
   Status addLoopClosure(const sss::core::LoopClosure& closure);
 

@@ -39,6 +39,7 @@
 #include "products/live_products.hpp"
 #include "products/mosaic_products.hpp"
 #include "pipeline/optimiser/pose_message.hpp"
+#include "pipeline/messages/subframe_messages.hpp"
 #include "pipeline/subframe/subframe_message.hpp"
 #include "pipeline/transport/dds.hpp"
 #include "pipeline/transport/logging.hpp"
@@ -87,7 +88,7 @@ void onSigusr1(int) { g_products_requested.store(true); }
 struct Shared {
   std::mutex mutex;
   std::condition_variable wake;
-  std::deque<sss::subframe::Subframe> subframes;
+  std::deque<sss::core::Subframe> subframes;
   std::deque<sss::core::LoopClosure> closures;
   std::deque<sss::optimiser::AbsoluteFix> fixes;  // SSS_FIX, in the navigation's frame
   bool products_requested = false;
@@ -171,7 +172,7 @@ int main(int argc, char** argv) {
   sss::products::MosaicStore mosaics(sss::subframe::PictureOptions{},
                                      static_cast<size_t>(options.products_mosaic_max_mib * 1024.0 * 1024.0));
   std::vector<sss::products::SubframeFootprint> footprints;  // ~1 kB per subframe, kept all mission
-  auto keepForProducts = [&](const sss::subframe::Subframe& subframe) {
+  auto keepForProducts = [&](const sss::core::Subframe& subframe) {
     mosaics.add(subframe);  // decimated: ~1/5 of the image
     footprints.push_back(sss::products::footprintOf(subframe));
   };
@@ -212,7 +213,7 @@ int main(int argc, char** argv) {
   std::thread worker([&] {
     double last_update_monotonic_s = -1e9;
     for (;;) {
-      std::deque<sss::subframe::Subframe> subframes;
+      std::deque<sss::core::Subframe> subframes;
       std::deque<sss::core::LoopClosure> closures;
       std::deque<sss::optimiser::AbsoluteFix> fixes;
       bool products = false;
@@ -399,9 +400,9 @@ int main(int argc, char** argv) {
     }
   });
   loop.bus().subscribe<sss_msgs::subframe_t>(options.subframe_channel, [&](const sss_msgs::subframe_t& message) {
-    sss::subframe::Subframe subframe;
+    sss::core::Subframe subframe;
     std::string error;
-    if (!sss::subframe::fromSubframeMessage(message, subframe, error)) {
+    if (!sss::messages::fromSubframeMessage(message, subframe, error)) {
       if (health.recordError("bad_subframe", error, sss::core::nowUtime()))
         spdlog::warn("subframe {} rejected: {}; further ones are counted in SSS_STATUS", message.subframe_id, error);
       return;

@@ -19,13 +19,13 @@ Pose alongTrack(const Pose& centre, double offset_m) {
 
 }  // namespace
 
-std::vector<sss::subframe::Subframe> makeSubframes(const Mission& mission, const SubframeOptions& options,
+std::vector<sss::core::Subframe> makeSubframes(const Mission& mission, const SubframeOptions& options,
                                                    std::vector<std::vector<Pose>>* truth_pings) {
-  std::vector<sss::subframe::Subframe> out;
+  std::vector<sss::core::Subframe> out;
   if (truth_pings) truth_pings->clear();
   const int centre = options.pings_per_subframe / 2;
   for (const Node& node : mission.nodes) {
-    sss::subframe::Subframe subframe;
+    sss::core::Subframe subframe;
     subframe.id = node.subframe_id;
     subframe.line_id = node.line;
     subframe.centre_ping_index = centre;
@@ -33,7 +33,7 @@ std::vector<sss::subframe::Subframe> makeSubframes(const Mission& mission, const
     std::vector<Pose> truth;
     for (int i = 0; i < options.pings_per_subframe; ++i) {
       const double offset_m = (i - centre) * options.ping_spacing_m;
-      sss::subframe::SubframePing ping;
+      sss::core::SubframePing ping;
       ping.utime_us = node.utime_us + static_cast<int64_t>(std::llround(1e6 * offset_m / kSpeedMPerS));
       ping.ping_number = node.subframe_id * options.pings_per_subframe + i;
       ping.T_world_body = alongTrack(node.dr, offset_m);

@@ -6,7 +6,7 @@
 
 #include "pipeline/core/closure_types.hpp"
 #include "pipeline/optimiser/synthetic_mission.hpp"
-#include "pipeline/subframe/subframe_builder.hpp"
+#include "pipeline/core/subframe_types.hpp"
 
 namespace sss::optimiser::synthetic {
 
@@ -20,7 +20,7 @@ struct SubframeOptions {
 
 // One subframe per mission node (same id), pings along the node's heading, centre = middle ping;
 // DR pings from the node's DR pose, no image. truth_pings[k][i] is the true pose of ping i of subframe k.
-std::vector<sss::subframe::Subframe> makeSubframes(const Mission& mission, const SubframeOptions& options,
+std::vector<sss::core::Subframe> makeSubframes(const Mission& mission, const SubframeOptions& options,
                                                    std::vector<std::vector<sss::core::Pose>>* truth_pings = nullptr);
 
 // The matcher's closure for mission.closures[index]: its relative pose and covariance, and

@@ -6,19 +6,21 @@
 #include <vector>
 
 #include "pipeline/core/config.hpp"
+#include "pipeline/core/subframe_types.hpp"
 #include "pipeline/subframe/ping_nav_fusion.hpp"
 
 namespace sss::subframe {
 
-// Mask codes, equal to subframe_t's MASK_ constants.
-enum MaskCode : uint8_t {
-  kMaskValid = 0,
-  kMaskNadir = 1,
-  kMaskWaterColumn = 2,
-  kMaskFarRange = 3,
-  kMaskTurn = 4,
-  kMaskNoData = 5,
-};
+// Mask codes and the column layout are core (pipeline/core/subframe_types.hpp).
+using sss::core::MaskCode;
+using sss::core::kMaskValid;
+using sss::core::kMaskNadir;
+using sss::core::kMaskWaterColumn;
+using sss::core::kMaskFarRange;
+using sss::core::kMaskTurn;
+using sss::core::kMaskNoData;
+using sss::core::columnOf;
+using sss::core::binOf;
 
 struct CanonicalTransformOptions {
   // Ground-range axis of either side: bin k at first_bin_range_m + k * bin_size_m. 1250 x 6 cm
@@ -92,12 +94,5 @@ class CanonicalTransform {
   std::vector<double> prefix_;    // reused prefix sums of one side's samples
   std::vector<float> raw_;        // reused resampled raw row
 };
-
-// Column of a side's ground-range bin, and back.
-inline int columnOf(int bins_per_side, bool port, int bin) { return port ? bins_per_side - 1 - bin : bins_per_side + bin; }
-inline int binOf(int bins_per_side, int column, bool& port) {
-  port = column < bins_per_side;
-  return port ? bins_per_side - 1 - column : column - bins_per_side;
-}
 
 }  // namespace sss::subframe

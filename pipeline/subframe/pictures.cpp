@@ -10,7 +10,7 @@
 #include <fstream>
 #include <limits>
 
-#include "pipeline/subframe/georeference.hpp"
+#include "pipeline/core/georeference.hpp"
 
 namespace sss::subframe {
 
@@ -88,7 +88,7 @@ std::optional<MosaicRaster> renderMosaic(const std::vector<Subframe>& subframes,
       for (int c = 0; c < s.cols(); c += 2) {
         const size_t i = static_cast<size_t>(r) * s.cols() + c;
         if (s.mask[i] != kMaskValid) continue;
-        const auto p = georeferencePixel(s.geometry, pose, altitude_m, c);
+        const auto p = sss::core::georeferencePixel(s.geometry, pose, altitude_m, c);
         if (!p) continue;
         points.push_back({p->x(), p->y(), s.image[i]});
         n_min = std::min(n_min, p->x());

@@ -14,6 +14,7 @@
 #include "pipeline/core/state_file.hpp"
 #include "pipeline/core/time.hpp"
 #include "pipeline/subframe/subframe_buffer.hpp"
+#include "pipeline/messages/subframe_messages.hpp"
 #include "pipeline/subframe/subframe_message.hpp"
 #include "pipeline/transport/logging.hpp"
 #include "pipeline/transport/process_loop.hpp"
@@ -124,7 +125,7 @@ int main(int argc, char** argv) {
       }
     }
     for (const sss::subframe::Subframe& subframe : subframes) {
-      const sss_msgs::subframe_t message = sss::subframe::toSubframeMessage(
+      const sss_msgs::subframe_t message = sss::messages::toSubframeMessage(
           subframe, options.buffer.subframes.intensity_bits, options.buffer.subframes.max_intensity,
           static_cast<float>(options.horizontal_beam_width_rad), static_cast<float>(options.vertical_beam_width_rad));
       // Latency in SSS_STATUS: from the arrival of the subframe's last ping to the end of the publish.

@@ -24,12 +24,6 @@ void readSubframeOptions(sss::core::ConfigSection& section, SubframeOptions& opt
   }
 }
 
-double SubframeGeometry::signedGroundRangeM(double column) const {
-  // Column c < bins_per_side is port bin (bins_per_side - 1 - c); fractional columns follow.
-  if (column < bins_per_side) return -(first_bin_range_m + (bins_per_side - 1 - column) * bin_size_m);
-  return first_bin_range_m + (column - bins_per_side) * bin_size_m;
-}
-
 SubframeBuilder::SubframeBuilder(const LineSegmenterOptions& line_options, const SubframeOptions& options,
                                  const SubframeGeometry& geometry)
     : line_options_(line_options), options_(options), geometry_(geometry) {}

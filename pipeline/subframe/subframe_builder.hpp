@@ -7,6 +7,7 @@
 
 #include "pipeline/core/config.hpp"
 #include "pipeline/core/pose.hpp"
+#include "pipeline/core/subframe_types.hpp"
 #include "pipeline/subframe/canonical_transform.hpp"
 
 namespace sss::subframe {
@@ -29,40 +30,11 @@ struct SubframeOptions {
 void readLineSegmenterOptions(sss::core::ConfigSection& section, LineSegmenterOptions& options);
 void readSubframeOptions(sss::core::ConfigSection& section, SubframeOptions& options);
 
-// The ground-range axis and the sonar mounting of a subframe's image.
-struct SubframeGeometry {
-  int bins_per_side = 0;
-  double bin_size_m = 0.0;
-  double first_bin_range_m = 0.0;
-  sss::core::Pose T_body_sonar;
-
-  int columns() const { return 2 * bins_per_side; }
-  // Signed across-track ground range of a (fractional) column: port negative, starboard positive.
-  double signedGroundRangeM(double column) const;
-};
-
-struct SubframePing {
-  int64_t utime_us = 0;
-  int64_t ping_number = 0;
-  sss::core::Pose T_world_body;  // DR
-  double altitude_m = 0.0;       // the sonar's height above the seabed (the h of the transform)
-  double distance_travelled_m = 0.0;
-};
-
-struct Subframe {
-  int64_t id = 0;
-  int line_id = 0;
-  int centre_ping_index = 0;     // row of the centre ping
-  std::vector<SubframePing> pings;
-  SubframeGeometry geometry;
-  std::vector<float> image;      // rows = pings, columns = geometry.columns(), normalised intensity
-  std::vector<uint8_t> mask;     // MaskCode per pixel
-  int64_t last_ping_arrival_monotonic_us = 0;
-
-  int rows() const { return static_cast<int>(pings.size()); }
-  int cols() const { return geometry.columns(); }
-  const SubframePing& centre() const { return pings[centre_ping_index]; }
-};
+// The subframe types are core types (pipeline/core/subframe_types.hpp), shared with the matcher and
+// the optimiser; their short names here for the stage's own code.
+using sss::core::Subframe;
+using sss::core::SubframeGeometry;
+using sss::core::SubframePing;
 
 struct SubframeBuilderCounters {
   uint64_t pings_in = 0;

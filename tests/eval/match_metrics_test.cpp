@@ -13,7 +13,7 @@
 
 #include "pipeline/matcher/overlap.hpp"
 #include "pipeline/matcher/pair_matcher.hpp"
-#include "pipeline/subframe/georeference.hpp"
+#include "pipeline/core/georeference.hpp"
 #include "tools/process/match_writer.hpp"
 #include "tools/sim/simulated_survey.hpp"
 
@@ -36,7 +36,7 @@ TEST(ClassifyPair, SplitsByHeadingDifferenceAcrossTheWrap) {
   EXPECT_STREQ(pairTypeName(PairType::kAntiParallel), "anti_parallel");
 }
 
-double headingOf(const sss::subframe::Subframe& s) {
+double headingOf(const sss::core::Subframe& s) {
   return sss::core::eulerFromQuaternion(s.centre().T_world_body.rotation).heading_rad;
 }
 
@@ -51,12 +51,12 @@ TEST(MatchFile, EvaluationFromTheFileEqualsTheInProcessOne) {
 
   // The best-overlapping full pair of each type present (anti-parallel and crossing here).
   const sss::matcher::OverlapOptions overlap;
-  std::vector<const sss::subframe::Subframe*> full;
+  std::vector<const sss::core::Subframe*> full;
   std::vector<sss::matcher::Footprint> footprints;
   for (const auto& s : survey.subframes) {
     if (s.rows() != 200) continue;
     full.push_back(&s);
-    footprints.push_back(sss::matcher::computeFootprint(s, sss::subframe::drPoses(s), overlap));
+    footprints.push_back(sss::matcher::computeFootprint(s, sss::core::drPoses(s), overlap));
   }
   std::pair<size_t, size_t> best[kPairTypes];
   double best_area[kPairTypes] = {0.0, 0.0, 0.0};
@@ -89,7 +89,7 @@ TEST(MatchFile, EvaluationFromTheFileEqualsTheInProcessOne) {
   for (const PairType type : {PairType::kAntiParallel, PairType::kCrossing}) {
     const auto& a = *full[best[static_cast<int>(type)].first];
     const auto& b = *full[best[static_cast<int>(type)].second];
-    const auto match = sss::matcher::matchPair(a, sss::subframe::drPoses(a), b, sss::sim::posesWithDrError(a, b, 3.0, 2.0),
+    const auto match = sss::matcher::matchPair(a, sss::core::drPoses(a), b, sss::sim::posesWithDrError(a, b, 3.0, 2.0),
                                                dense, options);
     in_process.push_back(evaluateMatches(survey, a, b, match.matches, options.dense.stride, match.decimation));
     writer.addPair(a, b, 0, match);

@@ -28,7 +28,7 @@ struct Check {
 
 Check checkAgainstTruth(const std::vector<PairOutcome>& outcomes, const sss::sim::SimulatedSurvey& survey) {
   const sss::sim::SubframeTruth truth(*survey.mission);
-  auto find = [&](int64_t id) -> const sss::subframe::Subframe& {
+  auto find = [&](int64_t id) -> const sss::core::Subframe& {
     for (const auto& s : survey.subframes) {
       if (s.id == id) return s;
     }
@@ -122,7 +122,7 @@ TEST(MatcherEngine, StoredSubframesAreBoundedAndMalformedOnesRejected) {
   EXPECT_EQ(engine.storedSubframes(), 2u);
   EXPECT_EQ(engine.counters().subframes_evicted, survey.subframes.size() - 2);
   EXPECT_LT(engine.memoryBytes(), 2u * 3u * 1024u * 1024u);
-  sss::subframe::Subframe broken = survey.subframes.front();
+  sss::core::Subframe broken = survey.subframes.front();
   broken.id = 1000;
   broken.mask.pop_back();
   EXPECT_TRUE(engine.addSubframe(broken).empty());
@@ -137,7 +137,7 @@ using PairIds = std::set<std::pair<int64_t, int64_t>>;
 
 // The three-line survey's subframes: 0, 1 on line 0; 2, 3 on line 1; 4, 5 on line 2 (full, tail).
 // Line k gets k * (2 m north, 1.5 m east) of DR error, as above.
-sss::subframe::Subframe surveySubframe(int64_t id) {
+sss::core::Subframe surveySubframe(int64_t id) {
   for (auto s : test::threeLineSurvey().subframes) {
     if (s.id != id) continue;
     for (auto& ping : s.pings) ping.T_world_body.translation += s.line_id * Eigen::Vector3d(2.0, 1.5, 0.0);

@@ -19,7 +19,7 @@
 
 #include "pipeline/core/time.hpp"
 #include "pipeline/messages/closure_messages.hpp"
-#include "pipeline/subframe/subframe_message.hpp"
+#include "pipeline/messages/subframe_messages.hpp"
 #include "pipeline/transport/lcm_bus.hpp"
 #include "tests/support/spawn_process.hpp"
 #include "sss_msgs/status_t.hpp"
@@ -66,7 +66,7 @@ TEST(MatcherNode, SubframesInLoopClosuresOutBadMessagesCounted) {
   ASSERT_GT(matcher, 0);
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   // A subframe whose image is shorter than its size says, and a trajectory with a zero quaternion.
-  sss_msgs::subframe_t broken = sss::subframe::toSubframeMessage(survey.subframes.front(), 16, 16.0);
+  sss_msgs::subframe_t broken = sss::messages::toSubframeMessage(survey.subframes.front(), 16, 16.0);
   broken.num_image_bytes -= 2;
   broken.image.resize(broken.num_image_bytes);
   bus.publish("SSS_SUBFRAME", broken);
@@ -74,7 +74,7 @@ TEST(MatcherNode, SubframesInLoopClosuresOutBadMessagesCounted) {
   bad_trajectory.orientation_wxyz[0] = {0.0, 0.0, 0.0, 0.0};
   bus.publish("SSS_TRAJECTORY", bad_trajectory);
   for (const auto& subframe : survey.subframes) {
-    bus.publish("SSS_SUBFRAME", sss::subframe::toSubframeMessage(subframe, 16, 16.0, 0.0087f, 0.87f));
+    bus.publish("SSS_SUBFRAME", sss::messages::toSubframeMessage(subframe, 16, 16.0, 0.0087f, 0.87f));
     bus.handleTimeout(100);
   }
   // Three lines overlap pairwise: at least one closure per line pair, ~0.3 s per pair.
@@ -94,8 +94,8 @@ TEST(MatcherNode, SubframesInLoopClosuresOutBadMessagesCounted) {
   EXPECT_GE(rejected_in_status, 1.0);
   const sss::sim::SubframeTruth truth(*survey.mission);
   for (const LoopClosure& c : closures) {
-    const sss::subframe::Subframe* a = nullptr;
-    const sss::subframe::Subframe* b = nullptr;
+    const sss::core::Subframe* a = nullptr;
+    const sss::core::Subframe* b = nullptr;
     for (const auto& s : survey.subframes) {
       if (s.id == c.subframe_id_a) a = &s;
       if (s.id == c.subframe_id_b) b = &s;
@@ -143,7 +143,7 @@ TEST(MatcherNode, RestartAfterSigkillRestoresStateAndMatchesNewLinesAgainstOldOn
   };
   auto publish = [&](int64_t id) {
     for (const auto& subframe : survey.subframes) {
-      if (subframe.id == id) bus.publish("SSS_SUBFRAME", sss::subframe::toSubframeMessage(subframe, 16, 16.0));
+      if (subframe.id == id) bus.publish("SSS_SUBFRAME", sss::messages::toSubframeMessage(subframe, 16, 16.0));
     }
     bus.handleTimeout(100);
   };

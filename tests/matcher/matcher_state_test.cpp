@@ -22,8 +22,8 @@ namespace fs = std::filesystem;
 using sss::core::Pose;
 
 // A straight subframe flown north with every pixel different, so a misplaced byte cannot go unseen.
-sss::subframe::Subframe testSubframe(int64_t id, int rows, int bins_per_side, double east_m = 0.0) {
-  sss::subframe::Subframe s;
+sss::core::Subframe testSubframe(int64_t id, int rows, int bins_per_side, double east_m = 0.0) {
+  sss::core::Subframe s;
   s.id = id;
   s.line_id = static_cast<int>(id / 2);
   s.centre_ping_index = rows / 2;
@@ -32,7 +32,7 @@ sss::subframe::Subframe testSubframe(int64_t id, int rows, int bins_per_side, do
   s.geometry.first_bin_range_m = 0.065;
   s.geometry.T_body_sonar = Pose(sss::core::quaternionFromEuler(0.01, -0.02, 0.0), Eigen::Vector3d(0.5, 0.0, 0.3));
   for (int r = 0; r < rows; ++r) {
-    sss::subframe::SubframePing ping;
+    sss::core::SubframePing ping;
     ping.utime_us = 1700000000000000 + 250000 * (id * rows + r);
     ping.ping_number = id * rows + r;
     ping.T_world_body = Pose(sss::core::quaternionFromEuler(0.001 * r, 0.002, 0.1 + 1e-4 * r),
@@ -88,12 +88,12 @@ class MatcherStateStoreTest : public ::testing::Test {
 };
 
 TEST_F(MatcherStateStoreTest, SubframeFileRoundTripsExactly) {
-  const sss::subframe::Subframe s = testSubframe(42, 20, 30);
+  const sss::core::Subframe s = testSubframe(42, 20, 30);
   std::string error;
   ASSERT_TRUE(store_.writeSubframe(s, error)) << error;
   EXPECT_EQ(fs::file_size(store_.subframePath(42)), subframeFileBytes(20, 30));
   EXPECT_FALSE(fs::exists(store_.subframePath(42) + ".tmp"));
-  sss::subframe::Subframe back;
+  sss::core::Subframe back;
   ASSERT_EQ(store_.readSubframe(42, back, error), StateFileStatus::kOk) << error;
   EXPECT_EQ(back.id, 42);
   EXPECT_EQ(back.line_id, s.line_id);
@@ -125,7 +125,7 @@ TEST_F(MatcherStateStoreTest, EveryFlippedByteAndEveryTruncationOfASubframeFileI
   const std::string path = store_.subframePath(7);
   const std::string good = readBytes(path);
   ASSERT_EQ(good.size(), subframeFileBytes(3, 4));
-  sss::subframe::Subframe back;
+  sss::core::Subframe back;
   for (size_t i = 0; i < good.size(); ++i) {
     patchByte(path, i, static_cast<char>(good[i] ^ 0x10));
     error.clear();
@@ -227,7 +227,7 @@ TEST_F(MatcherStateStoreTest, FullSizeFiguresAndRestoreOfTenSubframes) {
   ASSERT_EQ(engine.restore(store_).subframes, 0u);
   double add_s = 0.0;
   for (int64_t id = 0; id < 10; ++id) {
-    sss::subframe::Subframe s = testSubframe(id, 200, 1250);
+    sss::core::Subframe s = testSubframe(id, 200, 1250);
     s.line_id = 0;
     const auto start = Clock::now();
     EXPECT_TRUE(engine.addSubframe(std::move(s)).empty());

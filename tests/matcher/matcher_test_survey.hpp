@@ -33,7 +33,7 @@ inline const sss::sim::SimulatedSurvey& threeLineSurvey(bool textured = true) {
 }
 
 // The first full (200-ping) subframe of a line.
-inline const sss::subframe::Subframe* fullSubframeOfLine(const sss::sim::SimulatedSurvey& survey, int line_id) {
+inline const sss::core::Subframe* fullSubframeOfLine(const sss::sim::SimulatedSurvey& survey, int line_id) {
   for (const auto& s : survey.subframes) {
     if (s.line_id == line_id && s.rows() == 200) return &s;
   }

@@ -15,15 +15,15 @@ constexpr double kAltitudeM = 10.0;
 
 // A straight 100 m subframe starting at (north, east) with the given heading, every bin valid
 // except 20 nadir bins per side.
-sss::subframe::Subframe straightSubframe(int64_t id, int line, double north_m, double east_m, double heading_rad) {
-  sss::subframe::Subframe s;
+sss::core::Subframe straightSubframe(int64_t id, int line, double north_m, double east_m, double heading_rad) {
+  sss::core::Subframe s;
   s.id = id;
   s.line_id = line;
   s.geometry.bins_per_side = kBins;
   s.geometry.bin_size_m = kBinM;
   const Eigen::Vector2d direction(std::cos(heading_rad), std::sin(heading_rad));
   for (int i = 0; i < 200; ++i) {
-    sss::subframe::SubframePing ping;
+    sss::core::SubframePing ping;
     const Eigen::Vector2d p = Eigen::Vector2d(north_m, east_m) + 0.5 * i * direction;
     ping.T_world_body = sss::core::Pose(sss::core::quaternionFromEuler(0.0, 0.0, heading_rad), Eigen::Vector3d(p.x(), p.y(), 20.0));
     ping.altitude_m = kAltitudeM;
@@ -38,13 +38,13 @@ sss::subframe::Subframe straightSubframe(int64_t id, int line, double north_m, d
   return s;
 }
 
-std::vector<sss::core::Pose> posesOf(const sss::subframe::Subframe& s) {
+std::vector<sss::core::Pose> posesOf(const sss::core::Subframe& s) {
   std::vector<sss::core::Pose> poses;
   for (const auto& p : s.pings) poses.push_back(p.T_world_body);
   return poses;
 }
 
-Footprint footprintOf(const sss::subframe::Subframe& s) { return computeFootprint(s, posesOf(s), OverlapOptions{}); }
+Footprint footprintOf(const sss::core::Subframe& s) { return computeFootprint(s, posesOf(s), OverlapOptions{}); }
 
 TEST(Overlap, FootprintAreaIsTheTwoSwathsWithoutNadir) {
   const Footprint f = footprintOf(straightSubframe(0, 0, 0.0, 0.0, 0.0));

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "pipeline/subframe/georeference.hpp"
+#include "pipeline/core/georeference.hpp"
 #include "tests/matcher/matcher_test_survey.hpp"
 
 namespace sss::matcher {
@@ -33,7 +33,7 @@ void expectPairRecoversDrError(const PairCase& pair_case) {
   PairMatcherOptions options;
   const DenseMatcher dense(options.dense);
   const PairMatch match =
-      matchPair(*a, sss::subframe::drPoses(*a), *b, sss::sim::posesWithDrError(*a, *b, pair_case.dr_along_m, pair_case.dr_lateral_m), dense, options);
+      matchPair(*a, sss::core::drPoses(*a), *b, sss::sim::posesWithDrError(*a, *b, pair_case.dr_along_m, pair_case.dr_lateral_m), dense, options);
   const test::MatchEvaluation e = test::evaluateMatches(survey, *a, *b, match.matches, options.dense.stride, match.decimation);
   const sss::sim::SubframeTruth truth(*survey.mission);
   const Pose T_true = truth.trueRelativePose(*a, *b);
@@ -105,7 +105,7 @@ TEST(PairMatcher, ImagesOfDifferentSeabedClaimedToOverlapAreRejected) {
     options.min_matches = min_matches;
     const DenseMatcher dense(options.dense);
     const PairMatch match =
-        matchPair(*a, sss::subframe::drPoses(*a), *b, sss::sim::posesWithDrError(*a, *b, 60.0, 0.0), dense, options);
+        matchPair(*a, sss::core::drPoses(*a), *b, sss::sim::posesWithDrError(*a, *b, 60.0, 0.0), dense, options);
     std::printf("wrong pair (min_matches %d): %zu matches, %s\n", min_matches, match.matches.size(),
                 match.accepted ? "accepted" : match.reason.c_str());
     EXPECT_FALSE(match.accepted);
@@ -120,7 +120,7 @@ TEST(PairMatcher, TextureFreeSeabedIsRejected) {
   ASSERT_NE(b, nullptr);
   PairMatcherOptions options;
   const DenseMatcher dense(options.dense);
-  const PairMatch match = matchPair(*a, sss::subframe::drPoses(*a), *b, sss::subframe::drPoses(*b), dense, options);
+  const PairMatch match = matchPair(*a, sss::core::drPoses(*a), *b, sss::core::drPoses(*b), dense, options);
   std::printf("texture-free seabed: %zu matches, %s\n", match.matches.size(),
               match.accepted ? "accepted" : match.reason.c_str());
   EXPECT_FALSE(match.accepted);
@@ -184,7 +184,7 @@ TEST(PairMatcher, MalformedInputIsRejectedWithAReason) {
   ASSERT_NE(a, nullptr);
   PairMatcherOptions options;
   const DenseMatcher dense(options.dense);
-  const PairMatch match = matchPair(*a, {}, *a, sss::subframe::drPoses(*a), dense, options);
+  const PairMatch match = matchPair(*a, {}, *a, sss::core::drPoses(*a), dense, options);
   EXPECT_FALSE(match.accepted);
   EXPECT_NE(match.reason.find("pose count"), std::string::npos);
 }

@@ -56,7 +56,7 @@ OptimiserEngineOptions engineOptions() {
 struct Scenario {
   synthetic::Mission mission;
   synthetic::SubframeOptions subframe_options;
-  std::vector<sss::subframe::Subframe> subframes;
+  std::vector<sss::core::Subframe> subframes;
   std::vector<std::vector<sss::core::LoopClosure>> closures_at;  // per step, after the subframe
 };
 
@@ -296,13 +296,13 @@ Scenario withOdometerReset(const Scenario& base) {
   Scenario s = base;
   const double drop_m = s.subframes[kResetNode].centre().distance_travelled_m - 50.0;
   for (size_t i = kResetNode; i < s.subframes.size(); ++i)
-    for (sss::subframe::SubframePing& ping : s.subframes[i].pings) ping.distance_travelled_m -= drop_m;
+    for (sss::core::SubframePing& ping : s.subframes[i].pings) ping.distance_travelled_m -= drop_m;
   return s;
 }
 
 double centreAte(const OptimiserEngine& engine, const Scenario& s) {
   std::vector<Pose> estimates;
-  for (const sss::subframe::Subframe& subframe : s.subframes) estimates.push_back(*engine.graph().estimate(subframe.id));
+  for (const sss::core::Subframe& subframe : s.subframes) estimates.push_back(*engine.graph().estimate(subframe.id));
   return synthetic::translationRmse(estimates, s.mission.nodes);
 }
 
@@ -361,7 +361,7 @@ TEST(OptimiserEngineOdometer, ResetIsAcceptedWithTheStraightLineDistanceAndClosu
   EXPECT_EQ(engine.graph().counters().closures_accepted, reference.graph().counters().closures_accepted);
 
   // A decrease within the tolerance is jitter: accepted, no distance, no reset.
-  sss::subframe::Subframe jitter = s.subframes.back();
+  sss::core::Subframe jitter = s.subframes.back();
   jitter.id += 100;
   for (auto& ping : jitter.pings) {
     ping.utime_us += 60'000'000;
@@ -371,7 +371,7 @@ TEST(OptimiserEngineOdometer, ResetIsAcceptedWithTheStraightLineDistanceAndClosu
   EXPECT_EQ(engine.counters().odometer_resets, 1u);
   EXPECT_EQ(engine.graph().newestNode()->distance_travelled_m, nodes.back().distance_travelled_m);
   // Non-finite is still refused.
-  sss::subframe::Subframe broken = jitter;
+  sss::core::Subframe broken = jitter;
   broken.id += 1;
   for (auto& ping : broken.pings) {
     ping.utime_us += 60'000'000;

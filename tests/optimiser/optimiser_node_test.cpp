@@ -30,7 +30,7 @@
 #include "pipeline/core/pose.hpp"
 #include "pipeline/core/time.hpp"
 #include "pipeline/messages/closure_messages.hpp"
-#include "pipeline/subframe/subframe_message.hpp"
+#include "pipeline/messages/subframe_messages.hpp"
 #include "pipeline/transport/dds.hpp"
 #include "pipeline/transport/lcm_bus.hpp"
 #include "sss_msgs/nav_t.hpp"
@@ -97,8 +97,8 @@ int64_t pingUtime(int line, int k) { return (line == 0 ? kT0 : kLineBStartUs) + 
 int64_t subframeId(int line, int j) { return line * kSubframesPerLine + j; }
 int64_t centreUtime(int line, int j) { return pingUtime(line, j * kPingsPerSubframe + kCentre); }
 
-sss::subframe::Subframe makeSubframe(int line, int j) {
-  sss::subframe::Subframe sf;
+sss::core::Subframe makeSubframe(int line, int j) {
+  sss::core::Subframe sf;
   sf.id = subframeId(line, j);
   sf.line_id = line;
   sf.centre_ping_index = kCentre;
@@ -107,7 +107,7 @@ sss::subframe::Subframe makeSubframe(int line, int j) {
   sf.geometry.first_bin_range_m = 1.0;
   for (int r = 0; r < kPingsPerSubframe; ++r) {
     const int k = j * kPingsPerSubframe + r;
-    sss::subframe::SubframePing ping;
+    sss::core::SubframePing ping;
     ping.utime_us = pingUtime(line, k);
     ping.ping_number = line * 1000 + k;
     const State s = stateAt(ping.utime_us);
@@ -353,7 +353,7 @@ TEST(OptimiserNode, NavToPoseClosuresCorrectDdsCheckpointRestartAndBadInput) {
   ASSERT_TRUE(sendNavAndWait(dr_phase));
   for (int line = 0; line < 2; ++line) {
     for (int j = 0; j < kSubframesPerLine; ++j) {
-      bus.publish("SSS_SUBFRAME", sss::subframe::toSubframeMessage(makeSubframe(line, j), 16, 16.0));
+      bus.publish("SSS_SUBFRAME", sss::messages::toSubframeMessage(makeSubframe(line, j), 16, 16.0));
       pumpFor(0.01);
     }
   }
@@ -483,15 +483,15 @@ TEST(OptimiserNode, NavToPoseClosuresCorrectDdsCheckpointRestartAndBadInput) {
     bus.publish("SSS_LOOP", sss::messages::toLoopClosureMessage(singular, sss::core::nowUtime()));
     // A subframe whose image is shorter than its size says, and one whose centre pose is not finite
     // (decodes, refused by the graph).
-    sss_msgs::subframe_t short_image = sss::subframe::toSubframeMessage(makeSubframe(1, 0), 16, 16.0);
+    sss_msgs::subframe_t short_image = sss::messages::toSubframeMessage(makeSubframe(1, 0), 16, 16.0);
     short_image.subframe_id = 100;
     short_image.num_image_bytes -= 2;
     short_image.image.resize(static_cast<size_t>(short_image.num_image_bytes));
     bus.publish("SSS_SUBFRAME", short_image);
-    sss::subframe::Subframe nan_centre = makeSubframe(1, kSubframesPerLine);
+    sss::core::Subframe nan_centre = makeSubframe(1, kSubframesPerLine);
     nan_centre.id = 101;
     nan_centre.pings[kCentre].T_world_body.translation.x() = std::nan("");
-    bus.publish("SSS_SUBFRAME", sss::subframe::toSubframeMessage(nan_centre, 16, 16.0));
+    bus.publish("SSS_SUBFRAME", sss::messages::toSubframeMessage(nan_centre, 16, 16.0));
     sss_msgs::nav_t nan_nav = makeNav(kLineBStartUs + 30'000'000 + 5, plane);
     nan_nav.position_ned_m[0] = std::nan("");
     bus.publish("SSS_NAV", nan_nav);
@@ -620,9 +620,9 @@ TEST(OptimiserNode, NavToPoseClosuresCorrectDdsCheckpointRestartAndBadInput) {
     EXPECT_LT((positionOf(p) - stateAt(t).truth.translation).norm(), kCorrectedToleranceM) << t;
   }
   // One more subframe on line B (pings 120..139): an update, after which the counters are published.
-  const sss::subframe::Subframe after_restart = makeSubframe(1, kSubframesPerLine);
+  const sss::core::Subframe after_restart = makeSubframe(1, kSubframesPerLine);
   ASSERT_EQ(after_restart.id, 12);
-  bus.publish("SSS_SUBFRAME", sss::subframe::toSubframeMessage(after_restart, 16, 16.0));
+  bus.publish("SSS_SUBFRAME", sss::messages::toSubframeMessage(after_restart, 16, 16.0));
   ASSERT_TRUE(waitFor([&] { return counterOf(second_pid, "nodes") >= 13.0; }, 10.0))
       << "no SSS_STATUS counters after the restart (nodes " << counterOf(second_pid, "nodes") << ")";
   EXPECT_EQ(counterOf(second_pid, "nodes"), 13.0);
@@ -659,7 +659,7 @@ TEST(OptimiserNode, NavToPoseClosuresCorrectDdsCheckpointRestartAndBadInput) {
   }
   std::printf("[optimiser_node_test] products: %zu poses in slam.tum\n", tum_poses.size());
   EXPECT_EQ(tum_poses.size(), static_cast<size_t>(13 * kPingsPerSubframe));
-  std::vector<sss::subframe::SubframePing> all_pings;
+  std::vector<sss::core::SubframePing> all_pings;
   for (int line = 0; line < 2; ++line)
     for (int j = 0; j < kSubframesPerLine + line; ++j)
       for (const auto& ping : makeSubframe(line, j).pings) all_pings.push_back(ping);

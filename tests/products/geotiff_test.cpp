@@ -273,12 +273,12 @@ TEST(SurveyRasters, HeightmapCellCentresAndMosaicEdgesBecomeTheRightGeotransform
 // The store behind the mosaics keeps subframes at mosaic resolution and, past its bound, only the
 // newest (the vehicle's memory is bounded; the mosaics then show the newest part of the mission).
 TEST(MosaicStore, DecimatesToTheMosaicResolutionAndKeepsTheNewestWithinItsBound) {
-  sss::subframe::Subframe subframe;
+  sss::core::Subframe subframe;
   subframe.geometry.bins_per_side = 1000;
   subframe.geometry.bin_size_m = 0.05;  // 50 m per side
   subframe.pings.resize(200);
   subframe.image.assign(static_cast<size_t>(200) * 2000, 1.0f);
-  subframe.mask.assign(subframe.image.size(), sss::subframe::kMaskValid);
+  subframe.mask.assign(subframe.image.size(), sss::core::kMaskValid);
   sss::subframe::PictureOptions pictures;  // 0.5 m: every other column of 0.25 m bins, 5 bins each
   MosaicStore unbounded(pictures, std::numeric_limits<size_t>::max());
   unbounded.add(subframe);
@@ -286,7 +286,7 @@ TEST(MosaicStore, DecimatesToTheMosaicResolutionAndKeepsTheNewestWithinItsBound)
   EXPECT_EQ(unbounded.subframes().front().geometry.bins_per_side, 200);
   EXPECT_DOUBLE_EQ(unbounded.subframes().front().geometry.bin_size_m, 0.25);
   const size_t one = unbounded.bytes();
-  EXPECT_EQ(one, 200u * 400u * 5u + 200u * sizeof(sss::subframe::SubframePing)) << "float + mask: a fifth of the 1.6 MB image";
+  EXPECT_EQ(one, 200u * 400u * 5u + 200u * sizeof(sss::core::SubframePing)) << "float + mask: a fifth of the 1.6 MB image";
 
   MosaicStore bounded(pictures, 3 * one + one / 2);
   for (int64_t id = 0; id < 10; ++id) {
@@ -299,7 +299,7 @@ TEST(MosaicStore, DecimatesToTheMosaicResolutionAndKeepsTheNewestWithinItsBound)
   EXPECT_LE(bounded.bytes(), 3 * one + one / 2);
 
   // A subframe without its image (or with a wrong-sized one) has nothing to draw and is not kept.
-  sss::subframe::Subframe no_image = subframe;
+  sss::core::Subframe no_image = subframe;
   no_image.image.clear();
   unbounded.add(no_image);
   no_image.image.assign(100, 1.0f);

@@ -43,7 +43,7 @@ class LiveProductsTest : public ::testing::Test {
     options.pings_per_subframe = 50;  // 100 m subframes of 2 m pings: the mosaics are drawn in seconds under ASan
     options.ping_spacing_m = 2.0;
     std::vector<std::vector<sss::core::Pose>> truth;
-    std::vector<sss::subframe::Subframe> subframes = synthetic::makeSubframes(mission, options, &truth);
+    std::vector<sss::core::Subframe> subframes = synthetic::makeSubframes(mission, options, &truth);
     for (auto& s : subframes) {
       // The synthetic subframes carry no image: give each a plain 60 m swath at the mosaic's 0.5 m
       // (lines 100 m apart: a 20 m strip between two lines is seen twice).
@@ -51,7 +51,7 @@ class LiveProductsTest : public ::testing::Test {
       s.geometry.bin_size_m = 0.5;
       s.geometry.first_bin_range_m = 0.0;
       s.image.assign(static_cast<size_t>(s.rows()) * s.cols(), 1.0f);
-      s.mask.assign(s.image.size(), sss::subframe::kMaskValid);
+      s.mask.assign(s.image.size(), sss::core::kMaskValid);
       ASSERT_TRUE(engine_->addSubframe(s).ok);
       mosaics_->add(s);
       footprints_.push_back(footprintOf(s));

@@ -1,6 +1,6 @@
 // Geo-referencing on a flat seabed: pixels land within one ground-range bin of the simulator's
 // ray-cast seabed point, and a bright object in the canonical image lands where it lies.
-#include "pipeline/subframe/georeference.hpp"
+#include "pipeline/core/georeference.hpp"
 
 #include <gtest/gtest.h>
 

@@ -9,7 +9,7 @@
 #include <map>
 #include <set>
 
-#include "pipeline/subframe/georeference.hpp"
+#include "pipeline/core/georeference.hpp"
 #include "tests/subframe/subframe_test_mission.hpp"
 
 namespace sss::subframe {

@@ -14,7 +14,7 @@
 #include <thread>
 
 #include "pipeline/core/time.hpp"
-#include "pipeline/subframe/subframe_message.hpp"
+#include "pipeline/messages/subframe_messages.hpp"
 #include "pipeline/transport/lcm_bus.hpp"
 #include "tests/support/spawn_process.hpp"
 
@@ -40,12 +40,12 @@ TEST(SubframeChain, SimulatedMissionThroughDriverBridgeAndBufferProcesses) {
   sss::core::HealthMonitor health(sss::core::monotonicUtime());
   sss::transport::LcmBus bus(lcm_url, health);
   ASSERT_TRUE(bus.good());
-  std::vector<Subframe> subframes;
+  std::vector<sss::core::Subframe> subframes;
   int decode_failures = 0;
   bus.subscribe<sss_msgs::subframe_t>("SSS_SUBFRAME", [&](const sss_msgs::subframe_t& message) {
-    Subframe subframe;
+    sss::core::Subframe subframe;
     std::string error;
-    if (fromSubframeMessage(message, subframe, error)) {
+    if (sss::messages::fromSubframeMessage(message, subframe, error)) {
       subframes.push_back(std::move(subframe));
     } else {
       ++decode_failures;
@@ -78,7 +78,7 @@ TEST(SubframeChain, SimulatedMissionThroughDriverBridgeAndBufferProcesses) {
 
   EXPECT_EQ(decode_failures, 0);
   ASSERT_GE(subframes.size(), 4u) << "two lines of ~400 pings give two full subframes each";
-  std::map<int, std::vector<const Subframe*>> by_line;
+  std::map<int, std::vector<const sss::core::Subframe*>> by_line;
   for (size_t i = 0; i < subframes.size(); ++i) {
     if (i > 0) {
       EXPECT_GT(subframes[i].id, subframes[i - 1].id);

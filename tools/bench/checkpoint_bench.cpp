@@ -92,7 +92,7 @@ int main(int argc, char** argv) {
   mission_options.num_lines = std::max(2, static_cast<int>(std::ceil(hours * 3600.0 / line_time_s)));
   const synthetic::Mission mission = synthetic::makeLawnmowerMission(mission_options);
   std::vector<std::vector<sss::core::Pose>> truth;
-  const std::vector<sss::subframe::Subframe> subframes = synthetic::makeSubframes(mission, subframe_options, &truth);
+  const std::vector<sss::core::Subframe> subframes = synthetic::makeSubframes(mission, subframe_options, &truth);
 
   OptimiserEngineOptions options;
   options.graph.window_size = 45;  // as sss-bench-optimiser: two 2 km lines

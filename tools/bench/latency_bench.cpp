@@ -44,7 +44,7 @@
 #include "pipeline/core/time.hpp"
 #include "pipeline/messages/closure_messages.hpp"
 #include "pipeline/optimiser/synthetic_mission.hpp"
-#include "pipeline/subframe/subframe_message.hpp"
+#include "pipeline/messages/subframe_messages.hpp"
 #include "pipeline/transport/dds.hpp"
 #include "pipeline/transport/lcm_bus.hpp"
 #include "sss_msgs/nav_t.hpp"
@@ -116,8 +116,8 @@ void printStats(const char* what, const Stats& s) {
 
 // A 200-ping subframe around a synthetic node: straight along the node's DR heading, 0.5 m per ping.
 // The image is blank but of the size the subframe buffer publishes (the optimiser decodes it all).
-sss::subframe::Subframe subframeAround(const synthetic::Node& node, int bins_per_side) {
-  sss::subframe::Subframe sf;
+sss::core::Subframe subframeAround(const synthetic::Node& node, int bins_per_side) {
+  sss::core::Subframe sf;
   sf.id = node.subframe_id;
   sf.line_id = node.line;
   sf.centre_ping_index = kPingsPerSubframe / 2;
@@ -127,7 +127,7 @@ sss::subframe::Subframe subframeAround(const synthetic::Node& node, int bins_per
   const Eigen::Vector3d forward = node.dr.rotation * Eigen::Vector3d::UnitX();
   for (int r = 0; r < kPingsPerSubframe; ++r) {
     const int offset = r - sf.centre_ping_index;
-    sss::subframe::SubframePing ping;
+    sss::core::SubframePing ping;
     ping.utime_us = node.utime_us + static_cast<int64_t>(std::llround(offset * kPingPeriodS * 1e6));
     ping.ping_number = node.subframe_id * kPingsPerSubframe + r;
     const double along_m = offset * kPingPeriodS * kSpeedMS;
@@ -448,7 +448,7 @@ int main(int argc, char** argv) {
   auto sendNode = [&]() {
     const size_t index = next_node.load();
     const synthetic::Node& node = mission.nodes[index];
-    feed_bus.publish("SSS_SUBFRAME", sss::subframe::toSubframeMessage(subframeAround(node, bins_per_side), 16, 16.0));
+    feed_bus.publish("SSS_SUBFRAME", sss::messages::toSubframeMessage(subframeAround(node, bins_per_side), 16, 16.0));
     ++subframes_sent;
     while (next_closure < mission.closures.size() &&
            mission.closures[next_closure].newer_node == static_cast<int>(index)) {

@@ -21,7 +21,7 @@
 #include "pipeline/matcher/matcher_engine.hpp"
 #include "pipeline/matcher/overlap.hpp"
 #include "pipeline/matcher/pair_matcher.hpp"
-#include "pipeline/subframe/georeference.hpp"
+#include "pipeline/core/georeference.hpp"
 #include "tools/eval/match_metrics.hpp"
 #include "tools/sim/simulated_survey.hpp"
 
@@ -93,12 +93,12 @@ int main(int argc, char** argv) {
   }
   const sss::matcher::DenseMatcher dense(options.dense);
   sss::matcher::OverlapOptions overlap;
-  std::vector<const sss::subframe::Subframe*> full;
+  std::vector<const sss::core::Subframe*> full;
   std::vector<sss::matcher::Footprint> footprints;
   for (const auto& s : survey.subframes) {
     if (s.rows() != 200) continue;
     full.push_back(&s);
-    footprints.push_back(sss::matcher::computeFootprint(s, sss::subframe::drPoses(s), overlap));
+    footprints.push_back(sss::matcher::computeFootprint(s, sss::core::drPoses(s), overlap));
   }
 
   std::vector<double> seconds, georef, kd, init, patchmatch, consistency, pose, along_err, lateral_err;
@@ -106,7 +106,7 @@ int main(int argc, char** argv) {
   using sss::eval::PairType;
   sss::eval::MatchEvaluation total, by_type[sss::eval::kPairTypes];
   long pairs_by_type[sss::eval::kPairTypes] = {0, 0, 0};
-  const auto headingOf = [](const sss::subframe::Subframe& s) {
+  const auto headingOf = [](const sss::core::Subframe& s) {
     return sss::core::eulerFromQuaternion(s.centre().T_world_body.rotation).heading_rad;
   };
   for (size_t i = 0; i < full.size(); ++i) {
@@ -118,7 +118,7 @@ int main(int argc, char** argv) {
       if (area < overlap.min_overlap_fraction * std::min(footprints[i].area_m2, footprints[j].area_m2)) continue;
       const PairType type = sss::eval::classifyPair(headingOf(a), headingOf(b));
       for (int k = 0; k < repeat; ++k) {
-        const auto match = sss::matcher::matchPair(a, sss::subframe::drPoses(a), b, sss::sim::posesWithDrError(a, b, dr_along_m, dr_lateral_m), dense,
+        const auto match = sss::matcher::matchPair(a, sss::core::drPoses(a), b, sss::sim::posesWithDrError(a, b, dr_along_m, dr_lateral_m), dense,
                                                    options);
         seconds.push_back(match.seconds);
         georef.push_back(match.georeference_s);

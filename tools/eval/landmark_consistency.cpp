@@ -1,7 +1,7 @@
 // Landmark consistency error on the flat-seabed model. See landmark_consistency.hpp.
 #include "tools/eval/landmark_consistency.hpp"
 
-#include "pipeline/subframe/georeference.hpp"
+#include "pipeline/core/georeference.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -29,7 +29,7 @@ std::optional<Eigen::Vector3d> georeferenceObservation(const Trajectory& traject
   const double altitude_m = options.seabed_depth_m - T_world_sonar.translation.z();
   if (!(altitude_m > 0.0)) return std::nullopt;
   // The same flat-seabed geometry as the pipeline's geo-reference.
-  return sss::subframe::georeferenceGroundRange(T_world_sonar, altitude_m, observation.ground_range_m);
+  return sss::core::georeferenceGroundRange(T_world_sonar, altitude_m, observation.ground_range_m);
 }
 
 LandmarkConsistencyResult landmarkConsistency(const Trajectory& trajectory,

@@ -21,7 +21,7 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr int kHalfPatchPx = 6;  // a patch must fit inside B around the true pixel
 
 // Horizontal distance between the true positions of the two pings around a fractional row of B.
-double pingSpacingM(const sss::sim::Mission& mission, const sss::subframe::Subframe& b, double row) {
+double pingSpacingM(const sss::sim::Mission& mission, const sss::core::Subframe& b, double row) {
   if (b.rows() < 2) return 0.0;
   const int r0 = std::clamp(static_cast<int>(std::floor(row)), 0, b.rows() - 2);
   const Eigen::Vector3d p0 = mission.truthAtPing(static_cast<size_t>(b.pings[r0].ping_number)).T_world_body.translation;
@@ -49,8 +49,8 @@ MatchEvaluation& MatchEvaluation::operator+=(const MatchEvaluation& other) {
   return *this;
 }
 
-MatchEvaluation evaluateMatches(const sss::sim::Mission& mission, const sss::subframe::Subframe& a,
-                                const sss::subframe::Subframe& b,
+MatchEvaluation evaluateMatches(const sss::sim::Mission& mission, const sss::core::Subframe& a,
+                                const sss::core::Subframe& b,
                                 const std::vector<sss::matcher::Correspondence>& matches, int decimation,
                                 const std::vector<std::pair<int, int>>& probes, int recall_step) {
   const sss::sim::SubframeTruth truth(mission);
@@ -88,8 +88,8 @@ MatchEvaluation evaluateMatches(const sss::sim::Mission& mission, const sss::sub
   return e;
 }
 
-MatchEvaluation evaluateMatches(const sss::sim::SimulatedSurvey& survey, const sss::subframe::Subframe& a,
-                                const sss::subframe::Subframe& b,
+MatchEvaluation evaluateMatches(const sss::sim::SimulatedSurvey& survey, const sss::core::Subframe& a,
+                                const sss::core::Subframe& b,
                                 const std::vector<sss::matcher::Correspondence>& matches, int stride, int decimation,
                                 int recall_step) {
   return evaluateMatches(*survey.mission, a, b, matches, decimation,
@@ -279,7 +279,7 @@ bool evaluateMatchFile(const std::string& matches_path, const std::string& missi
     error = matches_path + ": parameters out of range (bins_per_side, bin_size_m, decimation, stride, probe_step)";
     return false;
   }
-  sss::subframe::SubframeGeometry geometry;
+  sss::core::SubframeGeometry geometry;
   geometry.bins_per_side = static_cast<int>(bins);
   geometry.bin_size_m = bin_size;
   geometry.first_bin_range_m = first_bin;
@@ -317,13 +317,13 @@ bool evaluateMatchFile(const std::string& matches_path, const std::string& missi
   const sss::sim::Mission mission(sim);
 
   // Subframes as the truth needs them: mission ping of every row, altitudes, geometry, mask.
-  std::map<int64_t, sss::subframe::Subframe> subframes;
+  std::map<int64_t, sss::core::Subframe> subframes;
   const double rate_hz = sim.sonar.ping_rate_hz;
   for (const auto& [id, rows] : pings) {
-    sss::subframe::Subframe& s = subframes[id];
+    sss::core::Subframe& s = subframes[id];
     s.id = id;
     s.geometry = geometry;
-    s.mask.assign(rows.size() * static_cast<size_t>(geometry.columns()), sss::subframe::kMaskNadir);
+    s.mask.assign(rows.size() * static_cast<size_t>(geometry.columns()), sss::core::kMaskNadir);
     for (size_t r = 0; r < rows.size(); ++r) {
       if (!rows[r].present) {
         error = matches_path + ": subframe " + std::to_string(id) + " has no ping row " + std::to_string(r);
@@ -337,7 +337,7 @@ bool evaluateMatchFile(const std::string& matches_path, const std::string& missi
                 " is not a ping time of the mission in " + mission_dir + "; is it the right mission?";
         return false;
       }
-      sss::subframe::SubframePing p;
+      sss::core::SubframePing p;
       p.utime_us = rows[r].utime_us;
       p.ping_number = ping;
       p.altitude_m = rows[r].altitude_m;
@@ -349,7 +349,7 @@ bool evaluateMatchFile(const std::string& matches_path, const std::string& missi
           return false;
         }
         std::fill(s.mask.begin() + static_cast<long>(r * geometry.columns() + first),
-                  s.mask.begin() + static_cast<long>(r * geometry.columns() + last + 1), sss::subframe::kMaskValid);
+                  s.mask.begin() + static_cast<long>(r * geometry.columns() + last + 1), sss::core::kMaskValid);
       }
     }
   }

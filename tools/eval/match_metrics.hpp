@@ -13,7 +13,7 @@ namespace sss::sim {
 class Mission;
 struct SimulatedSurvey;
 }  // namespace sss::sim
-namespace sss::subframe {
+namespace sss::core {
 struct Subframe;
 }
 namespace sss::matcher {
@@ -75,13 +75,13 @@ inline std::vector<std::pair<int, int>> recallProbes(int rows, int cols, const s
 // the true ping spacing) and ground-range error. Recall = matches within 2 px over the matchable
 // probes scaled back to the stride grid (bounded ray casts). Subframe pings' ping_number must be
 // the mission's ping index.
-MatchEvaluation evaluateMatches(const sss::sim::Mission& mission, const sss::subframe::Subframe& a,
-                                const sss::subframe::Subframe& b,
+MatchEvaluation evaluateMatches(const sss::sim::Mission& mission, const sss::core::Subframe& a,
+                                const sss::core::Subframe& b,
                                 const std::vector<sss::matcher::Correspondence>& matches, int decimation,
                                 const std::vector<std::pair<int, int>>& probes, int recall_step);
 // The same with the probes of A's mask.
-MatchEvaluation evaluateMatches(const sss::sim::SimulatedSurvey& survey, const sss::subframe::Subframe& a,
-                                const sss::subframe::Subframe& b,
+MatchEvaluation evaluateMatches(const sss::sim::SimulatedSurvey& survey, const sss::core::Subframe& a,
+                                const sss::core::Subframe& b,
                                 const std::vector<sss::matcher::Correspondence>& matches, int stride, int decimation,
                                 int recall_step = 4);
 

@@ -21,7 +21,7 @@ double headingOf(const sss::core::Pose& T_world_body) {
 }
 
 // Time and altitude of a fractional row, linear between its two pings.
-void interpolateRow(const sss::subframe::Subframe& s, double row, int64_t& utime_us, double& altitude_m) {
+void interpolateRow(const sss::core::Subframe& s, double row, int64_t& utime_us, double& altitude_m) {
   const int r0 = std::clamp(static_cast<int>(std::floor(row)), 0, std::max(0, s.rows() - 2));
   const int r1 = std::min(r0 + 1, s.rows() - 1);
   const double alpha = row - r0;
@@ -50,7 +50,7 @@ bool MatchCsvWriter::open(const std::string& path, int stride, int probe_step, s
   return true;
 }
 
-void MatchCsvWriter::writePreamble(const sss::subframe::SubframeGeometry& g, int decimation) {
+void MatchCsvWriter::writePreamble(const sss::core::SubframeGeometry& g, int decimation) {
   const Eigen::Vector3d& t = g.T_body_sonar.translation;
   const Eigen::Quaterniond& q = g.T_body_sonar.rotation;
   std::fprintf(file_,
@@ -66,7 +66,7 @@ void MatchCsvWriter::writePreamble(const sss::subframe::SubframeGeometry& g, int
   preamble_written_ = true;
 }
 
-void MatchCsvWriter::writePings(const sss::subframe::Subframe& s) {
+void MatchCsvWriter::writePings(const sss::core::Subframe& s) {
   if (!subframes_written_.insert(s.id).second) return;
   const int cols = s.cols();
   std::string runs;
@@ -90,7 +90,7 @@ void MatchCsvWriter::writePings(const sss::subframe::Subframe& s) {
   }
 }
 
-void MatchCsvWriter::addPair(const sss::subframe::Subframe& a, const sss::subframe::Subframe& b, int association_round,
+void MatchCsvWriter::addPair(const sss::core::Subframe& a, const sss::core::Subframe& b, int association_round,
                              const sss::matcher::PairMatch& match) {
   if (!file_ || a.rows() < 2 || b.rows() < 2) return;
   if (!preamble_written_) writePreamble(a.geometry, match.decimation);

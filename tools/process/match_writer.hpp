@@ -37,14 +37,14 @@ class MatchCsvWriter {
   // Creates the file; false with a message.
   bool open(const std::string& path, int stride, int probe_step, std::string& error);
   // One pair of one association round (rows of subframes not written yet, matches, probes).
-  void addPair(const sss::subframe::Subframe& a, const sss::subframe::Subframe& b, int association_round,
+  void addPair(const sss::core::Subframe& a, const sss::core::Subframe& b, int association_round,
                const sss::matcher::PairMatch& match);
   // Flushes and closes; false with a message when anything failed to write.
   bool close(std::string& error);
 
  private:
-  void writePreamble(const sss::subframe::SubframeGeometry& geometry, int decimation);
-  void writePings(const sss::subframe::Subframe& subframe);
+  void writePreamble(const sss::core::SubframeGeometry& geometry, int decimation);
+  void writePings(const sss::core::Subframe& subframe);
 
   std::FILE* file_ = nullptr;
   std::string path_;

@@ -875,7 +875,7 @@ class Runner {
   // matches.csv: the matcher engine shows every matched pair to the writer.
   bool openMatchWriter(std::string& error) {
     if (!match_writer_.open(request_.out_dir + "/matches.csv", options_.matcher.pair.dense.stride, 4, error)) return false;
-    matcher_.setPairMatchObserver([this](const sss::subframe::Subframe& a, const sss::subframe::Subframe& b, int round,
+    matcher_.setPairMatchObserver([this](const sss::core::Subframe& a, const sss::core::Subframe& b, int round,
                                          const sss::matcher::PairMatch& match) {
       match_writer_.addPair(a, b, round, match);
     });
@@ -959,7 +959,7 @@ class Runner {
   // (re-association, new overlaps) and what that finds is optimised at once, as the live chain
   // does asynchronously.
   void handleSubframes() {
-    for (sss::subframe::Subframe& subframe : subframes_) {
+    for (sss::core::Subframe& subframe : subframes_) {
       ++summary_.subframes;
       centres_.push_back({subframe.line_id, subframe.centre().T_world_body});
       footprints_.push_back(sss::products::footprintOf(subframe));
@@ -977,7 +977,7 @@ class Runner {
   sss::subframe::SubframeBuffer buffer_;
   sss::matcher::MatcherEngine matcher_;
   sss::optimiser::OptimiserEngine optimiser_;
-  std::vector<sss::subframe::Subframe> subframes_;  // reused
+  std::vector<sss::core::Subframe> subframes_;  // reused
   sss::products::MosaicStore mosaic_store_;  // every subframe at mosaic resolution (no bound offline)
   std::vector<std::pair<int, sss::core::Pose>> centres_;  // line id and DR centre pose of every subframe
   std::vector<sss::products::SubframeFootprint> footprints_;  // of every subframe, for GeoJSON and coverage

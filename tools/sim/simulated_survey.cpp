@@ -12,7 +12,7 @@ namespace {
 
 using sss::subframe::NavInput;
 using sss::subframe::PingInput;
-using sss::subframe::Subframe;
+using sss::core::Subframe;
 
 }  // namespace
 
@@ -132,7 +132,7 @@ std::optional<Eigen::Vector2d> SubframeTruth::pixelOf(const Subframe& subframe, 
       if (slant_m <= altitude_m) return std::nullopt;
       const double ground_m = std::sqrt(slant_m * slant_m - altitude_m * altitude_m);
       const bool starboard = (pose.rotation * Eigen::Vector3d::UnitY()).dot(offset) >= 0.0;
-      const sss::subframe::SubframeGeometry& g = subframe.geometry;
+      const sss::core::SubframeGeometry& g = subframe.geometry;
       const double bin = (ground_m - g.first_bin_range_m) / g.bin_size_m;
       const double column = starboard ? g.bins_per_side + bin : g.bins_per_side - 1 - bin;
       if (column < 0.0 || column > g.columns() - 1) return std::nullopt;

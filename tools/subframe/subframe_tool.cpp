@@ -20,6 +20,7 @@
 #include "pipeline/core/time.hpp"
 #include "pipeline/subframe/pictures.hpp"
 #include "pipeline/subframe/subframe_buffer.hpp"
+#include "pipeline/messages/subframe_messages.hpp"
 #include "pipeline/subframe/subframe_message.hpp"
 
 namespace {
@@ -91,13 +92,13 @@ int main(int argc, char** argv) {
   sss::edgetech::SonarDriver driver(driver_options);
 
   sss::subframe::SubframeBuffer buffer(options);
-  std::vector<sss::subframe::Subframe> all, out;
+  std::vector<sss::core::Subframe> all, out;
   std::vector<int64_t> latency_us;
   int64_t cpu_us = 0;
   size_t max_memory = 0, nav_index = 0, message_bytes = 0;
   auto collect = [&] {
-    for (sss::subframe::Subframe& s : out) {
-      const sss_msgs::subframe_t message = sss::subframe::toSubframeMessage(s, options.subframes.intensity_bits,
+    for (sss::core::Subframe& s : out) {
+      const sss_msgs::subframe_t message = sss::messages::toSubframeMessage(s, options.subframes.intensity_bits,
                                                                             options.subframes.max_intensity);
       std::vector<uint8_t> encoded(static_cast<size_t>(message.getEncodedSize()));
       message.encode(encoded.data(), 0, static_cast<int>(encoded.size()));

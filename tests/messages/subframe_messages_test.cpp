@@ -1,16 +1,16 @@
 // SSS_SUBFRAME translation: quantisation round trip (8 and 16 bits), geometry, poses and masks.
-#include "pipeline/subframe/subframe_message.hpp"
+#include "pipeline/messages/subframe_messages.hpp"
 
 #include <gtest/gtest.h>
 
-namespace sss::subframe {
+namespace sss::messages {
 namespace {
 
 Subframe smallSubframe() {
   Subframe s;
   s.id = 7;
   s.line_id = 2;
-  s.geometry = SubframeGeometry{3, 0.1, 0.5, sss::core::Pose(sss::core::quaternionFromEuler(0.0, 0.1, 0.0), Eigen::Vector3d(1, 0, 0.5))};
+  s.geometry = sss::core::SubframeGeometry{3, 0.1, 0.5, sss::core::Pose(sss::core::quaternionFromEuler(0.0, 0.1, 0.0), Eigen::Vector3d(1, 0, 0.5))};
   for (int r = 0; r < 4; ++r) {
     SubframePing p;
     p.utime_us = 1000 + r;
@@ -22,7 +22,7 @@ Subframe smallSubframe() {
   s.centre_ping_index = 2;
   for (int i = 0; i < 24; ++i) {
     s.image.push_back(0.1f * i);
-    s.mask.push_back(i % 6 == 0 ? kMaskNadir : kMaskValid);
+    s.mask.push_back(i % 6 == 0 ? sss::core::kMaskNadir : sss::core::kMaskValid);
   }
   return s;
 }
@@ -59,4 +59,4 @@ TEST(SubframeMessage, RejectsInconsistentSizes) {
 }
 
 }  // namespace
-}  // namespace sss::subframe
+}  // namespace sss::messages

@@ -1,11 +1,11 @@
 // Flat-seabed geo-referencing of canonical pixels. See georeference.hpp.
-#include "pipeline/subframe/georeference.hpp"
+#include "pipeline/core/georeference.hpp"
 
 #include <cmath>
 
-namespace sss::subframe {
+namespace sss::core {
 
-std::optional<Eigen::Vector3d> georeferenceGroundRange(const sss::core::Pose& T_world_sonar, double altitude_m,
+std::optional<Eigen::Vector3d> georeferenceGroundRange(const Pose& T_world_sonar, double altitude_m,
                                                        double signed_ground_range_m) {
   const Eigen::Vector3d origin = T_world_sonar.translation;
   const Eigen::Vector3d normal = T_world_sonar.rotation * Eigen::Vector3d::UnitX();
@@ -29,23 +29,23 @@ std::optional<Eigen::Vector3d> georeferenceGroundRange(const sss::core::Pose& T_
   return Eigen::Vector3d(origin + h * down + t * w + s * v);
 }
 
-std::optional<Eigen::Vector3d> georeferencePixel(const SubframeGeometry& geometry, const sss::core::Pose& T_world_body,
+std::optional<Eigen::Vector3d> georeferencePixel(const SubframeGeometry& geometry, const Pose& T_world_body,
                                                  double altitude_m, double column) {
   return georeferenceGroundRange(T_world_body * geometry.T_body_sonar, altitude_m, geometry.signedGroundRangeM(column));
 }
 
 std::optional<Eigen::Vector3d> georeferencePixel(const Subframe& subframe,
-                                                 const std::vector<sss::core::Pose>& T_world_body, int row,
+                                                 const std::vector<Pose>& T_world_body, int row,
                                                  double column) {
   if (row < 0 || row >= subframe.rows() || row >= static_cast<int>(T_world_body.size())) return std::nullopt;
   return georeferencePixel(subframe.geometry, T_world_body[row], subframe.pings[row].altitude_m, column);
 }
 
-std::vector<sss::core::Pose> drPoses(const Subframe& subframe) {
-  std::vector<sss::core::Pose> poses;
+std::vector<Pose> drPoses(const Subframe& subframe) {
+  std::vector<Pose> poses;
   poses.reserve(subframe.pings.size());
   for (const SubframePing& p : subframe.pings) poses.push_back(p.T_world_body);
   return poses;
 }
 
-}  // namespace sss::subframe
+}  // namespace sss::core
