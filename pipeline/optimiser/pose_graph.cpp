@@ -108,20 +108,23 @@ SlidingWindowPoseGraph::SlidingWindowPoseGraph(const PoseGraphOptions& options) 
 }
 
 Matrix6d SlidingWindowPoseGraph::odometryCovariance(const PoseGraphOptions& o, double distance_m) {
-  return odometryCovariance(o, distance_m, o.odometry_drift_fraction);
+  return odometryCovariance(o, distance_m, o.odometry_drift_fraction, o.odometry_drift_fraction);
 }
 
-Matrix6d SlidingWindowPoseGraph::odometryCovariance(const PoseGraphOptions& o, double distance_m, double drift_fraction) {
+Matrix6d SlidingWindowPoseGraph::odometryCovariance(const PoseGraphOptions& o, double distance_m,
+                                                    double along_drift_fraction, double cross_drift_fraction) {
   const double d = std::max(distance_m, 0.0);
-  const double horizontal = o.odometry_random_walk_m_per_sqrt_m * o.odometry_random_walk_m_per_sqrt_m * d +
-                            (drift_fraction * d) * (drift_fraction * d) +
-                            o.odometry_min_sigma_m * o.odometry_min_sigma_m;
+  const double random = o.odometry_random_walk_m_per_sqrt_m * o.odometry_random_walk_m_per_sqrt_m * d +
+                        o.odometry_min_sigma_m * o.odometry_min_sigma_m;
+  // Forward (x): the DVL scale's drift; starboard (y): the heading error's.
+  const double along = random + (along_drift_fraction * d) * (along_drift_fraction * d);
+  const double cross = random + (cross_drift_fraction * d) * (cross_drift_fraction * d);
   const double heading = o.odometry_heading_random_walk_rad_per_sqrt_m *
                              o.odometry_heading_random_walk_rad_per_sqrt_m * d +
                          o.odometry_min_heading_sigma_rad * o.odometry_min_heading_sigma_rad;
   const double attitude = o.odometry_attitude_sigma_rad * o.odometry_attitude_sigma_rad;
   Vector6d diagonal;
-  diagonal << horizontal, horizontal, o.odometry_depth_sigma_m * o.odometry_depth_sigma_m, attitude, attitude, heading;
+  diagonal << along, cross, o.odometry_depth_sigma_m * o.odometry_depth_sigma_m, attitude, attitude, heading;
   return diagonal.asDiagonal();
 }
 
@@ -446,7 +449,7 @@ ceres::CostFunction* SlidingWindowPoseGraph::makeCost(const Factor& f) const {
       return InsAbsoluteError::create(nodes_[f.index].dr, w);
     }
     case FactorKind::kOdometry:
-      if (calibration_.estimated) return CalibratedOdometryError::createHeld(calibratedOdometry(f.index));
+      if (calibration_.estimated) return CalibratedOdometryError::createHeld(calibratedOdometry(f.index, false));
       return RelativePoseError::create(nodes_[f.index].odometry, odometrySqrtInformation(f.index, false));
     case FactorKind::kClosure: {
       const Closure& c = closures_[f.index];

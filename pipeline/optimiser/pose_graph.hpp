@@ -134,13 +134,22 @@ struct PoseGraphOptions {
   // DVL scale factor s (DR's horizontal odometry is (1 + s) times the distance flown) and the INS
   // heading error e(psi) = b + a_c cos(psi) + a_s sin(psi): a constant bias, and the error of one
   // cycle per revolution (gyrocompass steaming and alignment residuals) that does not cancel on the
-  // reversed lines of a lawnmower. Most of a plain lawnmower's DR error is these, and no side-scan
-  // closure sees them, but absolute fixes do. Estimated at full smoothing with zero-mean priors of
-  // these sigmas, then held by the window: "auto" when fixes were accepted, "always", or "never".
+  // reversed lines of a lawnmower. Estimated at full smoothing with zero-mean priors of these sigmas,
+  // then held by the window. Absolute fixes observe all of them. Closures alone observe a_c and a_s
+  // (reversed lines drift apart) but not b (it turns the whole survey), and the scale mostly through
+  // the turns' length, where it cannot be told from the matcher's separation bias (README, measured:
+  // "always" without fixes gave scale errors of 2-8 sigma on randomised missions).
+  //   "auto": everything once fixes were accepted, else nothing;
+  //   "heading": the heading error always, the scale once fixes were accepted;
+  //   "always": everything always; "never".
   std::string calibration = "auto";
   double calibration_scale_sigma = 0.005;
   double calibration_heading_bias_sigma_rad = 0.005;
   double calibration_heading_deviation_sigma_rad = 0.005;
+  // While the mission runs the window holds the last estimate; a full smoothing re-estimates it once
+  // this much mission time has passed since the last one (the live optimiser then corrects with
+  // it as a post-processing run would). 0: only at the end of the mission.
+  double calibration_period_s = 600.0;
   // odometry_drift_fraction models the scale and heading errors as independent per edge; once they
   // are estimated, what is left drifts by this (slowly varying gyro bias, scale changing with the
   // seabed): otherwise every edge's slack absorbs what the calibration should explain.
@@ -307,6 +316,7 @@ struct SeparationBias {
 // The DR sensor calibration (PoseGraphOptions::calibration) as last estimated.
 struct DrCalibration {
   bool estimated = false;          // the odometry and INS factors use it (held between smoothings)
+  bool scale_estimated = false;    // the DVL scale too (with fixes); else it stays 0, sigma NaN
   double dvl_scale = 0.0;          // s: DR distance = (1 + s) x true
   double heading_bias_rad = 0.0;   // b
   double heading_cos_rad = 0.0;    // a_c: e(psi) = b + a_c cos(psi) + a_s sin(psi)
@@ -392,9 +402,10 @@ class SlidingWindowPoseGraph {
 
   // The odometry model (see PoseGraphOptions) for distance d.
   static sss::core::Matrix6d odometryCovariance(const PoseGraphOptions& options, double distance_m);
-  // The same with another systematic drift fraction (the calibrated model).
+  // The same with other systematic drift fractions along track (forward: the DVL scale) and across
+  // (starboard: the heading error), for the calibrated model.
   static sss::core::Matrix6d odometryCovariance(const PoseGraphOptions& options, double distance_m,
-                                                double drift_fraction);
+                                                double along_drift_fraction, double cross_drift_fraction);
 
  private:
   struct Node {
@@ -481,13 +492,22 @@ class SlidingWindowPoseGraph {
   // estimate_calibration: the DR calibration is a variable too (full smoothing).
   bool solve(const std::vector<Factor>& factors, int max_iterations, UpdateReport& report,
              bool estimate_separation_bias = false, bool estimate_calibration = false);
-  // Whether full smoothing estimates the calibration (PoseGraphOptions::calibration).
+  // Whether full smoothing estimates the calibration (PoseGraphOptions::calibration), and the DVL
+  // scale with it.
   bool calibrationWanted() const;
+  bool scaleWanted() const;
+  // Whether a window update should be a full smoothing that re-estimates it (calibration_period_s).
+  bool calibrationDue() const;
   // Whitening of node k's odometry edge: the configured model, or with the calibration in use
   // (calibrated_odometry_drift_fraction); divided by the odometry variance factor.
   sss::core::Matrix6d odometrySqrtInformation(int k, bool calibrated) const;
-  // Node k's odometry edge under the calibration model, holding the last estimate.
-  CalibratedOdometryError calibratedOdometry(int k) const;
+  // Node k's odometry edge under the calibration model, holding the last estimate. Its whitening:
+  // with the calibration a variable of the same solve (estimated), only the drift the calibration
+  // does not explain (calibrated_odometry_drift_fraction); with the calibration held constant, the
+  // configured model: a held estimate corrects the edge's mean, but its own error is common to every
+  // edge, and the window has no variable to carry it (the unobserved constant heading bias keeps
+  // its prior sigma, wider than the drift model) -- tighter edges would gate out good fixes.
+  CalibratedOdometryError calibratedOdometry(int k, bool estimated) const;
   // The first node's anchor: its DR pose, with the calibrated heading error removed when in use.
   sss::core::Pose firstNodePrior() const;
   // Unit direction (in A's body frame) along which the separation bias moves the closure's
@@ -515,6 +535,7 @@ class SlidingWindowPoseGraph {
   std::vector<Fix> fixes_;
   FixCounters fix_counters_;
   int64_t newest_accepted_fix_utime_us_ = -1;
+  int64_t calibration_utime_us_ = -1;  // newest node of the last full smoothing that estimated the calibration
   std::map<std::pair<int64_t, int64_t>, int> latest_for_pair_;  // (smaller id, larger id) -> closure
   std::map<std::pair<int, int>, bool> pcm_cache_;               // pair consistency within the horizon
   int pcm_horizon_start_ = 0;  // closures before it are decided for good

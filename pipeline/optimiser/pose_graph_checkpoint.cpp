@@ -23,7 +23,9 @@ constexpr const char* kMagic = "sss-pose-graph-checkpoint";
 // 3 adds the separation bias; older files restore without one (0, not applied).
 // 4 adds the absolute fixes; older files restore without any.
 // 5 adds the DR calibration; older files restore without one (not estimated).
-constexpr int kVersion = 5;
+// 6 adds when the calibration was last estimated and whether the DVL scale was part of it; older
+// files re-estimate it at the next update and take the scale as estimated with the rest.
+constexpr int kVersion = 6;
 constexpr size_t kMaxFileBytes = size_t{1} << 31;  // 2 GiB: far above any mission
 
 using checkpoint::TextReader;
@@ -136,6 +138,8 @@ std::string SlidingWindowPoseGraph::checkpointText() const {
   w.integer(c.estimated ? 1 : 0);
   for (double v : {c.dvl_scale, c.heading_bias_rad, c.heading_cos_rad, c.heading_sin_rad}) w.real(v);
   for (int i = 0; i < 4; ++i) w.real(c.sigma(i));
+  w.integer(calibration_utime_us_);
+  w.integer(c.scale_estimated ? 1 : 0);
   w.endLine();
   const WindowStats& s = window_stats_;
   w.word("window");
@@ -327,7 +331,11 @@ Status SlidingWindowPoseGraph::restoreCheckpointText(const std::string& text) {
         !r.real(c.sigma(0)) || !r.real(c.sigma(1)) || !r.real(c.sigma(2)) || !r.real(c.sigma(3)))
       return fail("bad calibration record");
     if (!(c.dvl_scale > -0.5)) return fail("calibration record: the DVL scale must be > -0.5");
+    int scale_estimated = estimated;
+    if (version >= 6 && (!r.integer(g.calibration_utime_us_) || !r.boundedInt(scale_estimated, 0, 1)))
+      return fail("bad calibration record (time, scale)");
     c.estimated = estimated == 1;
+    c.scale_estimated = scale_estimated == 1;
   }
   WindowStats& s = g.window_stats_;
   if (!r.expect("window")) return fail("bad window record");

@@ -54,9 +54,10 @@ std::vector<std::string> validatePoseGraphOptions(const PoseGraphOptions& o) {
   if (!(o.separation_bias_significance >= 0.0))
     problems.push_back("separation_bias_significance must be >= 0 (sigmas; 0: always significant)");
   positive(o.fix_gate_chi2, "fix_gate_chi2");
-  if (o.calibration != "auto" && o.calibration != "always" && o.calibration != "never")
-    problems.push_back("calibration must be one of auto, always, never (got '" + o.calibration + "')");
+  if (o.calibration != "auto" && o.calibration != "heading" && o.calibration != "always" && o.calibration != "never")
+    problems.push_back("calibration must be one of auto, heading, always, never (got '" + o.calibration + "')");
   positive(o.calibration_scale_sigma, "calibration_scale_sigma");
+  nonNegative(o.calibration_period_s, "calibration_period_s");
   nonNegative(o.calibrated_odometry_drift_fraction, "calibrated_odometry_drift_fraction");
   positive(o.calibration_heading_bias_sigma_rad, "calibration_heading_bias_sigma_rad");
   positive(o.calibration_heading_deviation_sigma_rad, "calibration_heading_deviation_sigma_rad");
@@ -106,8 +107,9 @@ void readPoseGraphOptions(sss::core::ConfigSection& section, PoseGraphOptions& o
   section.optional("separation_bias_apply", options.separation_bias_apply);
   section.optional("separation_bias_significance", options.separation_bias_significance, {inRange(0.0, 100.0)});
   section.optional("fix_gate_chi2", options.fix_gate_chi2, {greaterThan(0.0)});
-  section.optional("calibration", options.calibration, {sss::core::oneOf({"auto", "always", "never"})});
+  section.optional("calibration", options.calibration, {sss::core::oneOf({"auto", "heading", "always", "never"})});
   section.optional("calibration_scale_sigma", options.calibration_scale_sigma, {inRange(1e-6, 0.5)});
+  section.optional("calibration_period_s", options.calibration_period_s, {inRange(0.0, 1e6)});
   section.optional("calibrated_odometry_drift_fraction", options.calibrated_odometry_drift_fraction, {inRange(0.0, 1.0)});
   section.optional("calibration_heading_bias_sigma_rad", options.calibration_heading_bias_sigma_rad, {inRange(1e-6, 0.5)});
   section.optional("calibration_heading_deviation_sigma_rad", options.calibration_heading_deviation_sigma_rad,

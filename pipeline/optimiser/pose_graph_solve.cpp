@@ -85,17 +85,20 @@ Matrix6d SlidingWindowPoseGraph::odometrySqrtInformation(int k, bool calibrated)
   const Node& node = nodes_[k];
   if (!calibrated || k == 0) return node.odometry_sqrt_information / std::sqrt(variance_factors_.odometry);
   Matrix6d sqrt_information;
-  sqrtInformation(odometryCovariance(options_, node.distance_m - nodes_[k - 1].distance_m,
+  // The heading error is calibrated; the scale only when something observes it (scaleWanted()).
+  const double along = calibration_.scale_estimated ? options_.calibrated_odometry_drift_fraction
+                                                    : options_.odometry_drift_fraction;
+  sqrtInformation(odometryCovariance(options_, node.distance_m - nodes_[k - 1].distance_m, along,
                                      options_.calibrated_odometry_drift_fraction),
                   sqrt_information);
   return sqrt_information / std::sqrt(variance_factors_.odometry);
 }
 
-CalibratedOdometryError SlidingWindowPoseGraph::calibratedOdometry(int k) const {
+CalibratedOdometryError SlidingWindowPoseGraph::calibratedOdometry(int k, bool estimated) const {
   const Node& node = nodes_[k];
   CalibratedOdometryError error;
   error.measured = node.odometry;
-  error.sqrt_information = odometrySqrtInformation(k, true);
+  error.sqrt_information = odometrySqrtInformation(k, estimated);
   error.moment_cos = node.moment_cos;
   error.moment_sin = node.moment_sin;
   error.heading_a_rad = sss::core::eulerFromQuaternion(nodes_[k - 1].dr.rotation).heading_rad;
@@ -114,7 +117,12 @@ Pose SlidingWindowPoseGraph::firstNodePrior() const {
 }
 
 bool SlidingWindowPoseGraph::calibrationWanted() const {
-  return options_.calibration == "always" || (options_.calibration == "auto" && fix_counters_.accepted > 0);
+  if (options_.calibration == "never") return false;
+  return options_.calibration == "always" || options_.calibration == "heading" || fix_counters_.accepted > 0;
+}
+
+bool SlidingWindowPoseGraph::scaleWanted() const {
+  return options_.calibration == "always" || (options_.calibration != "never" && fix_counters_.accepted > 0);
 }
 
 bool SlidingWindowPoseGraph::solve(const std::vector<Factor>& factors, int max_iterations, UpdateReport& report,
@@ -155,7 +163,7 @@ bool SlidingWindowPoseGraph::solve(const std::vector<Factor>& factors, int max_i
       const double dr_heading_rad = sss::core::eulerFromQuaternion(node.dr.rotation).heading_rad;
       ceres::CostFunction* cost =
           f.kind == FactorKind::kOdometry
-              ? CalibratedOdometryError::createEstimated(calibratedOdometry(f.index))
+              ? CalibratedOdometryError::createEstimated(calibratedOdometry(f.index, true))
           : f.kind == FactorKind::kInsAbsolute
               ? CalibratedInsAbsoluteError::createEstimated(node.dr, insAbsoluteWeights(options_), dr_heading_rad)
               : CalibratedPosePriorError::create(node.dr, firstNodeSqrtInformation(options_), dr_heading_rad);
@@ -191,6 +199,9 @@ bool SlidingWindowPoseGraph::solve(const std::vector<Factor>& factors, int max_i
                                  new CalibrationPriorError{Eigen::Vector4d(1.0 / sigmas[0], 1.0 / sigmas[1],
                                                                            1.0 / sigmas[2], 1.0 / sigmas[3])}),
                              nullptr, calibration.data());
+    // Without fixes the scale stays at its last value: closures of parallel lines see it mostly
+    // through the turns' length, where it cannot be told from the matcher's separation bias.
+    if (!scaleWanted()) problem.SetManifold(calibration.data(), new ceres::SubsetManifold(kCalibrationSize, {0}));
   }
 
   ceres::Solver::Options solver_options;
@@ -238,6 +249,8 @@ bool SlidingWindowPoseGraph::solve(const std::vector<Factor>& factors, int max_i
     calibration_.heading_cos_rad = calibration[2];
     calibration_.heading_sin_rad = calibration[3];
     calibration_.sigma = marginalSigmas<kCalibrationSize>(problem, calibration.data());
+    calibration_.scale_estimated = scaleWanted();
+    if (!calibration_.scale_estimated) calibration_.sigma(0) = std::numeric_limits<double>::quiet_NaN();
   }
   if (estimate_separation_bias && biased_closures > 0 && std::isfinite(separation_bias_m)) {
     separation_bias_.estimate_m = separation_bias_.tested_m = separation_bias_m;
@@ -428,10 +441,27 @@ void SlidingWindowPoseGraph::refreshWindowStats(const std::vector<Factor>& facto
   window_stats_.prior_rows = static_cast<int>(prior_.residual.size());
 }
 
+bool SlidingWindowPoseGraph::calibrationDue() const {
+  if (options_.calibration_period_s <= 0.0 || nodes_.empty() || !calibrationWanted()) return false;
+  if (calibration_utime_us_ < 0) return true;
+  return 1e-6 * static_cast<double>(nodes_.back().utime_us - calibration_utime_us_) >= options_.calibration_period_s;
+}
+
 UpdateReport SlidingWindowPoseGraph::optimize() {
   const Clock::time_point start = Clock::now();
   UpdateReport report;
   if (nodes_.empty()) return report;
+  if (calibrationDue()) {
+    // The calibration changes every odometry edge, old and new: only a full smoothing can move it.
+    report = fullSmoothing();
+    while (static_cast<int>(nodes_.size()) - first_active_ > options_.window_size) {
+      marginaliseOldest();
+      ++counters_.nodes_marginalised;
+    }
+    refreshCovariances();
+    report.update_s = secondsSince(start);
+    return report;
+  }
   decideClosures(report);
   decideFixes(false);
   const std::vector<Factor> factors = windowFactors();
@@ -464,6 +494,7 @@ UpdateReport SlidingWindowPoseGraph::fullSmoothing() {
   const std::vector<Factor> factors = allFactors();
   bool ok = true;
   const bool calibrate = calibrationWanted();
+  if (calibrate) calibration_utime_us_ = nodes_.back().utime_us;
   const DrCalibration calibration_start = calibration_;
   if (options_.separation_bias_sigma_m > 0.0) {
     // The separation bias as a variable. Kept only when significant and asked for; otherwise the

@@ -183,7 +183,7 @@ TEST(PositionFixGraph, CheckpointCarriesTheFixes) {
       ASSERT_TRUE(plain.optimize().ok);
     }
     std::string version_3 = plain.checkpointText();
-    const std::string header = "sss-pose-graph-checkpoint 5";
+    const std::string header = "sss-pose-graph-checkpoint 6";
     ASSERT_EQ(version_3.rfind(header, 0), 0u);
     version_3.replace(0, header.size(), "sss-pose-graph-checkpoint 3");
     for (const char* newer : {"\nfixes ", "\ncalibration "}) {

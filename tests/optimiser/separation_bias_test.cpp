@@ -175,7 +175,7 @@ TEST(SeparationBias, SurvivesACheckpointAndOlderCheckpointsRestoreWithout) {
   // The same state as version 2 wrote it: no separation_bias record (nor version 4's fixes record
   // and version 5's calibration record).
   std::string version_2 = text;
-  const std::string header = "sss-pose-graph-checkpoint 5";
+  const std::string header = "sss-pose-graph-checkpoint 6";
   ASSERT_EQ(version_2.rfind(header, 0), 0u) << version_2.substr(0, 40);
   version_2.replace(0, header.size(), "sss-pose-graph-checkpoint 2");
   const size_t record = version_2.find("\nseparation_bias ");

@@ -538,10 +538,12 @@ void productsSection(FigureContext& context) {
                           {""}});
     fixes.rows.push_back({{"fix residual RMS (m)"}, {fixed(s.fixes_rms_residual_m, 2)}, {""}});
   }
-  if (s.calibration_estimated) {
+  if (s.calibration_estimated && std::isfinite(s.dvl_scale_sigma)) {
     fixes.rows.push_back({{"DVL scale error (%)"},
                           {fixed(100.0 * s.dvl_scale, 3)},
                           {fixed(100.0 * s.dvl_scale_sigma, 3)}});
+  }
+  if (s.calibration_estimated) {
     fixes.rows.push_back({{"heading bias (deg)"},
                           {fixed(s.heading_bias_rad * 180.0 / M_PI, 3)},
                           {fixed(s.heading_bias_sigma_rad * 180.0 / M_PI, 3)}});

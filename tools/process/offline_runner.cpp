@@ -694,8 +694,10 @@ bool writeSummaryJson(const std::string& path, const OfflineRequest& request, co
   json.key("seen_twice_m2").value(s.coverage_seen_twice_m2, 8);
   json.key("fraction_seen_twice").value(s.coverage_covered_m2 > 0.0 ? s.coverage_seen_twice_m2 / s.coverage_covered_m2 : 0.0, 4);
   json.endObject();
-  json.key("calibration").beginObject();  // DVL scale and INS heading error, when fixes observed them
+  // INS heading error (closures and fixes observe it) and DVL scale (with fixes only; else 0, sigma null)
+  json.key("calibration").beginObject();
   json.key("estimated").value(s.calibration.estimated);
+  json.key("dvl_scale_estimated").value(s.calibration.scale_estimated);
   json.key("dvl_scale").value(s.calibration.dvl_scale, 6);
   json.key("dvl_scale_sigma").value(s.calibration.sigma(0), 6);
   json.key("heading_bias_rad").value(s.calibration.heading_bias_rad, 6);
