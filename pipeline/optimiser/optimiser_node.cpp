@@ -100,6 +100,7 @@ struct Shared {
   sss::optimiser::PoseGraphCounters graph_counters;
   sss::optimiser::OptimiserEngineCounters engine_counters;
   sss::optimiser::FixCounters fix_counters;
+  sss::optimiser::DrCalibration calibration;
   double last_update_s = 0.0;
   double last_checkpoint_s = 0.0;
   size_t memory_bytes = 0;
@@ -280,6 +281,7 @@ int main(int argc, char** argv) {
         shared.graph_counters = engine.graph().counters();
         shared.engine_counters = engine.counters();
         shared.fix_counters = engine.graph().fixCounters();
+        shared.calibration = engine.graph().calibration();
         shared.last_update_s = engine.graph().counters().last_update_s;
         if (checkpoint_s >= 0.0) shared.last_checkpoint_s = checkpoint_s;
         shared.memory_bytes = engine.memoryBytes();
@@ -454,6 +456,7 @@ int main(int argc, char** argv) {
     sss::optimiser::PoseGraphCounters graph_counters;
     sss::optimiser::OptimiserEngineCounters engine_counters;
     sss::optimiser::FixCounters fix_counters;
+    sss::optimiser::DrCalibration calibration;
     size_t memory_bytes = 0;
     double last_checkpoint_s = 0.0;
     {
@@ -463,6 +466,7 @@ int main(int argc, char** argv) {
       graph_counters = shared.graph_counters;
       engine_counters = shared.engine_counters;
       fix_counters = shared.fix_counters;
+      calibration = shared.calibration;
       memory_bytes = shared.memory_bytes;
       last_checkpoint_s = shared.last_checkpoint_s;
     }
@@ -486,6 +490,16 @@ int main(int argc, char** argv) {
     health.setCounter("fixes_accepted", static_cast<double>(fix_counters.accepted));
     health.setCounter("fixes_rejected", static_cast<double>(fix_counters.rejected_gate + fix_counters.refused));
     health.setCounter("updates", static_cast<double>(graph_counters.updates));
+    // The DR calibration in use (re-estimated every calibration_period_s of mission time): 0 and
+    // NaN sigmas before the first estimate; the scale's sigma NaN while no fix observes it.
+    health.setCounter("full_smoothings", static_cast<double>(graph_counters.full_smoothings));
+    health.setCounter("calibration_estimated", calibration.estimated ? 1.0 : 0.0);
+    health.setCounter("calibration_dvl_scale", calibration.dvl_scale);
+    health.setCounter("calibration_dvl_scale_sigma", calibration.sigma(0));
+    health.setCounter("calibration_heading_bias_rad", calibration.heading_bias_rad);
+    health.setCounter("calibration_heading_cos_rad", calibration.heading_cos_rad);
+    health.setCounter("calibration_heading_cos_sigma_rad", calibration.sigma(2));
+    health.setCounter("calibration_heading_sin_rad", calibration.heading_sin_rad);
     health.setCounter("solver_failures", static_cast<double>(graph_counters.solver_failures));
     health.setCounter("last_update_ms", 1e3 * graph_counters.last_update_s);
     health.setCounter("memory_mb", static_cast<double>(memory_bytes) / 1e6);
