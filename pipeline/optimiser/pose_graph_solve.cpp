@@ -192,16 +192,18 @@ bool SlidingWindowPoseGraph::solve(const std::vector<Factor>& factors, int max_i
   }
   const bool calibrating = estimate_calibration && problem.HasParameterBlock(calibration.data());
   if (calibrating) {
-    const double sigmas[kCalibrationSize] = {options_.calibration_scale_sigma, options_.calibration_heading_bias_sigma_rad,
+    // Without fixes the scale is held at 0 by a prior a million times tighter than any data: closures
+    // of parallel lines see it mostly through the turns' length, where it cannot be told from the
+    // matcher's separation bias. (Not a SubsetManifold: Ceres' covariance in the tangent space of
+    // one frees memory that another Eigen build allocated, under AddressSanitizer.)
+    const double scale_sigma = scaleWanted() ? options_.calibration_scale_sigma : 1e-6 * options_.calibration_scale_sigma;
+    const double sigmas[kCalibrationSize] = {scale_sigma, options_.calibration_heading_bias_sigma_rad,
                                              options_.calibration_heading_deviation_sigma_rad,
                                              options_.calibration_heading_deviation_sigma_rad};
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<CalibrationPriorError, kCalibrationSize, kCalibrationSize>(
                                  new CalibrationPriorError{Eigen::Vector4d(1.0 / sigmas[0], 1.0 / sigmas[1],
                                                                            1.0 / sigmas[2], 1.0 / sigmas[3])}),
                              nullptr, calibration.data());
-    // Without fixes the scale stays at its last value: closures of parallel lines see it mostly
-    // through the turns' length, where it cannot be told from the matcher's separation bias.
-    if (!scaleWanted()) problem.SetManifold(calibration.data(), new ceres::SubsetManifold(kCalibrationSize, {0}));
   }
 
   ceres::Solver::Options solver_options;
@@ -250,7 +252,10 @@ bool SlidingWindowPoseGraph::solve(const std::vector<Factor>& factors, int max_i
     calibration_.heading_sin_rad = calibration[3];
     calibration_.sigma = marginalSigmas<kCalibrationSize>(problem, calibration.data());
     calibration_.scale_estimated = scaleWanted();
-    if (!calibration_.scale_estimated) calibration_.sigma(0) = std::numeric_limits<double>::quiet_NaN();
+    if (!calibration_.scale_estimated) {  // held at 0 by its prior (to ~1e-14): say so exactly
+      calibration_.dvl_scale = 0.0;
+      calibration_.sigma(0) = std::numeric_limits<double>::quiet_NaN();
+    }
   }
   if (estimate_separation_bias && biased_closures > 0 && std::isfinite(separation_bias_m)) {
     separation_bias_.estimate_m = separation_bias_.tested_m = separation_bias_m;
