@@ -517,6 +517,8 @@ class SlidingWindowPoseGraph {
   // new factors until they settle (full smoothing, every node active).
   void reweighFromResiduals(const std::vector<Factor>& factors, UpdateReport& report, bool estimate_calibration);
   void marginaliseOldest();
+  // marginaliseOldest() until the window holds window_size nodes.
+  void marginaliseBeyondWindow();
   // Joint covariance of the active nodes (6 x 6 blocks in node order); slot[n - first_active_] is
   // the block of node n.
   bool computeWindowCovariance(Eigen::MatrixXd& covariance, std::vector<int>& slot) const;

@@ -446,6 +446,13 @@ void SlidingWindowPoseGraph::refreshWindowStats(const std::vector<Factor>& facto
   window_stats_.prior_rows = static_cast<int>(prior_.residual.size());
 }
 
+void SlidingWindowPoseGraph::marginaliseBeyondWindow() {
+  while (static_cast<int>(nodes_.size()) - first_active_ > options_.window_size) {
+    marginaliseOldest();
+    ++counters_.nodes_marginalised;
+  }
+}
+
 bool SlidingWindowPoseGraph::calibrationDue() const {
   if (options_.calibration_period_s <= 0.0 || nodes_.empty() || !calibrationWanted()) return false;
   if (calibration_utime_us_ < 0) return true;
@@ -459,10 +466,7 @@ UpdateReport SlidingWindowPoseGraph::optimize() {
   if (calibrationDue()) {
     // The calibration changes every odometry edge, old and new: only a full smoothing can move it.
     report = fullSmoothing();
-    while (static_cast<int>(nodes_.size()) - first_active_ > options_.window_size) {
-      marginaliseOldest();
-      ++counters_.nodes_marginalised;
-    }
+    marginaliseBeyondWindow();
     refreshCovariances();
     report.update_s = secondsSince(start);
     return report;
@@ -473,10 +477,7 @@ UpdateReport SlidingWindowPoseGraph::optimize() {
   refreshWindowStats(factors);
   solve(factors, options_.max_iterations, report);
   // Marginalise at the solution even after a failed solve: the window must stay bounded.
-  while (static_cast<int>(nodes_.size()) - first_active_ > options_.window_size) {
-    marginaliseOldest();
-    ++counters_.nodes_marginalised;
-  }
+  marginaliseBeyondWindow();
   refreshCovariances();
   update_utime_us_ = nodes_.back().utime_us;
   report.update_s = secondsSince(start);
