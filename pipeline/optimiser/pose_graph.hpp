@@ -368,7 +368,7 @@ class SlidingWindowPoseGraph {
   UpdateReport optimize();
   // Re-optimises all nodes with all odometry and accepted closures (end of mission), then
   // re-derives the marginalisation prior at the smoothed estimate so the window can go on.
-  UpdateReport fullSmoothing();
+  UpdateReport fullSmoothing() { return smoothAll(true); }
 
   // ---- queries ------------------------------------------------------------------------------------
   std::optional<sss::core::Pose> estimate(int64_t subframe_id) const;
@@ -498,6 +498,9 @@ class SlidingWindowPoseGraph {
   bool scaleWanted() const;
   // Whether a window update should be a full smoothing that re-estimates it (calibration_period_s).
   bool calibrationDue() const;
+  // fullSmoothing(); mission_ended: fixes after the newest node are tied to it, as no later node
+  // will come (a smoothing during the mission leaves them for the next node).
+  UpdateReport smoothAll(bool mission_ended);
   // Whitening of node k's odometry edge: the configured model, or with the calibration in use
   // (calibrated_odometry_drift_fraction); divided by the odometry variance factor.
   sss::core::Matrix6d odometrySqrtInformation(int k, bool calibrated) const;

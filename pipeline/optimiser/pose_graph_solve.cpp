@@ -85,9 +85,9 @@ Matrix6d SlidingWindowPoseGraph::odometrySqrtInformation(int k, bool calibrated)
   const Node& node = nodes_[k];
   if (!calibrated || k == 0) return node.odometry_sqrt_information / std::sqrt(variance_factors_.odometry);
   Matrix6d sqrt_information;
-  // The heading error is calibrated; the scale only when something observes it (scaleWanted()).
-  const double along = calibration_.scale_estimated ? options_.calibrated_odometry_drift_fraction
-                                                    : options_.odometry_drift_fraction;
+  // The heading error is a variable of this solve; the scale only when something observes it. (The
+  // estimate's scale_estimated flag still holds the previous solve's answer here.)
+  const double along = scaleWanted() ? options_.calibrated_odometry_drift_fraction : options_.odometry_drift_fraction;
   sqrtInformation(odometryCovariance(options_, node.distance_m - nodes_[k - 1].distance_m, along,
                                      options_.calibrated_odometry_drift_fraction),
                   sqrt_information);
@@ -465,7 +465,7 @@ UpdateReport SlidingWindowPoseGraph::optimize() {
   if (nodes_.empty()) return report;
   if (calibrationDue()) {
     // The calibration changes every odometry edge, old and new: only a full smoothing can move it.
-    report = fullSmoothing();
+    report = smoothAll(false);
     marginaliseBeyondWindow();
     refreshCovariances();
     report.update_s = secondsSince(start);
@@ -488,12 +488,12 @@ UpdateReport SlidingWindowPoseGraph::optimize() {
   return report;
 }
 
-UpdateReport SlidingWindowPoseGraph::fullSmoothing() {
+UpdateReport SlidingWindowPoseGraph::smoothAll(bool mission_ended) {
   const Clock::time_point start = Clock::now();
   UpdateReport report;
   if (nodes_.empty()) return report;
   decideClosures(report);
-  decideFixes(true);
+  decideFixes(mission_ended);
   // Every node is a variable: solve with the window boundary at the first node.
   const int boundary = first_active_;
   first_active_ = 0;

@@ -177,6 +177,28 @@ TEST(DrCalibration, IsReEstimatedWhileTheMissionRuns) {
   }
 }
 
+// A smoothing during the mission leaves a fix newer than the newest node for the next node (the
+// nearest in time); only the end of the mission ties it to the last one.
+TEST(DrCalibration, ASmoothingDuringTheMissionLeavesNewerFixesForTheNextNode) {
+  const synthetic::Mission mission = synthetic::makeLawnmowerMission(missionOptions(6));
+  PoseGraphOptions options = graphOptions();
+  options.calibration = "heading";  // wanted from the first node: the first update is a smoothing
+  SlidingWindowPoseGraph graph(options);
+  std::mt19937_64 random(6);
+  const synthetic::Node& first = mission.nodes[0];
+  const synthetic::Node& second = mission.nodes[1];
+  ASSERT_TRUE(graph.addNode(first.subframe_id, first.utime_us, first.dr, first.distance_m).ok);
+  ASSERT_TRUE(graph.addFix(fixAt(second, 1.0, random)).ok);
+  ASSERT_TRUE(graph.optimize().ok);
+  ASSERT_EQ(graph.counters().full_smoothings, 1u);
+  ASSERT_EQ(graph.fixes().size(), 1u);
+  EXPECT_EQ(graph.fixes()[0].status, FixStatus::kPending);
+  EXPECT_EQ(graph.fixes()[0].subframe_id, -1);
+  ASSERT_TRUE(graph.addNode(second.subframe_id, second.utime_us, second.dr, second.distance_m).ok);
+  ASSERT_TRUE(graph.optimize().ok);
+  EXPECT_EQ(graph.fixes()[0].subframe_id, second.subframe_id);
+}
+
 // The calibration survives a checkpoint, and a restored graph goes on exactly as the original.
 TEST(DrCalibration, SurvivesACheckpoint) {
   synthetic::MissionOptions o = missionOptions(3);
