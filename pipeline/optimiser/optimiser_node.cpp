@@ -40,7 +40,7 @@
 #include "products/mosaic_products.hpp"
 #include "pipeline/optimiser/pose_message.hpp"
 #include "pipeline/messages/subframe_messages.hpp"
-#include "pipeline/subframe/subframe_message.hpp"
+#include "pipeline/messages/sensor_messages.hpp"
 #include "pipeline/transport/dds.hpp"
 #include "pipeline/transport/logging.hpp"
 #include "pipeline/transport/process_loop.hpp"
@@ -347,7 +347,7 @@ int main(int argc, char** argv) {
   // ---- subscriptions ------------------------------------------------------------------------------
   loop.bus().subscribe<sss_msgs::nav_t>(options.nav_channel, [&](const sss_msgs::nav_t& message) {
     const int64_t arrival = sss::core::monotonicUtime();
-    const sss::subframe::NavInput nav = sss::subframe::fromNavMessage(message);
+    const sss::core::NavSample nav = sss::messages::fromNavMessage(message);
     if (!nav.position_ned_m.allFinite() || !std::isfinite(nav.heading_rad) || !std::isfinite(nav.roll_rad) ||
         !std::isfinite(nav.pitch_rad) || nav.utime_us <= 0) {
       if (health.recordError("bad_nav", "nav sample with non-finite pose or no time", sss::core::nowUtime()))
@@ -386,7 +386,7 @@ int main(int argc, char** argv) {
       spdlog::info("the correction of the present pose jumped {:.2f} m (a fix or closures accepted); the published "
                    "pose follows at {:.2f} m/s, its covariance widened by what is left", *jump, options.slew.max_rate_m_s);
     }
-    const auto dr = sss::subframe::poseOf(nav);
+    const auto dr = sss::core::poseOf(nav);
     const sss_msgs::pose_t pose = sss::optimiser::toPoseMessage(nav.utime_us, dr, correction, *plane);
     loop.bus().publish(options.pose_channel, pose, arrival);
     if (writer) {

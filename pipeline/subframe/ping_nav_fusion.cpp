@@ -14,10 +14,6 @@ sss::core::Pose PingNavFusionOptions::T_body_sonar() const {
               sonar_position_body_m);
 }
 
-Pose poseOf(const NavInput& nav) {
-  return Pose(sss::core::quaternionFromEuler(nav.roll_rad, nav.pitch_rad, nav.heading_rad), nav.position_ned_m);
-}
-
 void readPingNavFusionOptions(sss::core::ConfigSection& section, PingNavFusionOptions& options) {
   using namespace sss::core;
   std::vector<double> lever{options.sonar_position_body_m.x(), options.sonar_position_body_m.y(),

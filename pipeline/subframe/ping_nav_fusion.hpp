@@ -11,43 +11,15 @@
 #include "pipeline/core/config.hpp"
 #include "pipeline/core/mission_origin.hpp"
 #include "pipeline/core/pose.hpp"
+#include "pipeline/core/sensor_types.hpp"
 #include "pipeline/subframe/bottom_tracker.hpp"
 
 namespace sss::subframe {
 
-// One DR navigation sample (SSS_NAV without the middleware).
-struct NavInput {
-  int64_t utime_us = 0;
-  Eigen::Vector3d position_ned_m = Eigen::Vector3d::Zero();  // body origin, local NED
-  // False before the navigation's first fix (no position, so no frame yet): not fused.
-  bool position_valid = true;
-  // The mission origin position_ned_m is relative to, when the source says (SSS_NAV does).
-  std::optional<sss::core::MissionOrigin> origin;
-  double roll_rad = 0.0;
-  double pitch_rad = 0.0;
-  double heading_rad = 0.0;
-  double altitude_m = -1.0;        // body above seabed (DVL)
-  bool altitude_valid = false;     // valid and not stale
-  double distance_travelled_m = 0.0;
-};
-
-// The DR pose of a nav sample: T_world_body from its local NED position and attitude.
-sss::core::Pose poseOf(const NavInput& nav);
-
-// One side-scan ping (SSS_PING without the middleware).
-struct PingInput {
-  int64_t utime_us = 0;
-  int64_t ping_number = 0;
-  double sound_speed_m_s = 1500.0;
-  double sample_interval_s = 0.0;  // two-way travel time between samples
-  double start_range_m = 0.0;      // slant range of sample 0
-  double altitude_m = -1.0;        // the sonar's own altitude; < 0 when unknown
-  std::vector<float> port;
-  std::vector<float> starboard;
-  int64_t arrival_monotonic_us = 0;  // when the ping reached this process (latency figures)
-
-  double sampleSpacingM() const { return 0.5 * sound_speed_m_s * sample_interval_s; }
-};
+// The sensor samples are core types (pipeline/core/sensor_types.hpp); the stage's names for them.
+using NavInput = sss::core::NavSample;
+using PingInput = sss::core::PingSample;
+using sss::core::poseOf;
 
 // Where a ping's altitude came from.
 enum class AltitudeSource { kNav, kPingHeader, kBottomTrack };

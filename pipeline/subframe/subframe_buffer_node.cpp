@@ -15,7 +15,7 @@
 #include "pipeline/core/time.hpp"
 #include "pipeline/subframe/subframe_buffer.hpp"
 #include "pipeline/messages/subframe_messages.hpp"
-#include "pipeline/subframe/subframe_message.hpp"
+#include "pipeline/messages/sensor_messages.hpp"
 #include "pipeline/transport/logging.hpp"
 #include "pipeline/transport/process_loop.hpp"
 #include "pipeline/transport/process_options.hpp"
@@ -134,7 +134,7 @@ int main(int argc, char** argv) {
     subframes.clear();
   };
   loop.bus().subscribe<sss_msgs::nav_t>(options.nav_channel, [&](const sss_msgs::nav_t& message) {
-    buffer.addNav(sss::subframe::fromNavMessage(message), subframes);
+    buffer.addNav(sss::messages::fromNavMessage(message), subframes);
     publishAll();
   });
   int64_t last_ping_monotonic_us = 0;
@@ -142,7 +142,7 @@ int main(int argc, char** argv) {
   loop.bus().subscribe<sss_msgs::ping_t>(options.ping_channel, [&](const sss_msgs::ping_t& message) {
     last_ping_monotonic_us = sss::core::monotonicUtime();
     flushed_since_last_ping = false;
-    buffer.addPing(sss::subframe::fromPingMessage(message, last_ping_monotonic_us), subframes);
+    buffer.addPing(sss::messages::fromPingMessage(message, last_ping_monotonic_us), subframes);
     publishAll();
   });
   // When the sonar stops (end of the mission, a stop between surveys) nothing else ends the open

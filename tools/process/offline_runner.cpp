@@ -44,7 +44,7 @@
 #include "products/navigation_products.hpp"
 #include "products/survey_rasters.hpp"
 #include "pipeline/subframe/subframe_buffer.hpp"
-#include "pipeline/subframe/subframe_message.hpp"
+#include "pipeline/messages/sensor_messages.hpp"
 #include "tools/eval/json_writer.hpp"
 #include "products/coverage.hpp"
 #include "products/footprints.hpp"
@@ -1344,14 +1344,14 @@ OfflineResult runOffline(const OfflineRequest& request) {
           ++faults;
           continue;
         }
-        runner.addNav(sss::subframe::fromNavMessage(message));
+        runner.addNav(sss::messages::fromNavMessage(message));
       } else if (event->channel == request.ping_channel) {
         sss_msgs::ping_t message;
         if (message.decode(event->data, 0, event->datalen) < 0) {
           ++faults;
           continue;
         }
-        runner.addPing(sss::subframe::fromPingMessage(message));
+        runner.addPing(sss::messages::fromPingMessage(message));
       }
       if (++events % 256 == 0 && size > 0) {
         runner.progress(static_cast<double>(std::ftell(log.getFilePtr())) / static_cast<double>(size), false);
@@ -1444,7 +1444,7 @@ OfflineResult runOffline(const OfflineRequest& request) {
           !nav_queue.empty() && (ping_queue.empty() || nav_queue.front().utime <= ping_queue.front().utime_us);
       if (nav_first) {
         record(request.nav_channel, nav_queue.front(), nav_queue.front().utime);
-        runner.addNav(sss::subframe::fromNavMessage(nav_queue.front()));
+        runner.addNav(sss::messages::fromNavMessage(nav_queue.front()));
         nav_queue.pop_front();
         continue;
       }
@@ -1462,7 +1462,7 @@ OfflineResult runOffline(const OfflineRequest& request) {
       }
       const sss_msgs::ping_t message = sss::edgetech::toPingMessage(ping);
       record(request.ping_channel, message, message.utime);
-      runner.addPing(sss::subframe::fromPingMessage(message));
+      runner.addPing(sss::messages::fromPingMessage(message));
       runner.progress(pings->fractionRead(), false);
     }
     feedPackets(INT64_MAX);  // the file's last navigation, after its last ping

@@ -21,7 +21,7 @@
 #include "pipeline/subframe/pictures.hpp"
 #include "pipeline/subframe/subframe_buffer.hpp"
 #include "pipeline/messages/subframe_messages.hpp"
-#include "pipeline/subframe/subframe_message.hpp"
+#include "pipeline/messages/sensor_messages.hpp"
 
 namespace {
 
@@ -79,7 +79,7 @@ int main(int argc, char** argv) {
     std::vector<sss::ins::NavSample> samples;
     bridge.onBytes(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size(), 0, samples);
     bridge.finish(0, samples);
-    for (const auto& s : samples) nav.push_back(sss::subframe::fromNavMessage(sss::ins::toNavMessage(s)));
+    for (const auto& s : samples) nav.push_back(sss::messages::fromNavMessage(sss::ins::toNavMessage(s)));
   }
   // Pings: streamed through the sonar driver (sonar clock, as in replay) and SSS_PING.
   std::FILE* jsf = std::fopen(sonar_path.c_str(), "rb");
@@ -125,7 +125,7 @@ int main(int argc, char** argv) {
       while (nav_index < nav.size() && nav[nav_index].utime_us <= message.utime + 1000000) {
         buffer.addNav(nav[nav_index++], out);
       }
-      buffer.addPing(sss::subframe::fromPingMessage(message, sss::core::monotonicUtime()), out);
+      buffer.addPing(sss::messages::fromPingMessage(message, sss::core::monotonicUtime()), out);
       collect();
       cpu_us += threadCpuUs() - cpu0;
       max_memory = std::max(max_memory, buffer.memoryBytes());

@@ -1,10 +1,13 @@
-// LCM translation of pings and nav. See subframe_message.hpp.
-#include "pipeline/subframe/subframe_message.hpp"
+// LCM translation of pings and nav. See sensor_messages.hpp.
+#include "pipeline/messages/sensor_messages.hpp"
 
-namespace sss::subframe {
+namespace sss::messages {
 
-PingInput fromPingMessage(const sss_msgs::ping_t& message, int64_t arrival_monotonic_us) {
-  PingInput ping;
+using sss::core::NavSample;
+using sss::core::PingSample;
+
+PingSample fromPingMessage(const sss_msgs::ping_t& message, int64_t arrival_monotonic_us) {
+  PingSample ping;
   ping.utime_us = message.utime;
   ping.ping_number = message.ping_number;
   ping.sound_speed_m_s = message.sound_speed_m_s;
@@ -17,8 +20,8 @@ PingInput fromPingMessage(const sss_msgs::ping_t& message, int64_t arrival_monot
   return ping;
 }
 
-NavInput fromNavMessage(const sss_msgs::nav_t& message) {
-  NavInput nav;
+NavSample fromNavMessage(const sss_msgs::nav_t& message) {
+  NavSample nav;
   nav.utime_us = message.utime;
   nav.position_ned_m = Eigen::Vector3d(message.position_ned_m[0], message.position_ned_m[1], message.position_ned_m[2]);
   // Before the INS's first fix the bridge has no frame (origin NaN) and no position to give.
@@ -35,4 +38,4 @@ NavInput fromNavMessage(const sss_msgs::nav_t& message) {
   return nav;
 }
 
-}  // namespace sss::subframe
+}  // namespace sss::messages
