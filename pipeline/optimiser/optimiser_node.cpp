@@ -14,17 +14,13 @@
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
-#include <condition_variable>
 #include <csignal>
 #include <cstdio>
-#include <deque>
-#include <filesystem>
 #include <memory>
-#include <mutex>
+#include <filesystem>
 #include <limits>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "pipeline/core/geodesy.hpp"
@@ -35,6 +31,7 @@
 #include "pipeline/optimiser/optimiser_engine.hpp"
 #include "pipeline/optimiser/correction_slew.hpp"
 #include "pipeline/optimiser/fix_message.hpp"
+#include "pipeline/optimiser/optimiser_worker.hpp"
 #include "products/footprints.hpp"
 #include "products/live_products.hpp"
 #include "products/mosaic_products.hpp"
@@ -50,7 +47,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using sss::optimiser::OptimiserEngine;
-using sss::optimiser::SlidingWindowPoseGraph;
 
 struct NodeOptions {
   sss::transport::ProcessOptions process;
@@ -83,29 +79,6 @@ struct NodeOptions {
 
 std::atomic<bool> g_products_requested{false};
 void onSigusr1(int) { g_products_requested.store(true); }
-
-// Inputs for the worker, and what it hands back to the process loop.
-struct Shared {
-  std::mutex mutex;
-  std::condition_variable wake;
-  std::deque<sss::core::Subframe> subframes;
-  std::deque<sss::core::LoopClosure> closures;
-  std::deque<sss::optimiser::AbsoluteFix> fixes;  // SSS_FIX, in the navigation's frame
-  bool products_requested = false;
-  bool stop = false;
-  std::optional<sss::core::MissionOrigin> origin;  // of the navigation (SSS_NAV), for the products
-  // Results.
-  std::shared_ptr<const SlidingWindowPoseGraph> snapshot;  // newest solved graph (for corrections)
-  std::optional<std::vector<sss::core::TrajectoryNode>> trajectory;  // to publish
-  sss::optimiser::PoseGraphCounters graph_counters;
-  sss::optimiser::OptimiserEngineCounters engine_counters;
-  sss::optimiser::FixCounters fix_counters;
-  sss::optimiser::DrCalibration calibration;
-  double last_update_s = 0.0;
-  double last_checkpoint_s = 0.0;
-  size_t memory_bytes = 0;
-  std::vector<std::string> messages;  // log lines from the worker (logged by the loop)
-};
 
 }  // namespace
 
@@ -197,104 +170,25 @@ int main(int argc, char** argv) {
                  "a restart loses the graph");
   }
 
-  Shared shared;
-  shared.snapshot = std::make_shared<const SlidingWindowPoseGraph>(engine.graph());
+  sss::optimiser::OptimiserWorker::Hooks hooks;
+  hooks.subframe_taken = keepForProducts;
+  hooks.write_products = [&](const OptimiserEngine& e, const std::optional<sss::core::MissionOrigin>& origin,
+                             std::vector<std::string>& messages) {
+    if (!options.products_directory.empty())
+      sss::products::writeLiveProducts(e, mosaics, footprints, options.products_directory, origin, messages);
+  };
   const int results_fd = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
   if (results_fd < 0) {
     spdlog::error("cannot create an eventfd for the optimiser thread");
     return 1;
   }
-  auto notifyLoop = [&] {
+  hooks.results_ready = [results_fd] {
     const uint64_t one = 1;
     if (write(results_fd, &one, sizeof one) < 0) {
       // Saturated counter: the loop is already due to read.
     }
   };
-
-  std::thread worker([&] {
-    double last_update_monotonic_s = -1e9;
-    for (;;) {
-      std::deque<sss::core::Subframe> subframes;
-      std::deque<sss::core::LoopClosure> closures;
-      std::deque<sss::optimiser::AbsoluteFix> fixes;
-      bool products = false;
-      std::optional<sss::core::MissionOrigin> origin;
-      {
-        std::unique_lock<std::mutex> lock(shared.mutex);
-        shared.wake.wait_for(lock, std::chrono::duration<double>(std::max(options.update_period_s, 0.05)), [&] {
-          return shared.stop || !shared.subframes.empty() || !shared.closures.empty() || !shared.fixes.empty() ||
-                 shared.products_requested;
-        });
-        if (shared.stop) return;
-        subframes.swap(shared.subframes);
-        closures.swap(shared.closures);
-        fixes.swap(shared.fixes);
-        products = shared.products_requested;
-        shared.products_requested = false;
-        origin = shared.origin;
-      }
-      std::vector<std::string> messages;
-      for (const auto& subframe : subframes) {
-        const auto status = engine.addSubframe(subframe);
-        if (!status.ok) messages.push_back("subframe " + std::to_string(subframe.id) + " refused: " + status.message);
-        else if (!status.message.empty()) messages.push_back(status.message);  // an odometer reset
-        if (status.ok) keepForProducts(subframe);
-      }
-      for (const auto& closure : closures) {
-        const auto status = engine.addLoopClosure(closure);
-        if (!status.ok) {
-          messages.push_back("closure " + std::to_string(closure.subframe_id_a) + "-" +
-                             std::to_string(closure.subframe_id_b) + " refused: " + status.message);
-        }
-      }
-      for (const auto& fix : fixes) {
-        const auto status = engine.addFix(fix);
-        if (!status.ok) messages.push_back("fix refused: " + status.message);
-      }
-      const double now_s = 1e-6 * static_cast<double>(sss::core::monotonicUtime());
-      bool updated = false;
-      if (products) {
-        engine.finish();
-        if (!options.products_directory.empty()) sss::products::writeLiveProducts(engine, mosaics, footprints, options.products_directory, origin, messages);
-        updated = true;
-      } else if (engine.hasNewInput() && now_s - last_update_monotonic_s >= options.update_period_s) {
-        const auto report = engine.update();
-        if (!report.ok) messages.push_back("update failed: " + report.message);
-        last_update_monotonic_s = now_s;
-        updated = true;
-      }
-      double checkpoint_s = -1.0;
-      if (updated && !checkpoint_path.empty()) {
-        const int64_t begin_us = sss::core::monotonicUtime();
-        const auto saved = engine.saveCheckpoint(checkpoint_path);
-        checkpoint_s = 1e-6 * static_cast<double>(sss::core::monotonicUtime() - begin_us);
-        if (!saved.ok) messages.push_back("checkpoint: " + saved.message);
-      }
-      if (!updated && messages.empty()) continue;
-      auto snapshot = updated ? std::make_shared<const SlidingWindowPoseGraph>(engine.graph()) : nullptr;
-      {
-        std::lock_guard<std::mutex> lock(shared.mutex);
-        if (snapshot) {
-          shared.snapshot = std::move(snapshot);
-          shared.trajectory = engine.trajectory();
-        }
-        shared.graph_counters = engine.graph().counters();
-        shared.engine_counters = engine.counters();
-        shared.fix_counters = engine.graph().fixCounters();
-        shared.calibration = engine.graph().calibration();
-        shared.last_update_s = engine.graph().counters().last_update_s;
-        if (checkpoint_s >= 0.0) shared.last_checkpoint_s = checkpoint_s;
-        shared.memory_bytes = engine.memoryBytes();
-        for (auto& m : messages) shared.messages.push_back(std::move(m));
-      }
-      notifyLoop();
-    }
-  });
-
-  auto snapshot = [&] {
-    std::lock_guard<std::mutex> lock(shared.mutex);
-    return shared.snapshot;
-  };
+  sss::optimiser::OptimiserWorker worker(engine, {options.update_period_s, checkpoint_path}, hooks);
 
   // ---- DDS: the newest correction, reliable, keep-last 1, transient-local ----------------------
   std::unique_ptr<sss::transport::dds::Participant> participant;
@@ -377,10 +271,9 @@ int main(int argc, char** argv) {
                      "bridge read the same file?); the navigation's is used");
       }
       plane.emplace(nav.origin->latitude_deg, nav.origin->longitude_deg);
-      std::lock_guard<std::mutex> lock(shared.mutex);
-      shared.origin = nav.origin;
+      worker.setOrigin(*nav.origin);
     }
-    const auto graph = snapshot();
+    const auto graph = worker.snapshot();
     const sss::optimiser::Correction correction = slew.apply(graph->correctionAt(nav.utime_us), nav.utime_us);
     if (const auto jump = slew.takeNewJump()) {
       spdlog::info("the correction of the present pose jumped {:.2f} m (a fix or closures accepted); the published "
@@ -411,9 +304,7 @@ int main(int argc, char** argv) {
     }
     // The image travels to the worker, which keeps it for the products at mosaic resolution (off this
     // loop, which answers every nav sample); the graph keeps poses only.
-    std::lock_guard<std::mutex> lock(shared.mutex);
-    shared.subframes.push_back(std::move(subframe));
-    shared.wake.notify_one();
+    worker.addSubframe(std::move(subframe));
   });
   loop.bus().subscribe<sss_msgs::loop_closure_t>(options.loop_channel, [&](const sss_msgs::loop_closure_t& message) {
     sss::core::LoopClosure closure;
@@ -423,19 +314,17 @@ int main(int argc, char** argv) {
         spdlog::warn("loop closure rejected: {}; further ones are counted in SSS_STATUS", error);
       return;
     }
-    std::lock_guard<std::mutex> lock(shared.mutex);
-    shared.closures.push_back(std::move(closure));
-    shared.wake.notify_one();
+    worker.addLoopClosure(std::move(closure));
   });
 
   // Absolute fixes placed in the mission frame by the INS bridge: used only in the navigation's frame.
   loop.bus().subscribe<sss_msgs::fix_t>(options.fix_channel, [&](const sss_msgs::fix_t& message) {
     std::string error;
     std::optional<sss::optimiser::AbsoluteFix> fix = sss::optimiser::fromFixMessage(message, error);
-    std::lock_guard<std::mutex> lock(shared.mutex);
     const sss::core::MissionOrigin origin = sss::optimiser::fixMessageOrigin(message);
-    if (fix && shared.origin && (std::abs(origin.latitude_deg - shared.origin->latitude_deg) > 1e-9 ||
-                                 std::abs(origin.longitude_deg - shared.origin->longitude_deg) > 1e-9)) {
+    const std::optional<sss::core::MissionOrigin> nav_origin = worker.origin();
+    if (fix && nav_origin && (std::abs(origin.latitude_deg - nav_origin->latitude_deg) > 1e-9 ||
+                              std::abs(origin.longitude_deg - nav_origin->longitude_deg) > 1e-9)) {
       error = "the fix's mission origin differs from the navigation's (another INS bridge?)";
       fix.reset();
     }
@@ -444,66 +333,18 @@ int main(int argc, char** argv) {
         spdlog::warn("fix rejected: {}; further ones are counted in SSS_STATUS", error);
       return;
     }
-    shared.fixes.push_back(*fix);
-    shared.wake.notify_one();
+    worker.addFix(*fix);
   });
 
   loop.addFileDescriptor(results_fd, [&] {
     uint64_t count = 0;
     if (read(results_fd, &count, sizeof count) < 0) return;
-    std::optional<std::vector<sss::core::TrajectoryNode>> trajectory;
-    std::vector<std::string> messages;
-    sss::optimiser::PoseGraphCounters graph_counters;
-    sss::optimiser::OptimiserEngineCounters engine_counters;
-    sss::optimiser::FixCounters fix_counters;
-    sss::optimiser::DrCalibration calibration;
-    size_t memory_bytes = 0;
-    double last_checkpoint_s = 0.0;
-    {
-      std::lock_guard<std::mutex> lock(shared.mutex);
-      trajectory.swap(shared.trajectory);
-      messages.swap(shared.messages);
-      graph_counters = shared.graph_counters;
-      engine_counters = shared.engine_counters;
-      fix_counters = shared.fix_counters;
-      calibration = shared.calibration;
-      memory_bytes = shared.memory_bytes;
-      last_checkpoint_s = shared.last_checkpoint_s;
+    sss::optimiser::OptimiserWorkerResults results = worker.takeResults();
+    for (const auto& m : results.messages) spdlog::info("{}", m);
+    if (results.trajectory && !results.trajectory->empty()) {
+      loop.bus().publish(options.trajectory_channel, sss::messages::toTrajectoryMessage(*results.trajectory, sss::core::nowUtime()));
     }
-    for (const auto& m : messages) spdlog::info("{}", m);
-    if (trajectory && !trajectory->empty()) {
-      loop.bus().publish(options.trajectory_channel, sss::messages::toTrajectoryMessage(*trajectory, sss::core::nowUtime()));
-    }
-    health.setCounter("nodes", static_cast<double>(graph_counters.nodes_added));
-    health.setCounter("nodes_marginalised", static_cast<double>(graph_counters.nodes_marginalised));
-    health.setCounter("closures_received", static_cast<double>(graph_counters.closures_received));
-    health.setCounter("closures_accepted", static_cast<double>(graph_counters.closures_accepted));
-    health.setCounter("closures_rejected",
-                      static_cast<double>(graph_counters.closures_rejected_gate +
-                                          graph_counters.closures_rejected_inconsistent +
-                                          graph_counters.closures_rejected_no_support));
-    health.setCounter("closures_refused", static_cast<double>(engine_counters.closures_refused));
-    health.setCounter("closures_waiting", static_cast<double>(engine_counters.closures_waiting));
-    health.setCounter("subframes_refused", static_cast<double>(engine_counters.subframes_refused));
-    health.setCounter("odometer_resets", static_cast<double>(engine_counters.odometer_resets));
-    health.setCounter("fixes_received", static_cast<double>(fix_counters.received));
-    health.setCounter("fixes_accepted", static_cast<double>(fix_counters.accepted));
-    health.setCounter("fixes_rejected", static_cast<double>(fix_counters.rejected_gate + fix_counters.refused));
-    health.setCounter("updates", static_cast<double>(graph_counters.updates));
-    // The DR calibration in use (re-estimated every calibration_period_s of mission time): 0 and
-    // NaN sigmas before the first estimate; the scale's sigma NaN while no fix observes it.
-    health.setCounter("full_smoothings", static_cast<double>(graph_counters.full_smoothings));
-    health.setCounter("calibration_estimated", calibration.estimated ? 1.0 : 0.0);
-    health.setCounter("calibration_dvl_scale", calibration.dvl_scale);
-    health.setCounter("calibration_dvl_scale_sigma", calibration.sigma(0));
-    health.setCounter("calibration_heading_bias_rad", calibration.heading_bias_rad);
-    health.setCounter("calibration_heading_cos_rad", calibration.heading_cos_rad);
-    health.setCounter("calibration_heading_cos_sigma_rad", calibration.sigma(2));
-    health.setCounter("calibration_heading_sin_rad", calibration.heading_sin_rad);
-    health.setCounter("solver_failures", static_cast<double>(graph_counters.solver_failures));
-    health.setCounter("last_update_ms", 1e3 * graph_counters.last_update_s);
-    health.setCounter("memory_mb", static_cast<double>(memory_bytes) / 1e6);
-    health.setCounter("last_checkpoint_ms", 1e3 * last_checkpoint_s);
+    sss::optimiser::setStatusCounters(results.status, health);
   });
 
   if (writer) {
@@ -518,46 +359,13 @@ int main(int argc, char** argv) {
   loop.addTimer(0.5, [&] {
     if (!g_products_requested.exchange(false)) return;
     spdlog::info("products requested (SIGUSR1): full smoothing");
-    std::lock_guard<std::mutex> lock(shared.mutex);
-    shared.products_requested = true;
-    shared.wake.notify_one();
+    worker.requestProducts();
   });
 
-  // A restored graph: its trajectory and counters go out at once (the matcher re-associates with
-  // them), not only after the next update.
-  if (engine.graph().numNodes() > 0) {
-    std::lock_guard<std::mutex> lock(shared.mutex);
-    shared.trajectory = engine.trajectory();
-    shared.graph_counters = engine.graph().counters();
-    shared.engine_counters = engine.counters();
-    shared.memory_bytes = engine.memoryBytes();
-    notifyLoop();
-  }
+  worker.start();
   const int exit_code = loop.run();
-  {
-    std::lock_guard<std::mutex> lock(shared.mutex);
-    shared.stop = true;
-    shared.wake.notify_one();
-  }
-  worker.join();
-  close(results_fd);
   // End of mission: whatever arrived last, full smoothing, products and a final checkpoint.
-  for (const auto& subframe : shared.subframes) {
-    const auto status = engine.addSubframe(subframe);
-    if (!status.message.empty()) spdlog::info("subframe {}: {}", subframe.id, status.message);
-    if (status.ok) keepForProducts(subframe);
-  }
-  for (const auto& closure : shared.closures) engine.addLoopClosure(closure);
-  for (const auto& fix : shared.fixes) engine.addFix(fix);
-  if (engine.graph().numNodes() > 0) {
-    engine.finish();
-    std::vector<std::string> messages;
-    if (!options.products_directory.empty()) sss::products::writeLiveProducts(engine, mosaics, footprints, options.products_directory, shared.origin, messages);
-    if (!checkpoint_path.empty()) {
-      const auto saved = engine.saveCheckpoint(checkpoint_path);
-      if (!saved.ok) messages.push_back("checkpoint: " + saved.message);
-    }
-    for (const auto& m : messages) spdlog::info("{}", m);
-  }
+  for (const auto& m : worker.finish()) spdlog::info("{}", m);
+  close(results_fd);
   return exit_code;
 }
