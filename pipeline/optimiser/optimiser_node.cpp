@@ -1,8 +1,9 @@
 // sss-optimiser: SSS_SUBFRAME + SSS_LOOP (+ SSS_FIX: absolute fixes) -> pose graph -> SSS_TRAJECTORY (matcher); SSS_NAV ->
 // SSS_POSE for every nav sample and the correction on DDS for the navigation computer.
-// Translation only; the logic is in OptimiserEngine. The graph is solved on a worker thread; the
-// process loop answers each nav sample from a snapshot of the newest solved graph, so a solve never
-// delays a pose. The engine (graph, ping poses, correspondences) is checkpointed after every update
+// Wiring only: the graph is solved by OptimiserWorker (optimiser_worker.hpp) on its own thread; the
+// process loop answers each nav sample with NavCorrector (nav_corrector.hpp) from a snapshot of the
+// newest solved graph, so a solve never delays a pose; the DDS correction is paced by
+// LatestSamplePacer. The engine (graph, ping poses, correspondences) is checkpointed after every update
 // into the state directory and restored at start. On SIGTERM (end of mission) or SIGUSR1 (on request) it runs full smoothing and
 // writes the products: optimised trajectory (TUM), corrected navigation (navigation.csv, .nmea), tie report
 // (loop_closures.csv), tracks and footprints (GeoJSON), coverage, mosaics, bathymetry (PLY) and heightmap,
@@ -31,6 +32,7 @@
 #include "pipeline/optimiser/optimiser_engine.hpp"
 #include "pipeline/optimiser/correction_slew.hpp"
 #include "pipeline/optimiser/fix_message.hpp"
+#include "pipeline/optimiser/nav_corrector.hpp"
 #include "pipeline/optimiser/optimiser_worker.hpp"
 #include "products/footprints.hpp"
 #include "products/live_products.hpp"
@@ -39,6 +41,7 @@
 #include "pipeline/messages/subframe_messages.hpp"
 #include "pipeline/messages/sensor_messages.hpp"
 #include "pipeline/transport/dds.hpp"
+#include "pipeline/transport/latest_sample_pacer.hpp"
 #include "pipeline/transport/logging.hpp"
 #include "pipeline/transport/process_loop.hpp"
 #include "pipeline/transport/process_options.hpp"
@@ -80,52 +83,113 @@ struct NodeOptions {
 std::atomic<bool> g_products_requested{false};
 void onSigusr1(int) { g_products_requested.store(true); }
 
+// The node's options from the configuration file (none: the defaults). Empty when valid, else
+// the problems, one per line.
+std::string readNodeOptions(const std::string& config_path, NodeOptions& options) {
+  options.process.process_name = "sss-optimiser";
+  if (config_path.empty()) return {};  // the defaults
+  using namespace sss::core;
+  Config config = Config::fromFile(config_path);
+  ConfigSection mission = config.section("mission");
+  options.configured_origin = sss::core::readMissionOrigin(mission);
+  ConfigSection section = config.section("optimiser");
+  sss::transport::readProcessOptions(section, options.process);
+  sss::optimiser::readOptimiserEngineOptions(section, options.engine);
+  sss::optimiser::readCorrectionSlewOptions(section, options.slew);
+  section.optional("subframe_channel", options.subframe_channel, {nonEmpty()});
+  section.optional("loop_channel", options.loop_channel, {nonEmpty()});
+  section.optional("fix_channel", options.fix_channel, {nonEmpty()});
+  section.optional("nav_channel", options.nav_channel, {nonEmpty()});
+  section.optional("pose_channel", options.pose_channel, {nonEmpty()});
+  section.optional("trajectory_channel", options.trajectory_channel, {nonEmpty()});
+  section.optional("update_period_s", options.update_period_s, {inRange(0.0, 3600.0)});
+  section.optional("state_directory", options.state_directory);
+  section.optional("products_directory", options.products_directory);
+  section.optional("products_mosaic_max_mib", options.products_mosaic_max_mib, {inRange(0.0, 65536.0)});
+  ConfigSection dds = section.section("dds");
+  dds.optional("enabled", options.dds_enabled);
+  dds.optional("domain_id", options.dds_domain_id, {inRange(0, 232)});
+  dds.optional("topic", options.dds_topic, {nonEmpty()});
+  dds.optional("rate_hz", options.dds_rate_hz, {inRange(0.01, 1000.0)});
+  dds.optional("vehicle_id", options.vehicle_id, {inRange(0, 1000000)});
+  dds.optional("loopback_only", options.dds_loopback_only);
+  dds.rejectUnknownKeys();
+  section.rejectUnknownKeys();
+  for (const std::string& problem : sss::optimiser::validateOptimiserEngineOptions(options.engine)) {
+    section.addProblem("optimiser", "", problem);
+  }
+  for (const std::string& problem : sss::optimiser::validateCorrectionSlewOptions(options.slew)) {
+    section.addProblem("optimiser", "", problem);
+  }
+  return config.problemReport();
+}
+
+// The checkpoint's path in the state directory (empty: none), restored into the engine if it is there.
+std::string restoreCheckpoint(const std::string& state_directory, OptimiserEngine& engine) {
+  if (state_directory.empty()) {
+    spdlog::warn("no state directory (config optimiser.state_directory or $STATE_DIRECTORY): no checkpoints, "
+                 "a restart loses the graph");
+    return {};
+  }
+  const std::string checkpoint_path = state_directory + "/optimiser.checkpoint";
+  std::error_code ec;
+  fs::create_directories(state_directory, ec);
+  if (!fs::exists(checkpoint_path)) return checkpoint_path;
+  const sss::optimiser::Status loaded = engine.loadCheckpoint(checkpoint_path);
+  if (loaded.ok) {
+    spdlog::info("resumed from {}: {} nodes, {} closures accepted, ping poses of {} subframes, {} odometer resets",
+                 checkpoint_path, engine.graph().numNodes(), engine.graph().counters().closures_accepted,
+                 engine.storedSubframes(), engine.counters().odometer_resets);
+  } else {
+    spdlog::error("checkpoint {} refused ({}); starting empty", checkpoint_path, loaded.message);
+  }
+  return checkpoint_path;
+}
+
+// The DDS participant, topic and writer of the correction, or why there are none.
+class DdsCorrectionWriter {
+ public:
+  explicit DdsCorrectionWriter(const NodeOptions& options)
+      : participant_(static_cast<uint32_t>(options.dds_domain_id),
+                     options.dds_loopback_only ? sss::transport::dds::loopbackConfigXml() : std::string()) {
+    if (!participant_.good()) return;
+    topic_ = std::make_unique<sss::transport::dds::Topic<sss_dds_NavigationCorrection>>(
+        participant_, &sss_dds_NavigationCorrection_desc, options.dds_topic);
+    if (topic_->good()) writer_ = std::make_unique<sss::transport::dds::Writer<sss_dds_NavigationCorrection>>(participant_, *topic_);
+  }
+  bool good() const { return writer_ && writer_->good(); }
+  std::string error() const { return participant_.good() ? "topic or writer" : participant_.error(); }
+  bool write(const sss_dds_NavigationCorrection& sample) { return writer_->write(sample); }
+
+ private:
+  sss::transport::dds::Participant participant_;
+  std::unique_ptr<sss::transport::dds::Topic<sss_dds_NavigationCorrection>> topic_;
+  std::unique_ptr<sss::transport::dds::Writer<sss_dds_NavigationCorrection>> writer_;
+};
+
+void logOriginChange(const std::optional<sss::core::MissionOrigin>& previous, const sss::core::MissionOrigin& origin,
+                     const std::optional<sss::core::MissionOrigin>& configured) {
+  if (previous) {
+    spdlog::error("the navigation's origin moved from {:.7f} {:.7f} to {:.7f} {:.7f} (INS bridge restarted "
+                  "without its state directory?): corrected poses are geo-referenced with the new one",
+                  previous->latitude_deg, previous->longitude_deg, origin.latitude_deg, origin.longitude_deg);
+  } else {
+    spdlog::info("mission origin (from SSS_NAV): {:.7f} {:.7f}", origin.latitude_deg, origin.longitude_deg);
+  }
+  if (configured && (configured->latitude_deg != origin.latitude_deg || configured->longitude_deg != origin.longitude_deg)) {
+    spdlog::warn("the navigation's origin differs from mission.origin_* in the configuration (does the INS "
+                 "bridge read the same file?); the navigation's is used");
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   sss::transport::NodeArguments arguments;
   if (const int exit_code = sss::transport::parseNodeArguments(argc, argv, arguments); exit_code >= 0) return exit_code;
-  const std::string& config_path = arguments.config_path;
   NodeOptions options;
-  options.process.process_name = "sss-optimiser";
-  std::string config_problems;  // empty: valid (or no file: the defaults)
-  if (!config_path.empty()) {
-    using namespace sss::core;
-    Config config = Config::fromFile(config_path);
-    ConfigSection mission = config.section("mission");
-    options.configured_origin = sss::core::readMissionOrigin(mission);
-    ConfigSection section = config.section("optimiser");
-    sss::transport::readProcessOptions(section, options.process);
-    sss::optimiser::readOptimiserEngineOptions(section, options.engine);
-    sss::optimiser::readCorrectionSlewOptions(section, options.slew);
-    section.optional("subframe_channel", options.subframe_channel, {nonEmpty()});
-    section.optional("loop_channel", options.loop_channel, {nonEmpty()});
-    section.optional("fix_channel", options.fix_channel, {nonEmpty()});
-    section.optional("nav_channel", options.nav_channel, {nonEmpty()});
-    section.optional("pose_channel", options.pose_channel, {nonEmpty()});
-    section.optional("trajectory_channel", options.trajectory_channel, {nonEmpty()});
-    section.optional("update_period_s", options.update_period_s, {inRange(0.0, 3600.0)});
-    section.optional("state_directory", options.state_directory);
-    section.optional("products_directory", options.products_directory);
-    section.optional("products_mosaic_max_mib", options.products_mosaic_max_mib, {inRange(0.0, 65536.0)});
-    ConfigSection dds = section.section("dds");
-    dds.optional("enabled", options.dds_enabled);
-    dds.optional("domain_id", options.dds_domain_id, {inRange(0, 232)});
-    dds.optional("topic", options.dds_topic, {nonEmpty()});
-    dds.optional("rate_hz", options.dds_rate_hz, {inRange(0.01, 1000.0)});
-    dds.optional("vehicle_id", options.vehicle_id, {inRange(0, 1000000)});
-    dds.optional("loopback_only", options.dds_loopback_only);
-    dds.rejectUnknownKeys();
-    section.rejectUnknownKeys();
-    for (const std::string& problem : sss::optimiser::validateOptimiserEngineOptions(options.engine)) {
-      section.addProblem("optimiser", "", problem);
-    }
-    for (const std::string& problem : sss::optimiser::validateCorrectionSlewOptions(options.slew)) {
-      section.addProblem("optimiser", "", problem);
-    }
-    config_problems = config.problemReport();
-  }
-  if (const int code = sss::transport::configVerdict("sss-optimiser", config_problems, config_path, arguments.check_config_only); code >= 0) {
+  const std::string config_problems = readNodeOptions(arguments.config_path, options);
+  if (const int code = sss::transport::configVerdict("sss-optimiser", config_problems, arguments.config_path, arguments.check_config_only); code >= 0) {
     return code;
   }
   if (!arguments.lcm_url_override.empty()) options.process.lcm_url = arguments.lcm_url_override;
@@ -137,8 +201,6 @@ int main(int argc, char** argv) {
   sss::transport::initLogging(options.process.process_name, options.process.log_level);
   sss::transport::ProcessLoop loop(options.process);
   sss::core::HealthMonitor& health = loop.health();
-  // The tangent plane of the origin in the navigation (rebuilt if the INS bridge's origin changes).
-  std::optional<sss::core::LocalTangentPlane> plane;
   // Determinism and bounded latency come from the iteration bound; the time limit is the config's.
   OptimiserEngine engine(options.engine);
   // The subframes at mosaic resolution for the products' mosaics: only since this start (a restart
@@ -150,25 +212,7 @@ int main(int argc, char** argv) {
     mosaics.add(subframe);  // decimated: ~1/5 of the image
     footprints.push_back(sss::products::footprintOf(subframe));
   };
-  const std::string checkpoint_path =
-      options.state_directory.empty() ? std::string() : options.state_directory + "/optimiser.checkpoint";
-  if (!checkpoint_path.empty()) {
-    std::error_code ec;
-    fs::create_directories(options.state_directory, ec);
-    if (fs::exists(checkpoint_path)) {
-      const sss::optimiser::Status loaded = engine.loadCheckpoint(checkpoint_path);
-      if (loaded.ok) {
-        spdlog::info("resumed from {}: {} nodes, {} closures accepted, ping poses of {} subframes, {} odometer resets",
-                     checkpoint_path, engine.graph().numNodes(), engine.graph().counters().closures_accepted,
-                     engine.storedSubframes(), engine.counters().odometer_resets);
-      } else {
-        spdlog::error("checkpoint {} refused ({}); starting empty", checkpoint_path, loaded.message);
-      }
-    }
-  } else {
-    spdlog::warn("no state directory (config optimiser.state_directory or $STATE_DIRECTORY): no checkpoints, "
-                 "a restart loses the graph");
-  }
+  const std::string checkpoint_path = restoreCheckpoint(options.state_directory, engine);
 
   sss::optimiser::OptimiserWorker::Hooks hooks;
   hooks.subframe_taken = keepForProducts;
@@ -191,39 +235,22 @@ int main(int argc, char** argv) {
   sss::optimiser::OptimiserWorker worker(engine, {options.update_period_s, checkpoint_path}, hooks);
 
   // ---- DDS: the newest correction, reliable, keep-last 1, transient-local ----------------------
-  std::unique_ptr<sss::transport::dds::Participant> participant;
-  std::unique_ptr<sss::transport::dds::Topic<sss_dds_NavigationCorrection>> topic;
-  std::unique_ptr<sss::transport::dds::Writer<sss_dds_NavigationCorrection>> writer;
+  std::unique_ptr<DdsCorrectionWriter> dds_writer;
   if (options.dds_enabled) {
-    participant = std::make_unique<sss::transport::dds::Participant>(
-        static_cast<uint32_t>(options.dds_domain_id),
-        options.dds_loopback_only ? sss::transport::dds::loopbackConfigXml() : std::string());
-    if (participant->good()) {
-      topic = std::make_unique<sss::transport::dds::Topic<sss_dds_NavigationCorrection>>(
-          *participant, &sss_dds_NavigationCorrection_desc, options.dds_topic);
-      if (topic->good()) writer = std::make_unique<sss::transport::dds::Writer<sss_dds_NavigationCorrection>>(*participant, *topic);
-    }
-    if (!writer || !writer->good()) {
+    dds_writer = std::make_unique<DdsCorrectionWriter>(options);
+    if (!dds_writer->good()) {
       spdlog::error("DDS writer for topic '{}' on domain {} could not be created ({}); corrections go on LCM only",
-                    options.dds_topic, options.dds_domain_id,
-                    participant && !participant->good() ? participant->error() : "topic or writer");
-      writer.reset();
+                    options.dds_topic, options.dds_domain_id, dds_writer->error());
+      dds_writer.reset();
       health.recordError("dds", "DDS writer unavailable", sss::core::nowUtime());
     }
   }
-  // Written from the nav callback, so the navigation computer gets a correction as soon as its
-  // nav sample is answered (not up to a timer period later), at most dds.rate_hz. A sample held
-  // back by the rate goes out from the timer only when the nav has gone quiet for half a period
-  // (otherwise the next nav sample, a few ms later, is written fresh instead).
-  std::optional<sss_dds_NavigationCorrection> pending_dds;
+  // Written from the nav callback, so the navigation computer gets a correction as soon as its nav
+  // sample is answered (not up to a timer period later), at most dds.rate_hz (latest_sample_pacer.hpp).
+  sss::transport::LatestSamplePacer<sss_dds_NavigationCorrection> dds_pacer(static_cast<int64_t>(1e6 / options.dds_rate_hz));
   uint64_t dds_written = 0;
-  const auto dds_period_us = static_cast<int64_t>(1e6 / options.dds_rate_hz);
-  int64_t last_dds_write_us = std::numeric_limits<int64_t>::min() / 2;
-  int64_t last_nav_us = 0;
-  auto writeDds = [&](const sss_dds_NavigationCorrection& sample, int64_t now_us) {
-    last_dds_write_us = now_us;
-    pending_dds.reset();
-    if (writer->write(sample)) {
+  auto writeDds = [&](const sss_dds_NavigationCorrection& sample) {
+    if (dds_writer->write(sample)) {
       ++dds_written;
       health.setCounter("dds_corrections", static_cast<double>(dds_written));
     } else if (health.recordError("dds_write", "DDS write failed", sss::core::nowUtime())) {
@@ -231,67 +258,44 @@ int main(int argc, char** argv) {
     }
   };
 
-  sss::optimiser::CorrectionSlew slew(options.slew);
+  sss::optimiser::NavCorrector corrector(options.slew);
   // Off the nav path (200 Hz, latency-bound): the slew's figures go to SSS_STATUS once a second.
   loop.addTimer(1.0, [&] {
-    health.setCounter("correction_lag_m", slew.lagM());
-    health.setCounter("correction_last_jump_m", slew.lastJumpM());
-    health.setCounter("correction_jumps", static_cast<double>(slew.jumps()));
+    health.setCounter("correction_lag_m", corrector.slew().lagM());
+    health.setCounter("correction_last_jump_m", corrector.slew().lastJumpM());
+    health.setCounter("correction_jumps", static_cast<double>(corrector.slew().jumps()));
   });
   // ---- subscriptions ------------------------------------------------------------------------------
   loop.bus().subscribe<sss_msgs::nav_t>(options.nav_channel, [&](const sss_msgs::nav_t& message) {
     const int64_t arrival = sss::core::monotonicUtime();
     const sss::core::NavSample nav = sss::messages::fromNavMessage(message);
-    if (!nav.position_ned_m.allFinite() || !std::isfinite(nav.heading_rad) || !std::isfinite(nav.roll_rad) ||
-        !std::isfinite(nav.pitch_rad) || nav.utime_us <= 0) {
+    const sss::optimiser::NavCorrection answer = corrector.correct(nav, *worker.snapshot());
+    if (answer.verdict == sss::optimiser::NavVerdict::kBadSample) {
       if (health.recordError("bad_nav", "nav sample with non-finite pose or no time", sss::core::nowUtime()))
         spdlog::warn("nav sample rejected (non-finite pose or no time); further ones are counted in SSS_STATUS");
       return;
     }
-    if (!nav.position_valid || !nav.origin) {
+    if (answer.verdict == sss::optimiser::NavVerdict::kNoPosition) {
       // Before the INS's first fix: no position, no frame, nothing to correct yet.
       if (health.recordError("nav_without_position", "nav sample without a position or origin", sss::core::nowUtime()))
         spdlog::warn("nav sample without a position (before the INS's first fix?) not corrected; further ones are "
                      "counted in SSS_STATUS");
       return;
     }
-    if (!plane || plane->originLatitudeDeg() != nav.origin->latitude_deg ||
-        plane->originLongitudeDeg() != nav.origin->longitude_deg) {
-      if (plane) {
-        spdlog::error("the navigation's origin moved from {:.7f} {:.7f} to {:.7f} {:.7f} (INS bridge restarted "
-                      "without its state directory?): corrected poses are geo-referenced with the new one",
-                      plane->originLatitudeDeg(), plane->originLongitudeDeg(), nav.origin->latitude_deg,
-                      nav.origin->longitude_deg);
-      } else {
-        spdlog::info("mission origin (from SSS_NAV): {:.7f} {:.7f}", nav.origin->latitude_deg, nav.origin->longitude_deg);
-      }
-      if (options.configured_origin && (options.configured_origin->latitude_deg != nav.origin->latitude_deg ||
-                                        options.configured_origin->longitude_deg != nav.origin->longitude_deg)) {
-        spdlog::warn("the navigation's origin differs from mission.origin_* in the configuration (does the INS "
-                     "bridge read the same file?); the navigation's is used");
-      }
-      plane.emplace(nav.origin->latitude_deg, nav.origin->longitude_deg);
+    if (answer.origin_changed) {
+      logOriginChange(answer.previous_origin, *nav.origin, options.configured_origin);
       worker.setOrigin(*nav.origin);
     }
-    const auto graph = worker.snapshot();
-    const sss::optimiser::Correction correction = slew.apply(graph->correctionAt(nav.utime_us), nav.utime_us);
-    if (const auto jump = slew.takeNewJump()) {
+    if (answer.jump_m) {
       spdlog::info("the correction of the present pose jumped {:.2f} m (a fix or closures accepted); the published "
-                   "pose follows at {:.2f} m/s, its covariance widened by what is left", *jump, options.slew.max_rate_m_s);
+                   "pose follows at {:.2f} m/s, its covariance widened by what is left", *answer.jump_m, options.slew.max_rate_m_s);
     }
-    const auto dr = sss::core::poseOf(nav);
-    const sss_msgs::pose_t pose = sss::optimiser::toPoseMessage(nav.utime_us, dr, correction, *plane);
+    const sss_msgs::pose_t pose = sss::optimiser::toPoseMessage(nav.utime_us, answer.dr, answer.correction, *corrector.plane());
     loop.bus().publish(options.pose_channel, pose, arrival);
-    if (writer) {
+    if (dds_writer) {
       const sss_dds_NavigationCorrection sample =
-          sss::optimiser::toDdsCorrection(pose, static_cast<uint32_t>(options.vehicle_id), correction.accepted_closures);
-      const int64_t now_us = sss::core::monotonicUtime();
-      last_nav_us = now_us;
-      if (now_us - last_dds_write_us >= dds_period_us) {
-        writeDds(sample, now_us);
-      } else {
-        pending_dds = sample;
-      }
+          sss::optimiser::toDdsCorrection(pose, static_cast<uint32_t>(options.vehicle_id), answer.correction.accepted_closures);
+      if (const auto due = dds_pacer.offer(sample, sss::core::monotonicUtime())) writeDds(*due);
     }
   });
   loop.bus().subscribe<sss_msgs::subframe_t>(options.subframe_channel, [&](const sss_msgs::subframe_t& message) {
@@ -347,12 +351,9 @@ int main(int argc, char** argv) {
     sss::optimiser::setStatusCounters(results.status, health);
   });
 
-  if (writer) {
+  if (dds_writer) {
     loop.addTimer(0.25 / options.dds_rate_hz, [&] {
-      const int64_t now_us = sss::core::monotonicUtime();
-      if (pending_dds && now_us - last_dds_write_us >= dds_period_us && now_us - last_nav_us >= dds_period_us / 2) {
-        writeDds(*pending_dds, now_us);
-      }
+      if (const auto due = dds_pacer.poll(sss::core::monotonicUtime())) writeDds(*due);
     });
   }
   std::signal(SIGUSR1, onSigusr1);
