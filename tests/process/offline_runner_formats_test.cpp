@@ -1,0 +1,378 @@
+// sss-process's runner on files from other sonars and set-ups, built from the formats' public
+// layouts: XTF in projected metres without altitude, XTF navigation packets or ship coordinates,
+// JSF situation or NMEA messages as the only navigation, a towed fish on a curved line.
+#include "tests/process/offline_runner_fixture.hpp"
+
+namespace {
+
+// An XTF with its navigation in projected metres (NavUnits 0, as Isis writes it) and no altitude
+// (a towed fish), with attitude packets between the pings, built from the public layout: it is
+// processed in the file's own grid (north = northing - N0 of the first fix), says so, and tracks
+// the bottom; and a multibeam-only file is refused in one line.
+TEST_F(OfflineRunnerTest, XtfInProjectedMetresWithoutAltitudeIsProcessedInItsGrid) {
+  sss::xtf::XtfWriterOptions options;
+  options.nav_units = sss::xtf::kNavUnitsMetres;
+  sss::xtf::XtfWriterChannel port, starboard;
+  starboard.type_of_channel = sss::xtf::kChannelStarboard;
+  starboard.name = "Starboard";
+  options.channels = {port, starboard};
+  const std::string path = root_ + "/projected.xtf";
+  {
+    sss::xtf::XtfWriter writer(path, options);
+    ASSERT_TRUE(writer.isOpen());
+    std::mt19937 random(3);
+    const double heading_rad = 30.0 * M_PI / 180.0, speed_m_s = 2.0, altitude_m = 15.0, spacing_m = 0.03;
+    for (int i = 0; i < 600; ++i) {  // 150 s at 4 Hz: 300 m
+      sss::xtf::XtfPingInput ping;
+      ping.ping_number = static_cast<uint32_t>(i);
+      ping.ping_time_us = 1780300800000000LL + i * 250000LL;
+      ping.sound_velocity = 750.0f;
+      ping.sensor_x = 650123.0 + speed_m_s * 0.25 * i * std::sin(heading_rad);   // easting
+      ping.sensor_y = 6580456.0 + speed_m_s * 0.25 * i * std::cos(heading_rad);  // northing
+      ping.depth_m = 30.0f;
+      ping.heading_deg = 30.0f;
+      addSeabedChannels(ping, 2500, spacing_m, altitude_m, random);
+      ASSERT_TRUE(writer.write(ping));
+      ASSERT_TRUE(writer.writeBytes(sss::xtf::encodeOtherPacket(3, 64)));  // an attitude packet
+    }
+  }
+  const std::string out_dir = root_ + "/run_projected";
+  const auto result = runSonarFileOnly(path, out_dir);
+  ASSERT_TRUE(result.ok) << result.error;
+  const auto& s = result.summary;
+  EXPECT_EQ(s.pings, 600u);
+  EXPECT_GE(s.pings_with_pose, 570u) << "95 % of the pings";
+  EXPECT_GE(s.subframes, 2u);
+  EXPECT_EQ(s.buffer.fusion.altitude_from_bottom_track, s.pings_with_pose);
+  EXPECT_EQ(s.origin_source, "projected_first_fix");
+  EXPECT_FALSE(s.origin);
+  EXPECT_DOUBLE_EQ(s.projected_origin_easting_m, 650123.0);
+  EXPECT_DOUBLE_EQ(s.projected_origin_northing_m, 6580456.0);
+  const std::string summary = readFile(out_dir + "/summary.json");
+  EXPECT_NE(summary.find("projected_northing_m"), std::string::npos) << summary;
+  const auto slam = sss::eval::readTum(out_dir + "/slam.tum");
+  ASSERT_TRUE(slam.ok) << slam.error;
+  EXPECT_FALSE(slam.origin);
+  EXPECT_NE(readFile(out_dir + "/slam.tum").find("north = northing - 6580456.000"), std::string::npos);
+  // The last pose: 299.5 m along 30 deg from the first fix, in the grid.
+  const Eigen::Vector3d last = slam.poses.back().T_world_body.translation;
+  const double along_m = 2.0 * 0.25 * 599;
+  EXPECT_NEAR(last.x(), along_m * std::cos(30.0 * M_PI / 180.0), 3.0);
+  EXPECT_NEAR(last.y(), along_m * std::sin(30.0 * M_PI / 180.0), 3.0);
+  std::istringstream altitudes(readFile(out_dir + "/altitude.csv"));
+  size_t near_truth = 0, rows = 0;
+  for (std::string line; std::getline(altitudes, line);) {
+    if (line.empty() || line[0] == '#' || line[0] == 'u') continue;
+    ++rows;
+    near_truth += std::abs(std::stod(line.substr(line.find(',') + 1)) - 15.0) < 0.2 ? 1 : 0;
+  }
+  EXPECT_GE(near_truth, rows * 95 / 100) << "bottom-tracked altitude within 0.2 m of the 15 m";
+  EXPECT_FALSE(s.geotiffs.empty()) << "the heightmap and coverage in the grid's coordinates";
+  EXPECT_EQ(s.geotiff_crs, "") << "no CRS is guessed for a grid the file does not name";
+  EXPECT_NE(std::find_if(s.findings.begin(), s.findings.end(),
+                         [](const std::string& f) { return f.find("products.projected_crs") != std::string::npos; }),
+            s.findings.end())
+      << "a projected input without a CRS is told how to name it";
+
+  // With the grid's CRS named: GeoTIFFs in the file's grid, and a corrected copy of the XTF whose
+  // pings hold slam.tum plus the grid offsets (f64 in XTF: the TUM file's 0.1 mm rounding).
+  {
+    // A CRS GDAL does not know is refused before any processing, with the key named (exit 2).
+    const std::string bad_config = root_ + "/projected_bad_crs.yaml";
+    std::ofstream(bad_config) << "products:\n  projected_crs: EPSG:99999999\n";
+    sss::offline::OfflineRequest bad;
+    bad.sonar_path = path;
+    bad.out_dir = root_ + "/run_projected_bad_crs";
+    bad.config_path = bad_config;
+    const auto refused = sss::offline::runOffline(bad);
+    EXPECT_EQ(refused.exit_code, 2);
+    EXPECT_NE(refused.error.find("products.projected_crs"), std::string::npos) << refused.error;
+
+    const std::string config_path = root_ + "/projected_products.yaml";
+    std::ofstream(config_path) << "products:\n  projected_crs: EPSG:32633\n";
+    sss::offline::OfflineRequest products;
+    products.sonar_path = path;
+    products.out_dir = root_ + "/run_projected_products";
+    products.config_path = config_path;
+    products.corrected_dir = products.out_dir + "/corrected";
+    const auto run = sss::offline::runOffline(products);
+    ASSERT_TRUE(run.ok) << run.error;
+    EXPECT_EQ(run.summary.geotiff_epsg, 32633);
+    EXPECT_EQ(run.summary.geotiff_crs, "WGS 84 / UTM zone 33N");
+    EXPECT_NE(std::find(run.summary.geotiffs.begin(), run.summary.geotiffs.end(), "mosaic_slam.tif"),
+              run.summary.geotiffs.end());
+    EXPECT_EQ(run.summary.corrected_records, run.summary.pings_with_pose);
+    const auto corrected_slam = sss::eval::readTum(products.out_dir + "/slam.tum");
+    ASSERT_TRUE(corrected_slam.ok) << corrected_slam.error;
+    std::map<int64_t, Eigen::Vector3d> slam_at;
+    for (const auto& p : corrected_slam.poses) slam_at[p.utime_us] = p.T_world_body.translation;
+    sss::xtf::XtfReader reader(products.corrected_dir + "/projected.xtf");
+    ASSERT_TRUE(reader.isOpen()) << reader.error();
+    sss::edgetech::DriverPing ping;
+    size_t compared = 0;
+    double worst_m = 0.0;
+    while (reader.next(ping)) {
+      const auto found = slam_at.find(ping.utime_us);
+      if (found == slam_at.end()) continue;  // a ping the chain dropped keeps its recorded navigation
+      const auto& side = *ping.ping.port;
+      worst_m = std::max(worst_m, std::hypot(side.easting_m - 650123.0 - found->second.y(),
+                                             side.northing_m - 6580456.0 - found->second.x()));
+      ++compared;
+    }
+    EXPECT_EQ(compared, run.summary.pings_with_pose);
+    EXPECT_LT(worst_m, 1e-3);
+  }
+
+  // A multibeam-only XTF: refused with the reason, exit 2.
+  sss::xtf::XtfWriterOptions multibeam;
+  sss::xtf::XtfWriterChannel bathymetry;
+  bathymetry.type_of_channel = 3;  // bathymetry
+  bathymetry.name = "Bathy";
+  multibeam.channels = {bathymetry};
+  const std::string multibeam_path = root_ + "/multibeam.xtf";
+  {
+    sss::xtf::XtfWriter writer(multibeam_path, multibeam);
+    ASSERT_TRUE(writer.writeBytes(sss::xtf::encodeOtherPacket(2, 256)));
+  }
+  sss::offline::OfflineRequest mb;
+  mb.sonar_path = multibeam_path;
+  mb.out_dir = root_ + "/run_multibeam";
+  const auto refused = sss::offline::runOffline(mb);
+  EXPECT_FALSE(refused.ok);
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_NE(refused.error.find("no side-scan channel"), std::string::npos) << refused.error;
+}
+
+// XTF pings without a sensor position: navigation from raw-position packets (type 107, 4 Hz,
+// latitude/longitude with attitude) between the pings, or the vessel's ShipY/X in the ping header.
+TEST_F(OfflineRunnerTest, XtfNavigationPacketsOrShipCoordinatesPositionPingsWithoutSensorPosition) {
+  for (const bool ship : {false, true}) {
+    sss::xtf::XtfWriterOptions options;
+    options.nav_units = sss::xtf::kNavUnitsLatLon;
+    sss::xtf::XtfWriterChannel port, starboard;
+    starboard.type_of_channel = sss::xtf::kChannelStarboard;
+    options.channels = {port, starboard};
+    const std::string path = root_ + (ship ? "/ship.xtf" : "/packets.xtf");
+    const sss::core::LocalTangentPlane plane(43.0, 5.0);
+    const double heading_rad = 100.0 * M_PI / 180.0;
+    auto positionAt = [&](double t_s) {
+      return plane.toGeodetic(Eigen::Vector3d(2.0 * t_s * std::cos(heading_rad), 2.0 * t_s * std::sin(heading_rad), 0.0));
+    };
+    {
+      sss::xtf::XtfWriter writer(path, options);
+      ASSERT_TRUE(writer.isOpen());
+      std::mt19937 random(5);
+      for (int i = 0; i < 600; ++i) {  // 150 s at 4 Hz
+        const double t_s = 0.25 * i;
+        const int64_t utime_us = 1780300800000000LL + i * 250000LL;
+        if (!ship) {
+          for (int k = 0; k < (i == 0 ? 2 : 1); ++k) {  // a 107 packet 50 ms before every ping (4 Hz)
+            const double packet_s = t_s - 0.05 + 0.2 * k;
+            if (packet_s < 0.0) continue;
+            std::vector<uint8_t> packet = sss::xtf::encodeOtherPacket(sss::xtf::kHeaderPosRawNavigation, 64);
+            const int64_t packet_us = 1780300800000000LL + static_cast<int64_t>(std::llround(packet_s * 1e6));
+            const int64_t seconds = packet_us / 1000000;
+            // 2026-06-01T08:00:00Z + seconds
+            const int64_t of_day = seconds % 86400;
+            sss::xtf::writeU16(packet.data(), 14, 2026);
+            packet[16] = 6;
+            packet[17] = 1;
+            packet[18] = static_cast<uint8_t>(of_day / 3600);
+            packet[19] = static_cast<uint8_t>(of_day / 60 % 60);
+            packet[20] = static_cast<uint8_t>(of_day % 60);
+            sss::xtf::writeU16(packet.data(), 21, static_cast<uint16_t>((packet_us % 1000000) / 100));
+            const auto geo = positionAt(packet_s);
+            sss::xtf::writeF64(packet.data(), 23, geo.latitude_deg);
+            sss::xtf::writeF64(packet.data(), 31, geo.longitude_deg);
+            sss::xtf::writeF32(packet.data(), 59, 100.0f);  // heading
+            ASSERT_TRUE(writer.writeBytes(packet));
+          }
+        }
+        sss::xtf::XtfPingInput ping;
+        ping.ping_number = static_cast<uint32_t>(i);
+        ping.ping_time_us = utime_us;
+        ping.depth_m = 30.0f;
+        ping.altitude_m = 15.0f;
+        ping.heading_deg = 100.0f;
+        addSeabedChannels(ping, 2500, 0.03, 15.0, random);
+        std::vector<uint8_t> packet = sss::xtf::encodeSonarPacket(options, ping);
+        if (ship) {  // SensorY/X stay 0: the vessel's position only
+          const auto geo = positionAt(t_s);
+          sss::xtf::writeF64(packet.data(), 128, geo.latitude_deg);
+          sss::xtf::writeF64(packet.data(), 136, geo.longitude_deg);
+        }
+        ASSERT_TRUE(writer.writeBytes(packet));
+      }
+    }
+    const std::string out_dir = root_ + (ship ? "/run_ship" : "/run_packets");
+    const auto result = runSonarFileOnly(path, out_dir);
+    ASSERT_TRUE(result.ok) << result.error;
+    const auto& s = result.summary;
+    EXPECT_GE(s.pings_with_pose, 570u) << (ship ? "ship" : "packets") << ": 95 % of the pings";
+    EXPECT_GE(s.subframes, 2u);
+    if (!ship) {
+      EXPECT_GE(s.nav_from_packets, 600u);
+      EXPECT_EQ(s.pings_without_position, 600u);
+    } else {
+      EXPECT_EQ(s.nav_from_packets, 0u);
+      EXPECT_EQ(s.pings_without_position, 0u);
+    }
+    ASSERT_TRUE(s.origin);
+    EXPECT_NEAR(s.origin->latitude_deg, 43.0, 1e-4);
+    const auto slam = sss::eval::readTum(out_dir + "/slam.tum");
+    ASSERT_TRUE(slam.ok) << slam.error;
+    const double t_last_s = 1e-6 * static_cast<double>(slam.poses.back().utime_us - 1780300800000000LL);
+    const Eigen::Vector3d last = slam.poses.back().T_world_body.translation;
+    EXPECT_NEAR(last.x(), 2.0 * t_last_s * std::cos(heading_rad), 1.0);
+    EXPECT_NEAR(last.y(), 2.0 * t_last_s * std::sin(heading_rad), 1.0);
+  }
+}
+
+// A JSF whose type 80 pings carry no position (no lat/lon bit) with 2090 situation messages
+// between them (latitude, longitude, depth, heading at 4 Hz, as the sonar's own INS sends), or
+// 2002 NMEA messages with GGA sentences: those messages are the navigation.
+TEST_F(OfflineRunnerTest, JsfSituationOrNmeaMessagesPositionPingsWithoutPosition) {
+ for (const bool nmea : {false, true}) {
+  const std::string path = root_ + (nmea ? "/nmea.jsf" : "/situation.jsf");
+  const sss::core::LocalTangentPlane plane(-12.5, 130.8);
+  const double heading_rad = 250.0 * M_PI / 180.0;
+  {
+    std::ofstream out(path, std::ios::binary);
+    std::mt19937 random(8);
+    std::exponential_distribution<double> speckle(1.0);
+    uint8_t sequence = 0;
+    for (int i = 0; i < 600; ++i) {
+      const double t_s = 0.25 * i;
+      const int64_t utime_us = 1780300800000000LL + i * 250000LL;
+      // 2090, 50 ms before the ping.
+      std::vector<uint8_t> body(276, 0);
+      const int64_t nav_us = utime_us - 50000;
+      const int32_t seconds = static_cast<int32_t>(nav_us / 1000000);
+      const int32_t milliseconds = static_cast<int32_t>(nav_us / 1000 % 1000);
+      std::memcpy(body.data() + 0, &seconds, 4);
+      std::memcpy(body.data() + 4, &milliseconds, 4);
+      const uint32_t validity = 0x7Fu;
+      std::memcpy(body.data() + 12, &validity, 4);
+      const uint64_t microseconds = static_cast<uint64_t>(nav_us);
+      std::memcpy(body.data() + 20, &microseconds, 8);
+      const double nav_s = std::max(0.0, t_s - 0.05);
+      const auto geo = plane.toGeodetic(Eigen::Vector3d(2.0 * nav_s * std::cos(heading_rad), 2.0 * nav_s * std::sin(heading_rad), 0.0));
+      const double fields[] = {geo.latitude_deg, geo.longitude_deg, 30.0, 250.0, 0.0, 0.0};
+      for (int f = 0; f < 6; ++f) std::memcpy(body.data() + 28 + 8 * f, &fields[f], 8);
+      sss::edgetech::JsfMessageHeader header;
+      header.message_type = sss::edgetech::kJsfSituation;
+      if (nmea) {  // the same fix as a GGA sentence from byte 12 (ddmm.mmmmmm, S and E)
+        const double lat = -geo.latitude_deg, lon = geo.longitude_deg;
+        char sentence[128];
+        std::snprintf(sentence, sizeof sentence, "GPGGA,080000.00,%02d%09.6f,S,%03d%09.6f,E,1,10,0.8,0.0,M,,M,,",
+                      static_cast<int>(lat), (lat - static_cast<int>(lat)) * 60.0, static_cast<int>(lon),
+                      (lon - static_cast<int>(lon)) * 60.0);
+        const std::string text = sss::ins::frameSentence(sentence);
+        body.assign(12, 0);
+        std::memcpy(body.data() + 0, &seconds, 4);
+        std::memcpy(body.data() + 4, &milliseconds, 4);
+        body.insert(body.end(), text.begin(), text.end());
+        header.message_type = sss::edgetech::kJsfNmea;
+      }
+      header.byte_count = static_cast<int32_t>(body.size());
+      uint8_t header_bytes[16];
+      sss::edgetech::encodeHeader(header, header_bytes);
+      out.write(reinterpret_cast<const char*>(header_bytes), 16);
+      out.write(reinterpret_cast<const char*>(body.data()), static_cast<std::streamsize>(body.size()));
+      for (uint8_t channel : {sss::edgetech::kChannelPort, sss::edgetech::kChannelStarboard}) {
+        sss::edgetech::SonarChannelRecord record;
+        record.channel = channel;
+        record.ping_time_us = utime_us;
+        record.ping_number = static_cast<uint32_t>(i);
+        record.sample_interval_s = 4e-5;  // 3 cm
+        record.validity = sss::edgetech::kValidHeading | sss::edgetech::kValidSoundSpeed;  // no position, no altitude
+        record.heading_rad = heading_rad;
+        std::vector<float> magnitudes;
+        for (int k = 0; k < 2500; ++k) {
+          const double r = k * 0.03;
+          magnitudes.push_back(static_cast<float>((r < 15.0 ? 2.0 : 400.0 * 15.0 / r) * speckle(random)));
+        }
+        int16_t weighting = 0;
+        const auto codes = sss::edgetech::quantiseEnvelope(magnitudes, weighting);
+        record.weighting_factor = weighting;
+        const auto bytes = sss::edgetech::encodeSonarData(record, codes, sequence++);
+        out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+      }
+    }
+  }
+  const std::string out_dir = root_ + (nmea ? "/run_nmea" : "/run_situation");
+  const auto result = runSonarFileOnly(path, out_dir);
+  ASSERT_TRUE(result.ok) << result.error;
+  const auto& s = result.summary;
+  EXPECT_EQ(s.pings, 600u);
+  EXPECT_GE(s.pings_with_pose, 570u) << "95 % of the pings";
+  EXPECT_GE(s.nav_from_packets, 600u);
+  EXPECT_GE(s.subframes, 2u);
+  ASSERT_TRUE(s.origin);
+  EXPECT_NEAR(s.origin->latitude_deg, -12.5, 1e-4);
+  const auto slam = sss::eval::readTum(out_dir + "/slam.tum");
+  ASSERT_TRUE(slam.ok) << slam.error;
+  const double t_last_s = 1e-6 * static_cast<double>(slam.poses.back().utime_us - 1780300800000000LL);
+  const Eigen::Vector3d last = slam.poses.back().T_world_body.translation;
+  EXPECT_NEAR(last.x(), 2.0 * t_last_s * std::cos(heading_rad), 1.0);
+  EXPECT_NEAR(last.y(), 2.0 * t_last_s * std::sin(heading_rad), 1.0);
+  if (!nmea) {
+    EXPECT_NEAR(last.z(), 30.0, 0.1) << "the depth of the situation messages";
+  }
+ }
+}
+
+// The towed record of the real-file issue, rebuilt: an XTF in latitude/longitude with altitude and
+// depth 0 in every ping, 1446 pings along a 311 m line that curves through 30 degrees. Every ping
+// gets a pose, the bottom track gives the altitude, and the curve still makes subframes.
+TEST_F(OfflineRunnerTest, TowedCurvedLineWithoutAltitudeOrDepthGivesSubframes) {
+  sss::xtf::XtfWriterOptions options;
+  sss::xtf::XtfWriterChannel port, starboard;
+  starboard.type_of_channel = sss::xtf::kChannelStarboard;
+  options.channels = {port, starboard};
+  const std::string path = root_ + "/towed_curve.xtf";
+  const sss::core::LocalTangentPlane plane(51.2, 2.9);
+  constexpr int kPings = 1446;
+  const double length_m = 311.0, turn_rad = 30.0 * M_PI / 180.0, radius_m = length_m / turn_rad;
+  const double period_s = 0.143;  // 7 Hz at 1.5 m/s
+  {
+    sss::xtf::XtfWriter writer(path, options);
+    ASSERT_TRUE(writer.isOpen());
+    std::mt19937 random(12);
+    for (int i = 0; i < kPings; ++i) {
+      const double s_m = length_m * i / (kPings - 1), angle = s_m / radius_m;  // heading from north, turning right
+      const Eigen::Vector3d ned(radius_m * std::sin(angle), radius_m * (1.0 - std::cos(angle)), 0.0);
+      const auto geo = plane.toGeodetic(ned);
+      sss::xtf::XtfPingInput ping;
+      ping.ping_number = static_cast<uint32_t>(i);
+      ping.ping_time_us = 1780300800000000LL + static_cast<int64_t>(std::llround(i * period_s * 1e6));
+      ping.sensor_y = geo.latitude_deg;
+      ping.sensor_x = geo.longitude_deg;
+      ping.heading_deg = static_cast<float>(angle * 180.0 / M_PI);  // depth and altitude stay 0
+      addSeabedChannels(ping, 1600, 0.03125, 9.0, random);
+      ASSERT_TRUE(writer.write(ping));
+    }
+  }
+  sss::offline::OfflineRequest r;
+  r.sonar_path = path;
+  r.out_dir = root_ + "/run_towed_curve";
+  const auto result = sss::offline::runOffline(r);
+  ASSERT_TRUE(result.ok) << result.error;
+  const auto& s = result.summary;
+  std::printf("towed curved line: %llu of %llu pings with a pose, %llu subframes, %llu lines, %llu bottom-tracked\n",
+              static_cast<unsigned long long>(s.pings_with_pose), static_cast<unsigned long long>(s.pings),
+              static_cast<unsigned long long>(s.subframes), static_cast<unsigned long long>(s.survey_lines),
+              static_cast<unsigned long long>(s.buffer.fusion.altitude_from_bottom_track));
+  EXPECT_EQ(s.pings, static_cast<uint64_t>(kPings));
+  EXPECT_GE(s.pings_with_pose, static_cast<uint64_t>(0.95 * kPings));
+  EXPECT_EQ(s.buffer.fusion.altitude_from_bottom_track, s.pings_with_pose);
+  EXPECT_GE(s.subframes, 1u);
+  EXPECT_TRUE(fs::is_regular_file(r.out_dir + "/mosaic_dr.png"));
+  // DR only, and the run says why: one pass, not lines too far apart for the swath.
+  ASSERT_EQ(s.findings.size(), 1u);
+  EXPECT_NE(s.findings[0].find("follow one another along one track"), std::string::npos) << s.findings[0];
+  std::printf("towed curved line: %llu pairs tried, %llu closures; %s\n", static_cast<unsigned long long>(s.pairs_attempted),
+              static_cast<unsigned long long>(s.matcher_closures), s.findings.empty() ? "" : s.findings[0].c_str());
+}
+
+}  // namespace
