@@ -7,7 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "pipeline/matcher/synthetic_pair.hpp"
+#include "tools/fixtures/synthetic_pair.hpp"
 
 namespace sss::matcher {
 namespace {

@@ -21,7 +21,7 @@
 #include "pipeline/messages/closure_messages.hpp"
 #include "pipeline/messages/subframe_messages.hpp"
 #include "pipeline/transport/lcm_bus.hpp"
-#include "tests/support/spawn_process.hpp"
+#include "tools/fixtures/spawn_process.hpp"
 #include "sss_msgs/status_t.hpp"
 #include "tests/matcher/matcher_test_survey.hpp"
 

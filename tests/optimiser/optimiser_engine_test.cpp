@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "pipeline/optimiser/checkpoint_io.hpp"
-#include "pipeline/optimiser/synthetic_subframes.hpp"
+#include "tools/fixtures/synthetic_subframes.hpp"
 #include "tests/optimiser/pose_graph_test_helpers.hpp"
 
 namespace sss::optimiser {

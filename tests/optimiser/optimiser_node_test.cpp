@@ -37,7 +37,7 @@
 #include "sss_msgs/pose_t.hpp"
 #include "sss_msgs/status_t.hpp"
 #include "sss_msgs/trajectory_t.hpp"
-#include "tests/support/spawn_process.hpp"
+#include "tools/fixtures/spawn_process.hpp"
 
 namespace sss::optimiser {
 namespace {

@@ -19,7 +19,7 @@
 #include <thread>
 #include <vector>
 
-#include "pipeline/optimiser/synthetic_subframes.hpp"
+#include "tools/fixtures/synthetic_subframes.hpp"
 #include "tests/optimiser/pose_graph_test_helpers.hpp"
 
 namespace sss::optimiser {

@@ -13,7 +13,7 @@
 #include <string>
 #include <unistd.h>
 
-#include "pipeline/optimiser/synthetic_mission.hpp"
+#include "tools/fixtures/synthetic_mission.hpp"
 #include "tests/optimiser/pose_graph_test_helpers.hpp"
 
 namespace sss::optimiser {

@@ -10,7 +10,7 @@
 #include <random>
 
 #include "pipeline/optimiser/pose_graph.hpp"
-#include "pipeline/optimiser/synthetic_mission.hpp"
+#include "tools/fixtures/synthetic_mission.hpp"
 #include "tests/optimiser/pose_graph_test_helpers.hpp"
 
 namespace sss::optimiser {

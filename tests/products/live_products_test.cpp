@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "pipeline/optimiser/optimiser_engine.hpp"
-#include "pipeline/optimiser/synthetic_subframes.hpp"
+#include "tools/fixtures/synthetic_subframes.hpp"
 #include "products/live_products.hpp"
 #include "tests/optimiser/pose_graph_test_helpers.hpp"
 #include "tests/support/geotiff_read.hpp"

@@ -16,7 +16,7 @@
 #include "pipeline/core/time.hpp"
 #include "pipeline/messages/subframe_messages.hpp"
 #include "pipeline/transport/lcm_bus.hpp"
-#include "tests/support/spawn_process.hpp"
+#include "tools/fixtures/spawn_process.hpp"
 
 namespace sss::subframe {
 namespace {

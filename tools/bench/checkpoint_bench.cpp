@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "pipeline/optimiser/optimiser_engine.hpp"
-#include "pipeline/optimiser/synthetic_subframes.hpp"
+#include "tools/fixtures/synthetic_subframes.hpp"
 
 namespace {
 

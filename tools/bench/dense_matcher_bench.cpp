@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "pipeline/matcher/dense_matcher.hpp"
-#include "pipeline/matcher/synthetic_pair.hpp"
+#include "tools/fixtures/synthetic_pair.hpp"
 
 namespace {
 

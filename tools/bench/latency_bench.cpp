@@ -43,14 +43,14 @@
 #include "pipeline/core/pose.hpp"
 #include "pipeline/core/time.hpp"
 #include "pipeline/messages/closure_messages.hpp"
-#include "pipeline/optimiser/synthetic_mission.hpp"
+#include "tools/fixtures/synthetic_mission.hpp"
 #include "pipeline/messages/subframe_messages.hpp"
 #include "pipeline/transport/dds.hpp"
 #include "pipeline/transport/lcm_bus.hpp"
 #include "sss_msgs/nav_t.hpp"
 #include "sss_msgs/pose_t.hpp"
 #include "sss_msgs/status_t.hpp"
-#include "tests/support/spawn_process.hpp"
+#include "tools/fixtures/spawn_process.hpp"
 
 namespace {
 

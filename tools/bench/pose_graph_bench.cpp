@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "pipeline/optimiser/pose_graph.hpp"
-#include "pipeline/optimiser/synthetic_mission.hpp"
+#include "tools/fixtures/synthetic_mission.hpp"
 
 namespace {
 
