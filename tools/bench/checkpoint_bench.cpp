@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "pipeline/optimiser/optimiser_engine.hpp"
 #include "tools/fixtures/synthetic_subframes.hpp"
 
@@ -156,20 +158,26 @@ int main(int argc, char** argv) {
   }
   for (const std::string& p : {path, path + ".journal", full_path, full_path + ".journal"}) std::remove(p.c_str());
 
-  std::string json = "{\"saves\": " + std::to_string(all_save_ms.size()) +
-                     ", \"save_p50_ms\": " + std::to_string(percentile(all_save_ms, 0.5)) +
-                     ", \"save_p95_ms\": " + std::to_string(percentile(all_save_ms, 0.95)) +
-                     ", \"save_max_ms\": " + std::to_string(percentile(all_save_ms, 1.0)) + ", \"hours\": [";
-  for (size_t k = 0; k < figures.size(); ++k) {
-    const HourFigures& f = figures[k];
-    char item[256];
-    std::snprintf(item, sizeof(item),
-                  "%s{\"h\": %.2f, \"file_mb\": %.3f, \"journal_mb\": %.2f, \"save_p50_ms\": %.2f, \"save_max_ms\": %.2f, "
-                  "\"graph_text_ms\": %.2f, \"full_rewrite_ms\": %.1f, \"load_ms\": %.1f}",
-                  k ? ", " : "", f.hours, f.file_mb, f.journal_mb, f.save_p50_ms, f.save_max_ms, f.graph_text_ms,
-                  f.full_rewrite_ms, f.load_ms);
-    json += item;
+  // Non-finite figures (no save measured) are null, so that the line stays valid JSON.
+  auto number = [](double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); };
+  nlohmann::ordered_json summary;
+  summary["saves"] = all_save_ms.size();
+  summary["save_p50_ms"] = number(percentile(all_save_ms, 0.5));
+  summary["save_p95_ms"] = number(percentile(all_save_ms, 0.95));
+  summary["save_max_ms"] = number(percentile(all_save_ms, 1.0));
+  summary["hours"] = nlohmann::ordered_json::array();
+  for (const HourFigures& f : figures) {
+    nlohmann::ordered_json hour;
+    hour["h"] = number(f.hours);
+    hour["file_mb"] = number(f.file_mb);
+    hour["journal_mb"] = number(f.journal_mb);
+    hour["save_p50_ms"] = number(f.save_p50_ms);
+    hour["save_max_ms"] = number(f.save_max_ms);
+    hour["graph_text_ms"] = number(f.graph_text_ms);
+    hour["full_rewrite_ms"] = number(f.full_rewrite_ms);
+    hour["load_ms"] = number(f.load_ms);
+    summary["hours"].push_back(hour);
   }
-  std::printf("%s]}\n", json.c_str());
+  std::printf("%s\n", summary.dump().c_str());
   return 0;
 }

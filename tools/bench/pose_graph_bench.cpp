@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "pipeline/optimiser/pose_graph.hpp"
 #include "tools/fixtures/synthetic_mission.hpp"
 
@@ -148,14 +150,27 @@ int main(int argc, char** argv) {
     std::printf("ATE: DR %.2f m, window %.2f m, full smoothing %.2f m\n", ate_dr, ate_window, ate_full);
   else
     std::printf("ATE: DR %.2f m, window %.2f m (full smoothing skipped)\n", ate_dr, ate_window);
-  std::printf(
-      "{\"updates\": %zu, \"nodes\": %zu, \"closures\": %zu, \"false_closures\": %d, \"false_accepted\": %d, "
-      "\"window\": %d, \"update_p50_s\": %.5f, \"update_p95_s\": %.5f, \"update_max_s\": %.5f, \"solve_p50_s\": %.5f, "
-      "\"solve_p95_s\": %.5f, \"solve_max_s\": %.5f, \"rss_start_mib\": %.1f, "
-      "\"rss_end_mib\": %.1f, \"ate_dr_m\": %.3f, \"ate_opt_m\": %.3f, \"ate_full_m\": %.3f, \"full_smoothing_s\": %.3f}\n",
-      update_s.size(), graph.numNodes(), mission.closures.size(), num_false, false_accepted, options.window_size,
-      percentile(update_s, 0.5), percentile(update_s, 0.95), percentile(update_s, 1.0), percentile(solve_s, 0.5),
-      percentile(solve_s, 0.95), percentile(solve_s, 1.0), rss_start_mib, rss_end_mib,
-      ate_dr, ate_window, ate_full, full_s);
+  // Non-finite figures (full smoothing skipped) are null, so that the line stays valid JSON.
+  auto number = [](double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); };
+  nlohmann::ordered_json figures;
+  figures["updates"] = update_s.size();
+  figures["nodes"] = graph.numNodes();
+  figures["closures"] = mission.closures.size();
+  figures["false_closures"] = num_false;
+  figures["false_accepted"] = false_accepted;
+  figures["window"] = options.window_size;
+  figures["update_p50_s"] = number(percentile(update_s, 0.5));
+  figures["update_p95_s"] = number(percentile(update_s, 0.95));
+  figures["update_max_s"] = number(percentile(update_s, 1.0));
+  figures["solve_p50_s"] = number(percentile(solve_s, 0.5));
+  figures["solve_p95_s"] = number(percentile(solve_s, 0.95));
+  figures["solve_max_s"] = number(percentile(solve_s, 1.0));
+  figures["rss_start_mib"] = number(rss_start_mib);
+  figures["rss_end_mib"] = number(rss_end_mib);
+  figures["ate_dr_m"] = number(ate_dr);
+  figures["ate_opt_m"] = number(ate_window);
+  figures["ate_full_m"] = number(ate_full);
+  figures["full_smoothing_s"] = number(full_s);
+  std::printf("%s\n", figures.dump().c_str());
   return 0;
 }
