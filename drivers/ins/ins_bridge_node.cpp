@@ -18,6 +18,7 @@
 #include <fstream>
 #include <string>
 
+#include "drivers/ins/bridge_state.hpp"
 #include "drivers/ins/fix_aligner.hpp"
 #include "drivers/ins/fix_message.hpp"
 #include "drivers/ins/ins_bridge.hpp"
@@ -58,41 +59,75 @@ struct NodeOptions {
   std::string state_directory;
 };
 
-constexpr const char* kOdometerFormat = "sss-ins-bridge odometer 1";
-
-void loadOdometer(const std::string& path, sss::ins::InsBridge& bridge) {
-  if (access(path.c_str(), F_OK) != 0) return;
-  sss::core::StateValues values;
-  std::string error;
-  sss::ins::OdometerState state;
-  long long utime_us = 0;
-  const bool ok = sss::core::readStateFile(path, kOdometerFormat, values, error) &&
-                  sss::core::stateNumber(values, "distance_travelled_m", state.distance_travelled_m) &&
-                  sss::core::stateInteger(values, "utime_us", utime_us) &&
-                  sss::core::stateNumber(values, "north_m", state.position_ned_m.x()) &&
-                  sss::core::stateNumber(values, "east_m", state.position_ned_m.y()) &&
-                  sss::core::stateNumber(values, "down_m", state.position_ned_m.z()) && state.distance_travelled_m >= 0.0;
-  if (!ok) {
-    spdlog::error("odometer not resumed, distance travelled starts from 0 (the optimiser bridges the reset): {}",
-                  error.empty() ? path + ": a value is missing or invalid" : error);
-    return;
-  }
-  state.utime_us = utime_us;
-  bridge.resumeOdometer(state);
-  spdlog::info("resumed the odometer from {}: {:.1f} m travelled", path, state.distance_travelled_m);
+// The node's options from the configuration file (none: the defaults); --file and --speed, already
+// in options, win over the file's. Empty when valid, else the problems, one per line.
+std::string readNodeOptions(const std::string& config_path, bool speed_given, NodeOptions& options) {
+  options.process.process_name = "sss-ins-bridge";
+  if (config_path.empty()) return {};
+  using namespace sss::core;
+  Config config = Config::fromFile(config_path);
+  ConfigSection mission = config.section("mission");
+  options.bridge.origin = sss::core::readMissionOrigin(mission);
+  ConfigSection section = config.section("ins_bridge");
+  sss::transport::readProcessOptions(section, options.process);
+  sss::ins::readInsBridgeOptions(section, options.bridge);
+  const bool file_given = options.source == "file";
+  section.optional("source", options.source, {oneOf({"udp", "tcp", "serial", "file"})});
+  if (file_given) options.source = "file";
+  section.optional("bind_address", options.bind_address, {nonEmpty()});
+  section.optional("udp_port", options.udp_port, {inRange(1, 65535)});
+  section.optional("host", options.tcp.host, {nonEmpty()});
+  section.optional("port", options.tcp.port, {inRange(1, 65535)});
+  section.optional("serial_device", options.serial_device, {nonEmpty()});
+  section.optional("serial_baud", options.serial_baud,
+                   {satisfies<int>([](int b) { return b == 9600 || b == 19200 || b == 38400 || b == 57600 ||
+                                                      b == 115200 || b == 230400 || b == 460800; },
+                                   "a standard baud rate (9600 ... 460800)")});
+  if (!file_given) section.optional("file", options.file);
+  if (!speed_given) section.optional("replay_speed", options.replay_speed, {inRange(0.0, 1000.0)});
+  section.optional("nav_channel", options.nav_channel, {nonEmpty()});
+  section.optional("fix_udp_port", options.fix_udp_port, {inRange(0, 65535)});
+  section.optional("fix_channel", options.fix_channel, {nonEmpty()});
+  section.optional("fix_gnss_max_depth_m", options.fix_aligner.gnss_max_depth_m, {atLeast(0.0)});
+  section.optional("fix_max_latency_s", options.fix_aligner.max_latency_s, {inRange(1.0, 3600.0)});
+  section.optional("fix_usbl_default_sigma_m", options.fix_reader.usbl_default_sigma_m, {greaterThan(0.0)});
+  section.optional("state_directory", options.state_directory);
+  section.rejectUnknownKeys();
+  return config.problemReport();
 }
 
-// On the real-time loop that answers every INS epoch: no fsync (it can block for tens of ms).
-// After a power loss the odometer may be a second or so behind; the optimiser bridges that.
-bool saveOdometer(const std::string& path, const sss::ins::OdometerState& state, std::string& error) {
-  auto number = [](double value) { return fmt::format("{:.17g}", value); };
-  return sss::core::writeStateFile(path, kOdometerFormat,
-                                   {{"distance_travelled_m", number(state.distance_travelled_m)},
-                                    {"utime_us", std::to_string(state.utime_us)},
-                                    {"north_m", number(state.position_ned_m.x())},
-                                    {"east_m", number(state.position_ned_m.y())},
-                                    {"down_m", number(state.position_ned_m.z())}},
-                                   error, sss::core::Durability::kSurvivesProcessKill);
+// SSS_STATUS: the staleness (recovers by itself when data returns) and the counters; the fixes'
+// counters only when fixes are read (fix_aligner set).
+void setStatusCounters(const sss::ins::InsBridge& bridge, const sss::ins::BridgeStateStore& state,
+                       const sss::ins::FixAligner* fix_aligner, const sss::ins::PositionFixReader& fix_reader,
+                       uint64_t fixes_published, sss::core::HealthMonitor& health) {
+  const std::string stale = bridge.describeStale(monotonicUtime());
+  health.setState(stale.empty() ? sss::core::HealthState::kOk : sss::core::HealthState::kWarning,
+                  stale.empty() ? "navigation ok" : stale);
+  const auto& stream = bridge.streamCounters();
+  health.setCounter("nmea_sentences", static_cast<double>(stream.sentences));
+  health.setCounter("nmea_bad_checksum", static_cast<double>(stream.bad_checksum));
+  health.setCounter("nmea_missing_checksum", static_cast<double>(stream.missing_checksum));
+  health.setCounter("nmea_overlong", static_cast<double>(stream.overlong));
+  health.setCounter("nmea_truncated", static_cast<double>(stream.truncated));
+  health.setCounter("nmea_garbage_bytes", static_cast<double>(stream.garbage_bytes));
+  health.setCounter("ins_epochs", static_cast<double>(bridge.assemblerCounters().epochs));
+  health.setCounter("ins_epochs_out_of_order", static_cast<double>(bridge.epochsOutOfOrder()));
+  health.setCounter("odometer_m", bridge.odometer().distance_travelled_m);
+  health.setCounter("odometer_write_failures", static_cast<double>(state.odometerWriteFailures()));
+  if (fix_aligner) {
+    const auto& aligned = fix_aligner->counters();
+    health.setCounter("fixes_in", static_cast<double>(aligned.fixes_in));
+    health.setCounter("fixes_published", static_cast<double>(fixes_published));
+    health.setCounter("fixes_below_surface", static_cast<double>(aligned.below_surface));
+    health.setCounter("fixes_outside_navigation", static_cast<double>(aligned.outside_navigation));
+    const auto& read = fix_reader.counters();
+    health.setCounter("fix_sentences_skipped", static_cast<double>(read.rejected_sentences + read.malformed));
+  }
+  if (bridge.origin()) {  // the mission frame, for the operator (NaN-free: only once it is known)
+    health.setCounter("origin_latitude_deg", bridge.origin()->latitude_deg);
+    health.setCounter("origin_longitude_deg", bridge.origin()->longitude_deg);
+  }
 }
 
 speed_t baudConstant(int baud) {
@@ -165,40 +200,7 @@ int main(int argc, char** argv) {
       return arg == "--help" ? 0 : 2;
     }
   }
-  options.process.process_name = "sss-ins-bridge";
-  std::string config_problems;  // empty: valid (or no file: the defaults)
-  if (!config_path.empty()) {
-    using namespace sss::core;
-    Config config = Config::fromFile(config_path);
-    ConfigSection mission = config.section("mission");
-    options.bridge.origin = sss::core::readMissionOrigin(mission);
-    ConfigSection section = config.section("ins_bridge");
-    sss::transport::readProcessOptions(section, options.process);
-    sss::ins::readInsBridgeOptions(section, options.bridge);
-    const bool file_given = options.source == "file";
-    section.optional("source", options.source, {oneOf({"udp", "tcp", "serial", "file"})});
-    if (file_given) options.source = "file";
-    section.optional("bind_address", options.bind_address, {nonEmpty()});
-    section.optional("udp_port", options.udp_port, {inRange(1, 65535)});
-    section.optional("host", options.tcp.host, {nonEmpty()});
-    section.optional("port", options.tcp.port, {inRange(1, 65535)});
-    section.optional("serial_device", options.serial_device, {nonEmpty()});
-    section.optional("serial_baud", options.serial_baud,
-                     {satisfies<int>([](int b) { return b == 9600 || b == 19200 || b == 38400 || b == 57600 ||
-                                                        b == 115200 || b == 230400 || b == 460800; },
-                                     "a standard baud rate (9600 ... 460800)")});
-    if (!file_given) section.optional("file", options.file);
-    if (!speed_given) section.optional("replay_speed", options.replay_speed, {inRange(0.0, 1000.0)});
-    section.optional("nav_channel", options.nav_channel, {nonEmpty()});
-    section.optional("fix_udp_port", options.fix_udp_port, {inRange(0, 65535)});
-    section.optional("fix_channel", options.fix_channel, {nonEmpty()});
-    section.optional("fix_gnss_max_depth_m", options.fix_aligner.gnss_max_depth_m, {atLeast(0.0)});
-    section.optional("fix_max_latency_s", options.fix_aligner.max_latency_s, {inRange(1.0, 3600.0)});
-    section.optional("fix_usbl_default_sigma_m", options.fix_reader.usbl_default_sigma_m, {greaterThan(0.0)});
-    section.optional("state_directory", options.state_directory);
-    section.rejectUnknownKeys();
-    config_problems = config.problemReport();
-  }
+  const std::string config_problems = readNodeOptions(config_path, speed_given, options);
   if (const int code = sss::transport::configVerdict("sss-ins-bridge", config_problems, config_path, check_config_only); code >= 0) {
     return code;
   }
@@ -210,48 +212,23 @@ int main(int argc, char** argv) {
   sss::ins::InsBridge bridge(options.bridge);
   std::vector<sss::ins::NavSample> samples;
 
-  // The odometer, saved every second while it moves. A file replay is offline: nothing kept.
-  const std::string state_directory = options.source == "file" ? std::string()
-      : sss::core::resolveSystemdDirectory(options.state_directory, std::getenv("STATE_DIRECTORY"));
-  const std::string odometer_path = state_directory.empty() ? "" : state_directory + "/odometer";
-  if (!odometer_path.empty()) loadOdometer(odometer_path, bridge);
-  // The mission origin: configured, else kept from an earlier run (a restart mid-mission must not
-  // move the frame), else the first fix, saved as soon as it is chosen.
-  const std::string origin_path = state_directory.empty() ? "" : state_directory + "/origin";
-  if (bridge.origin()) {
-    spdlog::info("mission origin (configured): {:.7f} {:.7f}", bridge.origin()->latitude_deg, bridge.origin()->longitude_deg);
-  } else if (!origin_path.empty() && access(origin_path.c_str(), F_OK) == 0) {
-    std::string origin_error;
-    if (const auto kept = sss::core::readOriginState(origin_path, origin_error)) {
-      bridge.resumeOrigin(*kept);
-      spdlog::info("mission origin kept from {}: {:.7f} {:.7f} (delete the file to start a new mission frame)",
-                   origin_path, kept->latitude_deg, kept->longitude_deg);
-    } else {
-      spdlog::error("mission origin not resumed, the first fix sets a new one: {}", origin_error);
-    }
-  }
-  bool origin_announced = bridge.origin().has_value();
-  auto announceOrigin = [&] {
-    if (origin_announced || !bridge.origin()) return;
-    origin_announced = true;
-    const sss::core::MissionOrigin origin = *bridge.origin();
-    spdlog::info("mission origin (first INS fix): {:.7f} {:.7f}", origin.latitude_deg, origin.longitude_deg);
-    std::string origin_error;
-    if (!origin_path.empty() && !sss::core::writeOriginState(origin_path, origin, origin_error)) {
-      spdlog::error("mission origin not saved (a restart would choose a new one): {}", origin_error);
-    }
+  // The odometer and the mission origin across restarts (bridge_state.hpp). A file replay is
+  // offline: nothing kept.
+  sss::ins::BridgeStateStore state(options.source == "file" ? std::string()
+      : sss::core::resolveSystemdDirectory(options.state_directory, std::getenv("STATE_DIRECTORY")));
+  auto log = [](const sss::ins::BridgeStateLog& lines) {
+    for (const std::string& line : lines.info) spdlog::info("{}", line);
+    for (const std::string& line : lines.errors) spdlog::error("{}", line);
   };
-  int64_t saved_odometer_utime_us = -1;
-  uint64_t odometer_write_failures = 0;
+  {
+    sss::ins::BridgeStateLog lines;
+    state.restore(bridge, lines);
+    log(lines);
+  }
   auto saveOdometerIfMoved = [&] {
-    const sss::ins::OdometerState state = bridge.odometer();
-    if (odometer_path.empty() || state.utime_us == saved_odometer_utime_us) return;
-    std::string save_error;
-    if (saveOdometer(odometer_path, state, save_error)) {
-      saved_odometer_utime_us = state.utime_us;
-    } else if (odometer_write_failures++ == 0) {
-      spdlog::error("odometer not saved (counted from now on): {}", save_error);
-    }
+    sss::ins::BridgeStateLog lines;
+    state.saveOdometerIfMoved(bridge, lines);
+    log(lines);
   };
   loop.addTimer(1.0, saveOdometerIfMoved);
 
@@ -268,7 +245,9 @@ int main(int argc, char** argv) {
     }
   };
   auto publishAll = [&](int64_t since_us) {
-    announceOrigin();
+    sss::ins::BridgeStateLog lines;
+    state.noteOrigin(bridge, lines);
+    log(lines);
     for (const auto& sample : samples) {
       loop.bus().publish(options.nav_channel, sss::ins::toNavMessage(sample), since_us);
       if ((sample.ins.validity & sss::ins::kValidPosition) && sample.origin)
@@ -279,36 +258,10 @@ int main(int argc, char** argv) {
   };
   // Health: staleness (recovers by itself when data returns), counters, faults logged once.
   loop.addTimer(0.5, [&] {
-    const std::string stale = bridge.describeStale(monotonicUtime());
-    health.setState(stale.empty() ? sss::core::HealthState::kOk : sss::core::HealthState::kWarning,
-                    stale.empty() ? "navigation ok" : stale);
-    const auto& stream = bridge.streamCounters();
-    health.setCounter("nmea_sentences", static_cast<double>(stream.sentences));
-    health.setCounter("nmea_bad_checksum", static_cast<double>(stream.bad_checksum));
-    health.setCounter("nmea_missing_checksum", static_cast<double>(stream.missing_checksum));
-    health.setCounter("nmea_overlong", static_cast<double>(stream.overlong));
-    health.setCounter("nmea_truncated", static_cast<double>(stream.truncated));
-    health.setCounter("nmea_garbage_bytes", static_cast<double>(stream.garbage_bytes));
-    health.setCounter("ins_epochs", static_cast<double>(bridge.assemblerCounters().epochs));
-    health.setCounter("ins_epochs_out_of_order", static_cast<double>(bridge.epochsOutOfOrder()));
-    health.setCounter("odometer_m", bridge.odometer().distance_travelled_m);
-    health.setCounter("odometer_write_failures", static_cast<double>(odometer_write_failures));
-    if (options.fix_udp_port > 0) {
-      const auto& aligned = fix_aligner.counters();
-      health.setCounter("fixes_in", static_cast<double>(aligned.fixes_in));
-      health.setCounter("fixes_published", static_cast<double>(fixes_published));
-      health.setCounter("fixes_below_surface", static_cast<double>(aligned.below_surface));
-      health.setCounter("fixes_outside_navigation", static_cast<double>(aligned.outside_navigation));
-      const auto& read = fix_reader.counters();
-      health.setCounter("fix_sentences_skipped", static_cast<double>(read.rejected_sentences + read.malformed));
-      if (!fix_problem_reported && !fix_reader.firstProblem().empty()) {  // once: later ones are counted
-        loop.reportFaults("fix_input", {"fixes: " + fix_reader.firstProblem()});
-        fix_problem_reported = true;
-      }
-    }
-    if (bridge.origin()) {  // the mission frame, for the operator (NaN-free: only once it is known)
-      health.setCounter("origin_latitude_deg", bridge.origin()->latitude_deg);
-      health.setCounter("origin_longitude_deg", bridge.origin()->longitude_deg);
+    setStatusCounters(bridge, state, options.fix_udp_port > 0 ? &fix_aligner : nullptr, fix_reader, fixes_published, health);
+    if (options.fix_udp_port > 0 && !fix_problem_reported && !fix_reader.firstProblem().empty()) {
+      loop.reportFaults("fix_input", {"fixes: " + fix_reader.firstProblem()});  // once: later ones are counted
+      fix_problem_reported = true;
     }
     loop.reportFaults("ins_input", bridge.takeNewFaultMessages());
   });
