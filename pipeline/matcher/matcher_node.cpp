@@ -1,6 +1,6 @@
-// sss-matcher: SSS_SUBFRAME + SSS_TRAJECTORY -> SSS_LOOP. Translation only; the logic is in
-// MatcherEngine. Matching a pair takes about a second, so it runs on a worker thread and the
-// process loop stays free for LCM, SSS_STATUS and the systemd watchdog. The stored subframes and
+// sss-matcher: SSS_SUBFRAME + SSS_TRAJECTORY -> SSS_LOOP. Wiring only; the logic is in
+// MatcherEngine, run by MatcherWorker (matcher_worker.hpp) on its own thread: matching a pair
+// takes about a second, and the process loop stays free for LCM, SSS_STATUS and the watchdog. The stored subframes and
 // the pair bookkeeping are kept in the state directory; the worker restores them first at start.
 //   sss-matcher [--config FILE [--check-config]] [--lcm-url URL]
 #include <sys/eventfd.h>
@@ -21,6 +21,7 @@
 #include "pipeline/core/time.hpp"
 #include "pipeline/messages/closure_messages.hpp"
 #include "pipeline/matcher/matcher_engine.hpp"
+#include "pipeline/matcher/matcher_worker.hpp"
 #include "pipeline/messages/subframe_messages.hpp"
 #include "pipeline/transport/logging.hpp"
 #include "pipeline/transport/process_loop.hpp"
@@ -41,26 +42,6 @@ struct NodeOptions {
   // Stored subframes and pair bookkeeping (MatcherStateStore). Empty: $STATE_DIRECTORY (systemd
   // StateDirectory=), else none: a restart then loses them.
   std::string state_directory;
-};
-
-// Work for the matcher thread, in arrival order; only the newest trajectory matters.
-struct WorkQueue {
-  std::mutex mutex;
-  std::condition_variable wake;
-  std::deque<std::pair<sss::core::Subframe, int64_t>> subframes;  // with arrival monotonic time
-  std::optional<std::vector<sss::matcher::TrajectoryNode>> trajectory;
-  bool stop = false;
-  uint64_t dropped_subframes = 0;
-};
-
-// Results for the process loop to publish.
-struct Results {
-  std::mutex mutex;
-  std::vector<std::pair<sss::matcher::PairOutcome, int64_t>> outcomes;  // with the input's arrival time
-  sss::matcher::MatcherEngineCounters counters;
-  size_t stored = 0;
-  size_t memory_bytes = 0;
-  bool busy = false;
 };
 
 }  // namespace
@@ -108,78 +89,35 @@ int main(int argc, char** argv) {
     spdlog::warn("no state directory (config matcher.state_directory or $STATE_DIRECTORY): a restart loses the "
                  "stored subframes");
   }
-  WorkQueue work;
-  Results results;
   const int results_fd = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
   if (results_fd < 0) {
     spdlog::error("cannot create an eventfd for the matcher thread");
     return 1;
   }
-
-  // Hands the engine's results to the process loop (worker thread).
-  auto handOver = [&](std::vector<sss::matcher::PairOutcome> outcomes, int64_t arrival) {
-    const std::string state_error = engine.takeStateError();
-    if (!state_error.empty() && health.recordError("state_write", state_error, sss::core::nowUtime()))
-      spdlog::warn("state directory: {}; further failures are counted in SSS_STATUS", state_error);
-    {
-      std::lock_guard<std::mutex> lock(results.mutex);
-      for (auto& outcome : outcomes) results.outcomes.emplace_back(std::move(outcome), arrival);
-      results.counters = engine.counters();
-      results.stored = engine.storedSubframes();
-      results.memory_bytes = engine.memoryBytes();
-      results.busy = false;
-    }
+  sss::matcher::MatcherWorker::Hooks hooks;
+  hooks.results_ready = [results_fd] {
     const uint64_t one = 1;
     if (write(results_fd, &one, sizeof one) < 0) {
       // The counter saturates only after 2^64 - 1 writes; nothing to do.
     }
   };
-
-  std::thread worker([&] {
-    // First the state of the previous run (seconds for hundreds of subframes): the loop meanwhile
-    // answers the watchdog and queues what arrives.
-    if (store) {
-      {
-        std::lock_guard<std::mutex> lock(results.mutex);
-        results.busy = true;
-      }
-      sss::matcher::RestoreReport report = engine.restore(*store);
-      for (const std::string& problem : report.problems) spdlog::error("state directory: {}", problem);
-      spdlog::info("restored {} subframes and {} matched pairs from {}{}; {} subframe(s) stored but not matched "
-                   "before the restart: {} pair(s) matched now",
-                   report.subframes, report.pairs, report.directory,
-                   report.state_file_found ? "" : " (without matcher.state)", report.subframes_without_state,
-                   report.outcomes.size());
-      handOver(std::move(report.outcomes), sss::core::monotonicUtime());
-    }
-    for (;;) {
-      std::optional<std::pair<sss::core::Subframe, int64_t>> subframe;
-      std::optional<std::vector<sss::matcher::TrajectoryNode>> trajectory;
-      {
-        std::unique_lock<std::mutex> lock(work.mutex);
-        work.wake.wait(lock, [&] { return work.stop || !work.subframes.empty() || work.trajectory.has_value(); });
-        if (work.stop) return;
-        // In arrival order, except that a waiting trajectory goes first: the subframes after it
-        // are then matched with the newest poses.
-        if (work.trajectory) {
-          trajectory = std::move(work.trajectory);
-          work.trajectory.reset();
-        } else {
-          subframe = std::move(work.subframes.front());
-          work.subframes.pop_front();
-        }
-      }
-      {
-        std::lock_guard<std::mutex> lock(results.mutex);
-        results.busy = true;
-      }
-      const int64_t arrival = subframe ? subframe->second : sss::core::monotonicUtime();
-      handOver(subframe ? engine.addSubframe(std::move(subframe->first)) : engine.updateTrajectory(*trajectory),
-               arrival);
-    }
-  });
+  hooks.state_error = [&health](const std::string& error) {
+    if (health.recordError("state_write", error, sss::core::nowUtime()))
+      spdlog::warn("state directory: {}; further failures are counted in SSS_STATUS", error);
+  };
+  hooks.restored = [](const sss::matcher::RestoreReport& report) {
+    for (const std::string& problem : report.problems) spdlog::error("state directory: {}", problem);
+    spdlog::info("restored {} subframes and {} matched pairs from {}{}; {} subframe(s) stored but not matched "
+                 "before the restart: {} pair(s) matched now",
+                 report.subframes, report.pairs, report.directory,
+                 report.state_file_found ? "" : " (without matcher.state)", report.subframes_without_state,
+                 report.outcomes.size());
+  };
+  sss::matcher::MatcherWorker worker(engine, store.get(), {options.max_queued_subframes}, hooks);
+  worker.start();
 
   uint64_t rejected_messages = 0;
+  bool queue_full_said = false;
   loop.bus().subscribe<sss_msgs::subframe_t>(options.subframe_channel, [&](const sss_msgs::subframe_t& message) {
     sss::core::Subframe subframe;
     std::string error;
@@ -189,15 +127,11 @@ int main(int argc, char** argv) {
         spdlog::warn("subframe {} rejected: {}; further ones are counted in SSS_STATUS", message.subframe_id, error);
       return;
     }
-    std::lock_guard<std::mutex> lock(work.mutex);
-    work.subframes.emplace_back(std::move(subframe), sss::core::monotonicUtime());
-    while (static_cast<int>(work.subframes.size()) > options.max_queued_subframes) {
-      work.subframes.pop_front();
-      if (work.dropped_subframes++ == 0)
-        spdlog::warn("matcher queue full ({} subframes): dropping the oldest; further drops are counted",
-                     options.max_queued_subframes);
+    if (worker.addSubframe(std::move(subframe), sss::core::monotonicUtime()) && !queue_full_said) {
+      queue_full_said = true;
+      spdlog::warn("matcher queue full ({} subframes): dropping the oldest; further drops are counted",
+                   options.max_queued_subframes);
     }
-    work.wake.notify_one();
   });
   loop.bus().subscribe<sss_msgs::trajectory_t>(options.trajectory_channel, [&](const sss_msgs::trajectory_t& message) {
     std::vector<sss::matcher::TrajectoryNode> nodes;
@@ -208,20 +142,13 @@ int main(int argc, char** argv) {
         spdlog::warn("trajectory rejected: {}; further ones are counted in SSS_STATUS", error);
       return;
     }
-    std::lock_guard<std::mutex> lock(work.mutex);
-    work.trajectory = std::move(nodes);
-    work.wake.notify_one();
+    worker.setTrajectory(std::move(nodes));
   });
 
   loop.addFileDescriptor(results_fd, [&] {
     uint64_t count = 0;
     if (read(results_fd, &count, sizeof count) < 0) return;
-    std::vector<std::pair<sss::matcher::PairOutcome, int64_t>> outcomes;
-    {
-      std::lock_guard<std::mutex> lock(results.mutex);
-      outcomes.swap(results.outcomes);
-    }
-    for (const auto& [outcome, arrival] : outcomes) {
+    for (const auto& [outcome, arrival] : worker.takeOutcomes()) {
       if (outcome.accepted) {
         loop.bus().publish(options.loop_channel,
                            sss::messages::toLoopClosureMessage(outcome.closure, sss::core::nowUtime()), arrival);
@@ -237,28 +164,14 @@ int main(int argc, char** argv) {
   });
 
   loop.addTimer(1.0, [&] {
-    sss::matcher::MatcherEngineCounters c;
-    size_t stored = 0, memory = 0, queued = 0;
-    uint64_t dropped = 0;
-    bool busy = false;
-    {
-      std::lock_guard<std::mutex> lock(results.mutex);
-      c = results.counters;
-      stored = results.stored;
-      memory = results.memory_bytes;
-      busy = results.busy;
-    }
-    {
-      std::lock_guard<std::mutex> lock(work.mutex);
-      queued = work.subframes.size();
-      dropped = work.dropped_subframes;
-    }
+    const sss::matcher::MatcherWorkerStatus status = worker.status();
+    const sss::matcher::MatcherEngineCounters& c = status.counters;
     const auto set = [&](const char* name, double value) { health.setCounter(name, value); };
     set("subframes_in", static_cast<double>(c.subframes_in));
     set("subframes_rejected", static_cast<double>(c.subframes_rejected + rejected_messages));
-    set("subframes_dropped_queue_full", static_cast<double>(dropped));
+    set("subframes_dropped_queue_full", static_cast<double>(status.dropped_subframes));
     set("subframes_evicted", static_cast<double>(c.subframes_evicted));
-    set("subframes_stored", static_cast<double>(stored));
+    set("subframes_stored", static_cast<double>(status.stored_subframes));
     set("trajectory_updates", static_cast<double>(c.trajectory_updates));
     set("pairs_attempted", static_cast<double>(c.pairs_attempted));
     set("closures_accepted", static_cast<double>(c.closures_accepted));
@@ -269,18 +182,13 @@ int main(int argc, char** argv) {
     set("state_files_corrupt", static_cast<double>(c.state_files_corrupt));
     set("state_write_errors", static_cast<double>(c.state_write_errors));
     set("mean_pair_s", c.pairs_attempted ? c.pair_seconds_total / static_cast<double>(c.pairs_attempted) : 0.0);
-    set("memory_bytes", static_cast<double>(memory));
-    set("busy", busy ? 1.0 : 0.0);
-    health.setQueueDepth(options.subframe_channel, false, static_cast<int>(queued));
+    set("memory_bytes", static_cast<double>(status.memory_bytes));
+    set("busy", status.busy ? 1.0 : 0.0);
+    health.setQueueDepth(options.subframe_channel, false, static_cast<int>(status.queued_subframes));
   });
 
   const int code = loop.run();
-  {
-    std::lock_guard<std::mutex> lock(work.mutex);
-    work.stop = true;
-    work.wake.notify_all();
-  }
-  worker.join();
+  worker.stop();
   close(results_fd);
   return code;
 }
