@@ -996,4 +996,27 @@ bool writeDepthMapPng(const std::string& path, const HeightmapRaster& map, const
   return savePng(path, image, error);
 }
 
+std::vector<PlotCurve> horizontalErrorCurves(const std::string& label, const std::vector<ErrorSample>& series,
+                                             int colour_index, int64_t t0_us) {
+  PlotCurve raw{label + " horizontal", {}, {}, colour_index, false};
+  PlotCurve aligned{label + " horizontal, SE(3)-aligned", {}, {}, colour_index, true};
+  for (const ErrorSample& s : series) {
+    const double minutes = static_cast<double>(s.utime_us - t0_us) / 60e6;
+    raw.x.push_back(minutes);
+    raw.y.push_back(s.horizontal_m);
+    aligned.x.push_back(minutes);
+    aligned.y.push_back(s.aligned_horizontal_m);
+  }
+  return {std::move(raw), std::move(aligned)};
+}
+
+std::vector<PlotBand> surveyLineBands(const std::vector<SurveyLine>& lines, int64_t t0_us) {
+  std::vector<PlotBand> bands;
+  for (const SurveyLine& line : lines) {
+    bands.push_back({static_cast<double>(line.start_utime_us - t0_us) / 60e6,
+                     static_cast<double>(line.end_utime_us - t0_us) / 60e6, "line " + std::to_string(line.index)});
+  }
+  return bands;
+}
+
 }  // namespace sss::eval

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "tools/eval/heightmap_metrics.hpp"
+#include "tools/eval/trajectory_metrics.hpp"
 
 #include <Eigen/Core>
 
@@ -38,6 +39,13 @@ struct PlotBand {
   double x_max = 0.0;
   std::string label;
 };
+
+// An estimate's horizontal error over time, minutes since t0_us: the raw curve and the dashed
+// SE(3)-aligned one.
+std::vector<PlotCurve> horizontalErrorCurves(const std::string& label, const std::vector<ErrorSample>& series,
+                                             int colour_index, int64_t t0_us);
+// The survey lines as labelled bands, minutes since t0_us.
+std::vector<PlotBand> surveyLineBands(const std::vector<SurveyLine>& lines, int64_t t0_us);
 
 bool writeCurvePlot(const std::string& path, const std::vector<PlotCurve>& curves, const std::vector<PlotBand>& bands,
                     const std::string& title, const std::string& x_label, const std::string& y_label,

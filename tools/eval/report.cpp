@@ -285,23 +285,10 @@ bool writeFigures(const EvalRequest& request, EvalReport& report, std::string& e
     std::vector<PlotCurve> curves;
     for (size_t i = 0; i < report.estimates.size(); ++i) {
       const EstimateReport& e = report.estimates[i];
-      PlotCurve raw{e.input.label + " horizontal", {}, {}, static_cast<int>(i), false};
-      PlotCurve aligned{e.input.label + " horizontal, SE(3)-aligned", {}, {}, static_cast<int>(i), true};
-      for (const ErrorSample& s : e.evaluation.series) {
-        const double minutes = static_cast<double>(s.utime_us - t0) / 60e6;
-        raw.x.push_back(minutes);
-        raw.y.push_back(s.horizontal_m);
-        aligned.x.push_back(minutes);
-        aligned.y.push_back(s.aligned_horizontal_m);
-      }
-      curves.push_back(std::move(raw));
-      curves.push_back(std::move(aligned));
+      for (PlotCurve& curve : horizontalErrorCurves(e.input.label, e.evaluation.series, static_cast<int>(i), t0))
+        curves.push_back(std::move(curve));
     }
-    std::vector<PlotBand> bands;
-    for (const SurveyLine& line : report.lines) {
-      bands.push_back({static_cast<double>(line.start_utime_us - t0) / 60e6, static_cast<double>(line.end_utime_us - t0) / 60e6,
-                       "line " + std::to_string(line.index)});
-    }
+    const std::vector<PlotBand> bands = surveyLineBands(report.lines, t0);
     const std::string error_path = withSuffix(request.plot_path, "_error");
     if (!writeCurvePlot(error_path, curves, bands, "Horizontal position error over the mission", "time since start (min)",
                         "horizontal error (m)", error)) {

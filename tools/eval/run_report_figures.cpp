@@ -32,23 +32,9 @@ void trajectoryFigures(FigureContext& context, const Trajectory& truth, const Gr
   std::vector<PlotCurve> curves;
   for (const auto& [label, evaluation, colour] :
        {std::tuple{std::string("DR"), &report.dr, kDrColour}, std::tuple{std::string("SLAM"), &report.slam, kSlamColour}}) {
-    PlotCurve raw{label + " horizontal", {}, {}, colour, false};
-    PlotCurve aligned{label + " horizontal, SE(3)-aligned", {}, {}, colour, true};
-    for (const ErrorSample& s : evaluation->series) {
-      const double minutes = static_cast<double>(s.utime_us - t0) / 60e6;
-      raw.x.push_back(minutes);
-      raw.y.push_back(s.horizontal_m);
-      aligned.x.push_back(minutes);
-      aligned.y.push_back(s.aligned_horizontal_m);
-    }
-    curves.push_back(std::move(raw));
-    curves.push_back(std::move(aligned));
+    for (PlotCurve& curve : horizontalErrorCurves(label, evaluation->series, colour, t0)) curves.push_back(std::move(curve));
   }
-  std::vector<PlotBand> bands;
-  for (const SurveyLine& line : report.lines) {
-    bands.push_back({static_cast<double>(line.start_utime_us - t0) / 60e6, static_cast<double>(line.end_utime_us - t0) / 60e6,
-                     "line " + std::to_string(line.index)});
-  }
+  const std::vector<PlotBand> bands = surveyLineBands(report.lines, t0);
   if (drawFigure(context, "error_over_time.png", [&](const std::string& path, std::string& error) {
         return writeCurvePlot(path, curves, bands, "Horizontal position error against the truth: DR vs SLAM",
                               "time since start (min)", "horizontal error (m)", error);
