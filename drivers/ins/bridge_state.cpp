@@ -14,23 +14,16 @@ namespace {
 
 constexpr const char* kOdometerFormat = "sss-ins-bridge odometer 1";
 
-std::string number(double value) {
+std::string formatted(const char* format, double value) {
   char text[40];
-  std::snprintf(text, sizeof text, "%.17g", value);
+  std::snprintf(text, sizeof text, format, value);
   return text;
 }
 
-std::string metres(double value) {
-  char text[40];
-  std::snprintf(text, sizeof text, "%.1f", value);
-  return text;
-}
-
-std::string degrees(double value) {
-  char text[40];
-  std::snprintf(text, sizeof text, "%.7f", value);
-  return text;
-}
+// Exact in the state file; degrees to ~1 cm and metres to 0.1 m in the log.
+std::string number(double value) { return formatted("%.17g", value); }
+std::string metres(double value) { return formatted("%.1f", value); }
+std::string degrees(double value) { return formatted("%.7f", value); }
 
 }  // namespace
 

@@ -216,19 +216,16 @@ int main(int argc, char** argv) {
   // offline: nothing kept.
   sss::ins::BridgeStateStore state(options.source == "file" ? std::string()
       : sss::core::resolveSystemdDirectory(options.state_directory, std::getenv("STATE_DIRECTORY")));
-  auto log = [](const sss::ins::BridgeStateLog& lines) {
+  // Runs one step of the store and writes what it says.
+  auto logged = [](const auto& step) {
+    sss::ins::BridgeStateLog lines;
+    step(lines);
     for (const std::string& line : lines.info) spdlog::info("{}", line);
     for (const std::string& line : lines.errors) spdlog::error("{}", line);
   };
-  {
-    sss::ins::BridgeStateLog lines;
-    state.restore(bridge, lines);
-    log(lines);
-  }
+  logged([&](sss::ins::BridgeStateLog& lines) { state.restore(bridge, lines); });
   auto saveOdometerIfMoved = [&] {
-    sss::ins::BridgeStateLog lines;
-    state.saveOdometerIfMoved(bridge, lines);
-    log(lines);
+    logged([&](sss::ins::BridgeStateLog& lines) { state.saveOdometerIfMoved(bridge, lines); });
   };
   loop.addTimer(1.0, saveOdometerIfMoved);
 
@@ -245,9 +242,7 @@ int main(int argc, char** argv) {
     }
   };
   auto publishAll = [&](int64_t since_us) {
-    sss::ins::BridgeStateLog lines;
-    state.noteOrigin(bridge, lines);
-    log(lines);
+    logged([&](sss::ins::BridgeStateLog& lines) { state.noteOrigin(bridge, lines); });
     for (const auto& sample : samples) {
       loop.bus().publish(options.nav_channel, sss::ins::toNavMessage(sample), since_us);
       if ((sample.ins.validity & sss::ins::kValidPosition) && sample.origin)

@@ -19,7 +19,6 @@
 #include <cstdio>
 #include <memory>
 #include <filesystem>
-#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
