@@ -13,6 +13,8 @@ PACKAGES=(
   liblcm-dev liblcm-bin libglib2.0-dev cyclonedds-dev cyclonedds-tools
   # configuration, logging, service integration
   libyaml-cpp-dev libspdlog-dev libfmt-dev libsystemd-dev systemd nlohmann-json3-dev
+  # command lines of every program
+  libcli11-dev
   # survey products: GeoTIFF rasters (gdalinfo for checking them by hand)
   libgdal-dev gdal-bin
   # tests, benchmarks, fuzzing (clang's libFuzzer runtime)

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "pipeline/core/time.hpp"
+#include "pipeline/transport/command_line.hpp"
 #include "pipeline/transport/logging.hpp"
 #include "pipeline/transport/process_loop.hpp"
 
@@ -56,19 +57,13 @@ int main(int argc, char** argv) {
   sss::transport::ProcessOptions options;
   options.process_name = "sss-status";
   double once_after_s = 0.0;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--lcm-url" && i + 1 < argc) {
-      options.lcm_url = argv[++i];
-    } else if (arg == "--channel" && i + 1 < argc) {
-      options.status_channel = argv[++i];
-    } else if (arg == "--once" && i + 1 < argc) {
-      once_after_s = std::atof(argv[++i]);
-    } else {
-      std::fprintf(stderr, "usage: %s [--lcm-url URL] [--channel SSS_STATUS] [--once SECONDS]\n", argv[0]);
-      return arg == "--help" ? 0 : 2;
-    }
-  }
+  sss::cli::CommandLine command_line("sss-status",
+                                     "a terminal view of every process's SSS_STATUS, refreshed once per second");
+  command_line.add_option("--lcm-url", options.lcm_url, "LCM URL");
+  command_line.add_option("--channel", options.status_channel, "status channel");
+  command_line.add_option("--once", once_after_s, "print once after this many seconds and exit (0: refresh forever)")
+      ->check(sss::cli::nonNegative());
+  if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
   sss::transport::initLogging("sss-status", "warn");
   // The viewer publishes its own status on another channel so it never shows itself.
   const std::string watched_channel = options.status_channel;

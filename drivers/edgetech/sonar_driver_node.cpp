@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <deque>
 #include <fstream>
+#include <optional>
 #include <string>
 
 #include "drivers/edgetech/ping_message.hpp"
@@ -33,10 +34,6 @@ struct NodeOptions {
   double replay_speed = 1.0;    // 0: as fast as possible
   int xtf_pair_index = 0;       // XTF with several side-scan pairs: 0 = lowest frequency
 };
-
-void usage(const char* program) {
-  std::fprintf(stderr, "usage: %s [--config FILE [--check-config]] [--file FILE.jsf|FILE.xtf [--speed X]] [--lcm-url URL]\n", program);
-}
 
 // Replays a file through the same byte path as TCP, publishing each ping at its sonar time
 // divided by the speed factor.
@@ -122,29 +119,21 @@ bool hasXtfExtension(const std::string& path) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string config_path;
-  std::string lcm_url_override;
+  sss::transport::NodeArguments arguments;
   NodeOptions options;
-  bool speed_given = false;
-  bool check_config_only = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--config" && i + 1 < argc) {
-      config_path = argv[++i];
-    } else if (arg == "--file" && i + 1 < argc) {
-      options.replay_file = argv[++i];
-    } else if (arg == "--speed" && i + 1 < argc) {
-      options.replay_speed = std::atof(argv[++i]);
-      speed_given = true;
-    } else if (arg == "--check-config") {
-      check_config_only = true;
-    } else if (arg == "--lcm-url" && i + 1 < argc) {
-      lcm_url_override = argv[++i];
-    } else {
-      usage(argv[0]);
-      return arg == "--help" ? 0 : 2;
-    }
-  }
+  sss::cli::CommandLine command_line("sss-sonar-driver",
+                                     "EdgeTech 2205 JSF from the sonar processor's TCP data port, or a .jsf/.xtf file "
+                                     "replayed -> SSS_PING");
+  sss::transport::addNodeFlags(command_line, arguments);
+  // The flags win over the configuration file's keys (replay_file, replay_speed).
+  std::optional<std::string> replay_file;
+  std::optional<double> replay_speed;
+  command_line.add_option("--file", replay_file, "replay this .jsf or .xtf file instead of TCP");
+  command_line.add_option("--speed", replay_speed, "replay speed (0: as fast as possible)")->check(CLI::Range(0.0, 1000.0));
+  if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
+  const std::string& config_path = arguments.config_path;
+  const std::string& lcm_url_override = arguments.lcm_url_override;
+  const bool check_config_only = arguments.check_config_only;
 
   options.process.process_name = "sss-sonar-driver";
   std::string config_problems;  // empty: valid (or no file: the defaults)
@@ -160,11 +149,13 @@ int main(int argc, char** argv) {
     section.optional("silence_timeout_s", options.tcp.silence_timeout_s, {sss::core::inRange(0.0, 3600.0)});
     section.optional("ping_channel", options.ping_channel, {sss::core::nonEmpty()});
     section.optional("replay_file", options.replay_file);
-    if (!speed_given) section.optional("replay_speed", options.replay_speed, {sss::core::inRange(0.0, 1000.0)});
+    section.optional("replay_speed", options.replay_speed, {sss::core::inRange(0.0, 1000.0)});
     section.optional("xtf_pair_index", options.xtf_pair_index, {sss::core::inRange(0, 7)});
     section.rejectUnknownKeys();
     config_problems = config.problemReport();
   }
+  if (replay_file) options.replay_file = *replay_file;
+  if (replay_speed) options.replay_speed = *replay_speed;
   if (const int code = sss::transport::configVerdict("sss-sonar-driver", config_problems, config_path, check_config_only); code >= 0) {
     return code;
   }

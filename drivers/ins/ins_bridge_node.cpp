@@ -16,6 +16,7 @@
 #include <cstring>
 #include <deque>
 #include <fstream>
+#include <optional>
 #include <string>
 
 #include "drivers/ins/bridge_state.hpp"
@@ -59,9 +60,9 @@ struct NodeOptions {
   std::string state_directory;
 };
 
-// The node's options from the configuration file (none: the defaults); --file and --speed, already
-// in options, win over the file's. Empty when valid, else the problems, one per line.
-std::string readNodeOptions(const std::string& config_path, bool speed_given, NodeOptions& options) {
+// The node's options from the configuration file (none: the defaults). Empty when valid, else the
+// problems, one per line.
+std::string readNodeOptions(const std::string& config_path, NodeOptions& options) {
   options.process.process_name = "sss-ins-bridge";
   if (config_path.empty()) return {};
   using namespace sss::core;
@@ -71,9 +72,7 @@ std::string readNodeOptions(const std::string& config_path, bool speed_given, No
   ConfigSection section = config.section("ins_bridge");
   sss::transport::readProcessOptions(section, options.process);
   sss::ins::readInsBridgeOptions(section, options.bridge);
-  const bool file_given = options.source == "file";
   section.optional("source", options.source, {oneOf({"udp", "tcp", "serial", "file"})});
-  if (file_given) options.source = "file";
   section.optional("bind_address", options.bind_address, {nonEmpty()});
   section.optional("udp_port", options.udp_port, {inRange(1, 65535)});
   section.optional("host", options.tcp.host, {nonEmpty()});
@@ -83,8 +82,8 @@ std::string readNodeOptions(const std::string& config_path, bool speed_given, No
                    {satisfies<int>([](int b) { return b == 9600 || b == 19200 || b == 38400 || b == 57600 ||
                                                       b == 115200 || b == 230400 || b == 460800; },
                                    "a standard baud rate (9600 ... 460800)")});
-  if (!file_given) section.optional("file", options.file);
-  if (!speed_given) section.optional("replay_speed", options.replay_speed, {inRange(0.0, 1000.0)});
+  section.optional("file", options.file);
+  section.optional("replay_speed", options.replay_speed, {inRange(0.0, 1000.0)});
   section.optional("nav_channel", options.nav_channel, {nonEmpty()});
   section.optional("fix_udp_port", options.fix_udp_port, {inRange(0, 65535)});
   section.optional("fix_channel", options.fix_channel, {nonEmpty()});
@@ -177,31 +176,29 @@ int openSerial(const NodeOptions& options, std::string& error) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::string config_path, lcm_url_override;
+  sss::transport::NodeArguments arguments;
   NodeOptions options;
-  bool speed_given = false;
-  bool check_config_only = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--config" && i + 1 < argc) {
-      config_path = argv[++i];
-    } else if (arg == "--file" && i + 1 < argc) {
-      options.file = argv[++i];
-      options.source = "file";
-    } else if (arg == "--speed" && i + 1 < argc) {
-      options.replay_speed = std::atof(argv[++i]);
-      speed_given = true;
-    } else if (arg == "--check-config") {
-      check_config_only = true;
-    } else if (arg == "--lcm-url" && i + 1 < argc) {
-      lcm_url_override = argv[++i];
-    } else {
-      std::fprintf(stderr, "usage: %s [--config FILE [--check-config]] [--file ins.nmea [--speed X]] [--lcm-url URL]\n", argv[0]);
-      return arg == "--help" ? 0 : 2;
-    }
+  sss::cli::CommandLine command_line("sss-ins-bridge",
+                                     "iXblue NMEA ($PIXSE) over UDP, TCP, a serial line or a file -> SSS_NAV; "
+                                     "absolute fixes -> SSS_FIX");
+  sss::transport::addNodeFlags(command_line, arguments);
+  // The flags win over the configuration file's keys (source/file, replay_speed).
+  std::optional<std::string> replay_file;
+  std::optional<double> replay_speed;
+  command_line.add_option("--file", replay_file, "replay this NMEA file (source: file)");
+  command_line.add_option("--speed", replay_speed, "replay speed (0: as fast as possible)")->check(CLI::Range(0.0, 1000.0));
+  if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
+  const std::string& config_path = arguments.config_path;
+  const std::string& lcm_url_override = arguments.lcm_url_override;
+  const std::string config_problems = readNodeOptions(config_path, options);
+  if (replay_file) {
+    options.file = *replay_file;
+    options.source = "file";
   }
-  const std::string config_problems = readNodeOptions(config_path, speed_given, options);
-  if (const int code = sss::transport::configVerdict("sss-ins-bridge", config_problems, config_path, check_config_only); code >= 0) {
+  if (replay_speed) options.replay_speed = *replay_speed;
+  if (const int code = sss::transport::configVerdict("sss-ins-bridge", config_problems, config_path,
+                                                      arguments.check_config_only);
+      code >= 0) {
     return code;
   }
   if (!lcm_url_override.empty()) options.process.lcm_url = lcm_url_override;

@@ -43,7 +43,10 @@ struct NodeOptions {
 
 int main(int argc, char** argv) {
   sss::transport::NodeArguments arguments;
-  if (const int exit_code = sss::transport::parseNodeArguments(argc, argv, arguments); exit_code >= 0) return exit_code;
+  const int usage_exit_code = sss::transport::parseNodeArguments(
+      "sss-matcher", "dense side-scan matching of overlapping subframes: SSS_SUBFRAME + SSS_TRAJECTORY -> SSS_LOOP",
+      argc, argv, arguments);
+  if (usage_exit_code >= 0) return usage_exit_code;
   const std::string& config_path = arguments.config_path;
   NodeOptions options;
   options.process.process_name = "sss-matcher";

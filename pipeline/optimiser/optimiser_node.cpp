@@ -185,7 +185,10 @@ void logOriginChange(const std::optional<sss::core::MissionOrigin>& previous, co
 
 int main(int argc, char** argv) {
   sss::transport::NodeArguments arguments;
-  if (const int exit_code = sss::transport::parseNodeArguments(argc, argv, arguments); exit_code >= 0) return exit_code;
+  const int usage_exit_code = sss::transport::parseNodeArguments(
+      "sss-optimiser", "sliding-window pose graph: SSS_SUBFRAME + SSS_LOOP + SSS_NAV (+ SSS_FIX) -> SSS_POSE, SSS_TRAJECTORY, DDS",
+      argc, argv, arguments);
+  if (usage_exit_code >= 0) return usage_exit_code;
   NodeOptions options;
   const std::string config_problems = readNodeOptions(arguments.config_path, options);
   if (const int code = sss::transport::configVerdict("sss-optimiser", config_problems, arguments.config_path, arguments.check_config_only); code >= 0) {

@@ -66,7 +66,10 @@ sss::subframe::SubframeNumbering loadNumbering(const std::string& path) {
 
 int main(int argc, char** argv) {
   sss::transport::NodeArguments arguments;
-  if (const int exit_code = sss::transport::parseNodeArguments(argc, argv, arguments); exit_code >= 0) return exit_code;
+  const int usage_exit_code = sss::transport::parseNodeArguments(
+      "sss-subframe-buffer", "canonical side-scan subframes: SSS_PING + SSS_NAV -> SSS_SUBFRAME",
+      argc, argv, arguments);
+  if (usage_exit_code >= 0) return usage_exit_code;
   const std::string& config_path = arguments.config_path;
   NodeOptions options;
   options.process.process_name = "sss-subframe-buffer";

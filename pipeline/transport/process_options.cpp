@@ -2,6 +2,7 @@
 #include "pipeline/transport/process_options.hpp"
 
 #include <cstdio>
+#include <string>
 
 namespace sss::transport {
 
@@ -20,21 +21,17 @@ void readProcessOptions(sss::core::ConfigSection& section, ProcessOptions& optio
                    {oneOf({"trace", "debug", "info", "warn", "error", "critical", "off"})});
 }
 
-int parseNodeArguments(int argc, char** argv, NodeArguments& arguments) {
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--config" && i + 1 < argc) {
-      arguments.config_path = argv[++i];
-    } else if (arg == "--check-config") {
-      arguments.check_config_only = true;
-    } else if (arg == "--lcm-url" && i + 1 < argc) {
-      arguments.lcm_url_override = argv[++i];
-    } else {
-      std::fprintf(stderr, "usage: %s [--config FILE [--check-config]] [--lcm-url URL]\n", argv[0]);
-      return arg == "--help" ? 0 : 2;
-    }
-  }
-  return -1;
+void addNodeFlags(sss::cli::CommandLine& command_line, NodeArguments& arguments) {
+  command_line.add_option("--config", arguments.config_path, "YAML configuration (every key optional; see config/sss-slam.yaml)");
+  command_line.add_flag("--check-config", arguments.check_config_only, "validate the configuration, print the verdict and exit");
+  command_line.add_option("--lcm-url", arguments.lcm_url_override, "LCM URL instead of the configured one (udpm://, memq://, ...)");
+}
+
+int parseNodeArguments(const std::string& process_name, const std::string& description, int argc, char** argv,
+                       NodeArguments& arguments) {
+  sss::cli::CommandLine command_line(process_name, description);
+  addNodeFlags(command_line, arguments);
+  return sss::cli::parseCommandLine(command_line, argc, argv);
 }
 
 int configVerdict(const std::string& process_name, const std::string& problems, const std::string& config_path,

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "pipeline/core/config.hpp"
+#include "pipeline/transport/command_line.hpp"
 
 namespace sss::transport {
 
@@ -24,15 +25,18 @@ struct ProcessOptions {
 // log_level); process_name is set by the program.
 void readProcessOptions(sss::core::ConfigSection& section, ProcessOptions& options);
 
-// The command line of a pipeline process that takes only the common flags:
-//   NAME [--config FILE [--check-config]] [--lcm-url URL]
+// The flags every pipeline process takes: NAME [--config FILE [--check-config]] [--lcm-url URL].
 struct NodeArguments {
   std::string config_path;
   std::string lcm_url_override;
   bool check_config_only = false;
 };
-// -1 to go on; otherwise the exit code to return (usage printed: 0 for --help, 2 for bad flags).
-int parseNodeArguments(int argc, char** argv, NodeArguments& arguments);
+// Declares them on a process's command line (which may add its own).
+void addNodeFlags(sss::cli::CommandLine& command_line, NodeArguments& arguments);
+// The command line of a process that takes only those flags. -1 to go on; otherwise the exit code
+// to return (command_line.hpp: 0 for --help, 2 for bad flags).
+int parseNodeArguments(const std::string& process_name, const std::string& description, int argc, char** argv,
+                       NodeArguments& arguments);
 
 // The end of every process's configuration step. problems: Config::problemReport() (empty when
 // valid). Prints them and returns 2 when there are any; with --check-config says the file is valid

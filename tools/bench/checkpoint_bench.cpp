@@ -16,20 +16,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pipeline/transport/command_line.hpp"
 #include "pipeline/optimiser/optimiser_engine.hpp"
 #include "tools/fixtures/synthetic_subframes.hpp"
 
 namespace {
 
 using namespace sss::optimiser;
-
-void usage() {
-  std::fprintf(stderr,
-               "usage: sss-bench-optimiser-checkpoint [--hours H] [--correspondences N] [--rounds R] [--dir D]\n"
-               "H-hour (default 3) lawnmower of 2 km lines, 100 m subframes of 200 pings, closures between\n"
-               "neighbouring lines with N correspondences (default 3000, the bathymetry's max_points_per_closure),\n"
-               "each pair sent in R association rounds (default 2); checkpoints into D (default /tmp).\n");
-}
 
 double fileBytes(const std::string& path) {
   struct stat s {};
@@ -63,28 +56,20 @@ int main(int argc, char** argv) {
   std::string dir = "/tmp";
   synthetic::SubframeOptions subframe_options;
   subframe_options.correspondences_per_closure = 3000;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto next = [&]() -> const char* {
-      if (i + 1 >= argc) {
-        usage();
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (arg == "--hours") hours = std::atof(next());
-    else if (arg == "--correspondences") subframe_options.correspondences_per_closure = std::atoi(next());
-    else if (arg == "--rounds") rounds = std::atoi(next());
-    else if (arg == "--dir") dir = next();
-    else {
-      usage();
-      return arg == "--help" || arg == "-h" ? 0 : 2;
-    }
-  }
-  if (!(hours > 0.0) || rounds < 1 || subframe_options.correspondences_per_closure < 0) {
-    usage();
-    return 2;
-  }
+  sss::cli::CommandLine command_line(
+      "sss-bench-optimiser-checkpoint",
+      "an H-hour lawnmower of 2 km lines, 100 m subframes of 200 pings, closures between neighbouring lines with N "
+      "correspondences, each pair sent in R association rounds; times and sizes of the optimiser's checkpoints");
+  command_line.add_option("--hours", hours, "mission length")->check(sss::cli::positive())->capture_default_str();
+  command_line.add_option("--correspondences", subframe_options.correspondences_per_closure,
+                          "correspondences per closure (the bathymetry's max_points_per_closure)")
+      ->check(sss::cli::nonNegative())
+      ->capture_default_str();
+  command_line.add_option("--rounds", rounds, "association rounds per pair")->check(sss::cli::positive())
+      ->capture_default_str();
+  command_line.add_option("--dir", dir, "checkpoint folder")->capture_default_str();
+  if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
+
   synthetic::MissionOptions mission_options;
   mission_options.line_length_m = 2000.0;
   mission_options.heading_bias_rad = 0.0005;

@@ -10,18 +10,11 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/transport/command_line.hpp"
 #include "pipeline/matcher/dense_matcher.hpp"
 #include "tools/fixtures/synthetic_pair.hpp"
 
 namespace {
-
-void usage() {
-  std::fprintf(stderr,
-               "usage: sss-bench-dense-matcher [--repeats N] [--dr-error-m M] [--threads T] [--stride S]\n"
-               "                               [--iterations I] [--no-fb]\n"
-               "Matches one parallel and one anti-parallel simulated pair per repeat with a DR error of\n"
-               "M metres (default 5) between the lines and prints timings, accuracy and a JSON summary.\n");
-}
 
 }  // namespace
 
@@ -30,26 +23,23 @@ int main(int argc, char** argv) {
   int repeats = 2;
   double dr_error_m = 5.0;
   DenseMatcherOptions options;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto next = [&]() -> const char* {
-      if (i + 1 >= argc) {
-        usage();
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (arg == "--repeats") repeats = std::atoi(next());
-    else if (arg == "--dr-error-m") dr_error_m = std::atof(next());
-    else if (arg == "--threads") options.threads = std::atoi(next());
-    else if (arg == "--stride") options.stride = std::atoi(next());
-    else if (arg == "--iterations") options.iterations = std::atoi(next());
-    else if (arg == "--no-fb") options.forward_backward_check = false;
-    else {
-      usage();
-      return arg == "--help" || arg == "-h" ? 0 : 2;
-    }
-  }
+  sss::cli::CommandLine command_line(
+      "sss-bench-dense-matcher",
+      "matches one parallel and one anti-parallel simulated pair per repeat with a DR error between the lines and "
+      "prints timings, accuracy and a JSON summary");
+  command_line.add_option("--repeats", repeats, "pairs of each direction")->check(sss::cli::positive())
+      ->capture_default_str();
+  command_line.add_option("--dr-error-m", dr_error_m, "DR error between the lines")->check(sss::cli::nonNegative())
+      ->capture_default_str();
+  command_line.add_option("--threads", options.threads, "matcher threads")->check(sss::cli::positive())
+      ->capture_default_str();
+  command_line.add_option("--stride", options.stride, "probe stride")->check(sss::cli::positive())->capture_default_str();
+  command_line.add_option("--iterations", options.iterations, "PatchMatch iterations")->check(sss::cli::positive())
+      ->capture_default_str();
+  bool no_forward_backward = false;
+  command_line.add_flag("--no-fb", no_forward_backward, "no forward-backward check");
+  if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
+  if (no_forward_backward) options.forward_backward_check = false;
   const DenseMatcher matcher(options);
 
   synthetic::Seabed seabed;

@@ -18,6 +18,7 @@
 #include <sstream>
 #include <thread>
 
+#include "pipeline/transport/command_line.hpp"
 #include "drivers/edgetech/jsf_format.hpp"
 #include "drivers/ins/ixblue_nmea.hpp"
 #include "pipeline/core/health.hpp"
@@ -58,13 +59,14 @@ pid_t spawn(const char* path, const std::string& config) {
 int main(int argc, char** argv) {
   double seconds = 30.0, ping_rate_hz = 10.0, ins_rate_hz = 20.0;
   size_t samples = 20000;
-  for (int i = 1; i + 1 < argc; i += 2) {
-    const std::string arg = argv[i];
-    if (arg == "--seconds") seconds = std::atof(argv[i + 1]);
-    else if (arg == "--ping-rate-hz") ping_rate_hz = std::atof(argv[i + 1]);
-    else if (arg == "--samples") samples = static_cast<size_t>(std::atol(argv[i + 1]));
-    else if (arg == "--ins-rate-hz") ins_rate_hz = std::atof(argv[i + 1]);
-  }
+  sss::cli::CommandLine command_line("sss-bench-drivers",
+                                     "the sonar driver and INS bridge on a synthetic stream: throughput and latency");
+  command_line.add_option("--seconds", seconds, "stream length")->check(sss::cli::positive())->capture_default_str();
+  command_line.add_option("--ping-rate-hz", ping_rate_hz, "ping rate")->check(sss::cli::positive())
+      ->capture_default_str();
+  command_line.add_option("--samples", samples, "samples per side")->check(sss::cli::positive())->capture_default_str();
+  command_line.add_option("--ins-rate-hz", ins_rate_hz, "INS rate")->check(sss::cli::positive())->capture_default_str();
+  if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
   const int64_t start_utime = sss::core::nowUtime();
   const int pings = static_cast<int>(seconds * ping_rate_hz);
 

@@ -38,6 +38,7 @@
 #include <thread>
 #include <vector>
 
+#include "pipeline/transport/command_line.hpp"
 #include "navigation_correction.h"
 #include "pipeline/core/geodesy.hpp"
 #include "pipeline/core/pose.hpp"
@@ -73,18 +74,6 @@ constexpr double kOriginLon = 18.07;
 constexpr int kPingsPerSubframe = 200;  // the paper's subframe: 50 s at 4 pings/s, 100 m at 2 m/s
 constexpr double kPingPeriodS = 0.25;
 constexpr double kSpeedMS = 2.0;
-
-void usage() {
-  std::fprintf(stderr,
-               "usage: sss-bench-latency [--samples N] [--rate-hz HZ] [--dds-rate-hz HZ] [--update-period-s S]\n"
-               "                         [--bins-per-side N] [--no-load] [--realtime] [--optimiser PATH] [--keep]\n"
-               "Runs sss-optimiser on a private LCM port and loopback DDS domain, publishes N (default 5000)\n"
-               "SSS_NAV at HZ (default 200) and times SSS_POSE and the DDS correction; first with a solved,\n"
-               "quiet graph, then (unless --no-load) while subframes of 2 x N bins (default 1250) and closures\n"
-               "arrive and the graph is solved every S s (default 0.2). --realtime: the deployed scheduling\n"
-               "(optimiser loop SCHED_FIFO 10, nav publisher and DDS reader SCHED_FIFO 20; needs CAP_SYS_NICE).\n"
-               "Last line: JSON summary.\n");
-}
 
 double percentile(std::vector<double> values, double percent) {
   if (values.empty()) return std::nan("");
@@ -285,34 +274,30 @@ int main(int argc, char** argv) {
   int bins_per_side = 1250;
   bool load = true, keep = false, realtime = false;
   std::string optimiser_path = SSS_OPTIMISER_PATH;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto next = [&]() -> const char* {
-      if (i + 1 >= argc) {
-        usage();
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (arg == "--samples") samples = std::atoi(next());
-    else if (arg == "--rate-hz") rate_hz = std::atof(next());
-    else if (arg == "--dds-rate-hz") dds_rate_hz = std::atof(next());
-    else if (arg == "--update-period-s") update_period_s = std::atof(next());
-    else if (arg == "--bins-per-side") bins_per_side = std::atoi(next());
-    else if (arg == "--no-load") load = false;
-    else if (arg == "--realtime") realtime = true;
-    else if (arg == "--optimiser") optimiser_path = next();
-    else if (arg == "--keep") keep = true;
-    else {
-      usage();
-      return arg == "--help" || arg == "-h" ? 0 : 2;
-    }
-  }
-  if (samples < 10 || !(rate_hz > 0.0 && rate_hz <= 5000.0) || !(dds_rate_hz > 0.0 && dds_rate_hz <= 1000.0) ||
-      !(update_period_s >= 0.0) || bins_per_side < 1) {
-    usage();
-    return 2;
-  }
+  sss::cli::CommandLine command_line(
+      "sss-bench-latency",
+      "runs sss-optimiser on a private LCM port and loopback DDS domain, publishes N SSS_NAV at HZ and times SSS_POSE "
+      "and the DDS correction; first with a solved, quiet graph, then (unless --no-load) while subframes and "
+      "closures arrive and the graph is solved every S s. Last line: JSON summary.",
+      "--realtime: the deployed scheduling (optimiser loop SCHED_FIFO 10, nav publisher and DDS reader SCHED_FIFO 20;\n"
+      "needs CAP_SYS_NICE).");
+  command_line.add_option("--samples", samples, "nav samples N")->check(CLI::Range(10, 100000000))->capture_default_str();
+  command_line.add_option("--rate-hz", rate_hz, "nav rate HZ")->check(CLI::Range(1e-3, 5000.0))->capture_default_str();
+  command_line.add_option("--dds-rate-hz", dds_rate_hz, "DDS correction rate")
+      ->check(CLI::Range(1e-3, 1000.0))
+      ->capture_default_str();
+  command_line.add_option("--update-period-s", update_period_s, "graph update period S")
+      ->check(sss::cli::nonNegative())
+      ->capture_default_str();
+  command_line.add_option("--bins-per-side", bins_per_side, "subframe bins per side")->check(sss::cli::positive())
+      ->capture_default_str();
+  bool no_load = false;
+  command_line.add_flag("--no-load", no_load, "only the quiet graph");
+  command_line.add_flag("--realtime", realtime, "the deployed scheduling");
+  command_line.add_option("--optimiser", optimiser_path, "the sss-optimiser to run")->capture_default_str();
+  command_line.add_flag("--keep", keep, "keep the private state directory");
+  if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
+  load = !no_load;
 
   // The publisher thread first, before any thread is started, so the DDS reader's threads (ours and
   // Cyclone's) inherit it.

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/transport/command_line.hpp"
 #include "pipeline/core/config.hpp"
 #include "pipeline/matcher/matcher_engine.hpp"
 #include "pipeline/matcher/overlap.hpp"
@@ -43,30 +44,30 @@ int main(int argc, char** argv) {
   std::string config_path;
   double dr_along_m = 3.0, dr_lateral_m = 2.0;
   std::string pattern = "lawnmower";
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--pattern" && i + 1 < argc && (std::string(argv[i + 1]) == "lawnmower" || std::string(argv[i + 1]) == "cross")) {
-      pattern = argv[++i];
-    } else if (arg == "--lines" && i + 1 < argc) {
-      lines = std::atoi(argv[++i]);
-    } else if (arg == "--line-length-m" && i + 1 < argc) {
-      line_length_m = std::atof(argv[++i]);
-    } else if (arg == "--repeat" && i + 1 < argc) {
-      repeat = std::max(1, std::atoi(argv[++i]));
-    } else if (arg == "--line-spacing-m" && i + 1 < argc) {
-      line_spacing_m = std::atof(argv[++i]);
-    } else if (arg == "--dr-error-m" && i + 1 < argc &&
-               std::sscanf(argv[i + 1], "%lf,%lf", &dr_along_m, &dr_lateral_m) == 2 && std::isfinite(dr_along_m) &&
-               std::isfinite(dr_lateral_m) && std::hypot(dr_along_m, dr_lateral_m) <= 50.0) {
-      ++i;
-    } else if (arg == "--config" && i + 1 < argc) {
-      config_path = argv[++i];
-    } else {
-      std::fprintf(stderr, "usage: %s [--pattern lawnmower|cross] [--lines N] [--line-length-m M] [--line-spacing-m M] [--repeat K]\n"
-                   "          [--config FILE (its matcher section; default: the built-in defaults)] [--dr-error-m ALONG,LATERAL (3,2)]\n",
-                   argv[0]);
-      return arg == "--help" ? 0 : 2;
-    }
+  std::vector<double> dr_error_m = {dr_along_m, dr_lateral_m};
+  sss::cli::CommandLine command_line("sss-bench-matcher",
+                                     "renders a simulated survey and times the matcher on every overlapping pair");
+  command_line.add_option("--pattern", pattern, "survey pattern")
+      ->check(CLI::IsMember({"lawnmower", "cross"}))
+      ->capture_default_str();
+  command_line.add_option("--lines", lines, "survey lines (at least 2)")->check(CLI::Range(2, 1000))
+      ->capture_default_str();
+  command_line.add_option("--line-length-m", line_length_m, "line length")->check(sss::cli::positive())
+      ->capture_default_str();
+  command_line.add_option("--line-spacing-m", line_spacing_m, "line spacing")->check(sss::cli::positive())
+      ->capture_default_str();
+  command_line.add_option("--repeat", repeat, "repeats of the whole run")->check(sss::cli::positive())
+      ->capture_default_str();
+  command_line.add_option("--config", config_path, "its matcher section (default: the built-in defaults)");
+  command_line.add_option("--dr-error-m", dr_error_m, "ALONG,LATERAL DR error between the lines (3,2)")
+      ->delimiter(',')
+      ->expected(2)
+      ->check(CLI::Range(-50.0, 50.0));
+  if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
+  dr_along_m = dr_error_m[0], dr_lateral_m = dr_error_m[1];
+  if (std::hypot(dr_along_m, dr_lateral_m) > 50.0) {
+    std::fprintf(stderr, "sss-bench-matcher: --dr-error-m: at most 50 m in all\n");
+    return 2;
   }
   sss::sim::SimOptions sim;
   sim.trajectory.lines = std::max(2, lines);

@@ -10,21 +10,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "pipeline/transport/command_line.hpp"
 #include "pipeline/optimiser/pose_graph.hpp"
 #include "tools/fixtures/synthetic_mission.hpp"
 
 namespace {
 
 using namespace sss::optimiser;
-
-void usage() {
-  std::fprintf(stderr,
-               "usage: sss-bench-optimiser [--hours H] [--line-length-m L] [--window N] [--false-fraction F]\n"
-               "                           [--seed S] [--no-full-smoothing]\n"
-               "Simulates an H-hour (default 8) lawnmower of L-metre lines (default 2000) with 100 m subframes,\n"
-               "closures between neighbouring lines (fraction F false, default 0.03), feeds it node by node\n"
-               "to a window of N nodes (default 45), prints update times and RSS, then a JSON summary.\n");
-}
 
 double rssMiB() {
   std::ifstream status("/proc/self/status");
@@ -62,28 +54,25 @@ int main(int argc, char** argv) {
   mission_options.velocity_scale_error = 0.001;
   PoseGraphOptions options;
   options.window_size = 45;  // two 2 km lines of 20 subframes: adjacent-line closures stay inside
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto next = [&]() -> const char* {
-      if (i + 1 >= argc) {
-        usage();
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (arg == "--hours") hours = std::atof(next());
-    else if (arg == "--line-length-m") mission_options.line_length_m = std::atof(next());
-    else if (arg == "--window") options.window_size = std::atoi(next());
-    else if (arg == "--false-fraction") mission_options.false_fraction = std::atof(next());
-    else if (arg == "--seed") mission_options.seed = std::strtoull(next(), nullptr, 10);
-    else if (arg == "--no-full-smoothing") full_smoothing = false;
-    else {
-      usage();
-      return arg == "--help" || arg == "-h" ? 0 : 2;
-    }
-  }
-  if (!(hours > 0.0) || !validatePoseGraphOptions(options).empty()) {
-    usage();
+  sss::cli::CommandLine command_line(
+      "sss-bench-optimiser",
+      "simulates an H-hour lawnmower with 100 m subframes and closures between neighbouring lines (a fraction "
+      "false), feeds it node by node to the window, prints update times and RSS, then a JSON summary");
+  command_line.add_option("--hours", hours, "mission length")->check(sss::cli::positive())->capture_default_str();
+  command_line.add_option("--line-length-m", mission_options.line_length_m, "line length")
+      ->check(sss::cli::positive())
+      ->capture_default_str();
+  command_line.add_option("--window", options.window_size, "window size (nodes)")->capture_default_str();
+  command_line.add_option("--false-fraction", mission_options.false_fraction, "fraction of false closures")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  command_line.add_option("--seed", mission_options.seed, "seed")->capture_default_str();
+  bool no_full_smoothing = false;
+  command_line.add_flag("--no-full-smoothing", no_full_smoothing, "no end-of-mission smoothing");
+  if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
+  full_smoothing = !no_full_smoothing;
+  if (const std::vector<std::string> problems = validatePoseGraphOptions(options); !problems.empty()) {
+    std::fprintf(stderr, "sss-bench-optimiser: %s\n", problems.front().c_str());
     return 2;
   }
   const double line_time_s =

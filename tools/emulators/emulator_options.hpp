@@ -1,16 +1,13 @@
-// Command-line options shared by the emulators: pacing and fault injection.
+// Command-line options shared by the emulators: address, pacing and fault injection.
 #pragma once
 
-#include <string>
-
+#include "pipeline/transport/command_line.hpp"
 #include "tools/emulators/stream_server.hpp"
 
 namespace sss::emulators {
 
-// Parses one option (and its value) at argv[i]; advances i. Returns false if argv[i] is not a
-// stream option, and sets error when its value is bad.
-bool parseStreamOption(int argc, char** argv, int& i, StreamServerOptions& options, std::string& error);
-// The help lines for those options.
-const char* streamOptionsHelp();
+// Declares --bind/--host, --port, --speed and the fault flags on an emulator's command line; the
+// values land in options (its current values are the defaults).
+void addStreamOptions(sss::cli::CommandLine& command_line, StreamServerOptions& options);
 
 }  // namespace sss::emulators

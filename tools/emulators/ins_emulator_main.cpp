@@ -24,34 +24,18 @@ int main(int argc, char** argv) {
   std::string file, fixes_file;
   int fixes_port = 8111;
   bool tcp = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    std::string error;
-    if (arg == "--file" && i + 1 < argc) {
-      file = argv[++i];
-    } else if (arg == "--fixes" && i + 1 < argc) {
-      fixes_file = argv[++i];
-    } else if (arg == "--fixes-port" && i + 1 < argc) {
-      fixes_port = std::atoi(argv[++i]);
-    } else if (arg == "--tcp") {
-      tcp = true;
-    } else if (arg == "--udp") {
-      tcp = false;
-    } else if (!sss::emulators::parseStreamOption(argc, argv, i, options, error) || !error.empty()) {
-      if (!error.empty()) std::fprintf(stderr, "sss-ins-emulator: %s\n", error.c_str());
-      std::fprintf(stderr,
-                   "usage: sss-ins-emulator --file ins.nmea [--udp | --tcp] [--host ADDR] [--port 8110]\n"
-                   "                        [--fixes fixes.nmea [--fixes-port 8111]] [options]\n"
-                   "  UDP sends to --host:--port; TCP listens on --host:--port; fixes go by UDP to\n"
-                   "  --host:--fixes-port (no faults injected into them)\n%s",
-                   sss::emulators::streamOptionsHelp());
-      return arg == "--help" ? 0 : 2;
-    }
-  }
-  if (file.empty()) {
-    std::fprintf(stderr, "sss-ins-emulator: --file is required\n");
-    return 2;
-  }
+  sss::cli::CommandLine command_line(
+      "sss-ins-emulator",
+      "sends a recorded iXblue NMEA stream as the INS does, paced by the epoch times, with fault injection",
+      "UDP sends to --host:--port; TCP listens on --host:--port; fixes go by UDP to --host:--fixes-port\n"
+      "(no faults injected into them).");
+  command_line.add_option("--file", file, "the NMEA file to send")->required();
+  command_line.add_option("--fixes", fixes_file, "also send these absolute fixes (sss-sim's fixes.nmea)");
+  command_line.add_option("--fixes-port", fixes_port, "UDP port of the fixes")->check(CLI::Range(1, 65535))
+      ->capture_default_str();
+  command_line.add_flag("--tcp,!--udp", tcp, "serve as a TCP server instead of sending UDP datagrams");
+  sss::emulators::addStreamOptions(command_line, options);
+  if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   std::string error;

@@ -17,25 +17,13 @@ int main(int argc, char** argv) {
   sss::emulators::StreamServerOptions options;
   std::string file;
   bool repeat = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    std::string error;
-    if (arg == "--file" && i + 1 < argc) {
-      file = argv[++i];
-    } else if (arg == "--repeat") {
-      repeat = true;
-    } else if (!sss::emulators::parseStreamOption(argc, argv, i, options, error) || !error.empty()) {
-      if (!error.empty()) std::fprintf(stderr, "sss-sonar-emulator: %s\n", error.c_str());
-      std::fprintf(stderr,
-                   "usage: sss-sonar-emulator --file FILE.jsf [--bind ADDR] [--port 1701] [--repeat] [options]\n%s",
-                   sss::emulators::streamOptionsHelp());
-      return arg == "--help" ? 0 : 2;
-    }
-  }
-  if (file.empty()) {
-    std::fprintf(stderr, "sss-sonar-emulator: --file is required\n");
-    return 2;
-  }
+  sss::cli::CommandLine command_line("sss-sonar-emulator",
+                                     "serves a .jsf file over TCP as an EdgeTech 2205 sonar processor's data port does, "
+                                     "paced by the ping times, with optional fault injection");
+  command_line.add_option("--file", file, "the JSF file to serve")->required();
+  command_line.add_flag("--repeat", repeat, "serve the file again after every pass");
+  sss::emulators::addStreamOptions(command_line, options);
+  if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   std::string error;

@@ -1,11 +1,11 @@
 // sss-eval: trajectory (ATE raw / aligned / gauge-free, RPE, per survey line, LCE), loop-closure,
 // heightmap and matching accuracy against the simulator's ground truth; prints a table, writes the
 // JSON report (keys in report.hpp) and PNG figures.
+#include "pipeline/transport/command_line.hpp"
 #include "tools/eval/report.hpp"
 
-#include <cerrno>
 #include <cmath>
-#include <cstdlib>
+#include <limits>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -14,15 +14,7 @@
 
 namespace {
 
-const char* kUsage =
-    "usage: sss-eval --gt TRUTH.tum --est EST.tum [--est MORE.tum ...] [--label NAME ...]\n"
-    "                [--seabed seabed.yaml --heightmap HM.yaml [--heightmap ...] [--heightmap-label NAME ...]]\n"
-    "                [--json OUT.json] [--plot OUT.png] [--error-map PREFIX]\n"
-    "                [--time-tolerance-s S] [--max-gap-s S] [--no-interpolation] [--rpe-windows-m 10,50,100]\n"
-    "                [--closures loop_closures.csv [--closures-dr DR.tum] [--closure-table]]\n"
-    "                [--no-lce | [--lce] [--lce-swath-m 10,70] [--lce-grid-m 5] [--lce-max-pairs 20000]\n"
-    "                            [--lce-seabed-depth-m D]]\n"
-    "                [--matches matches.csv --mission MISSION_DIR [--match-table]]\n"
+const char* kExplanation =
     "TUM lines: 'sec.usec x y z qx qy qz qw' in local NED metres (as sss-sim writes them).\n"
     "--label names the estimates in order (default: file name); the first estimate is the baseline\n"
     "  of the 'vs first' column (horizontal ATE RMSE improvement, %).\n"
@@ -55,17 +47,6 @@ const char* kUsage =
     "  crossing) and overall; --match-table also lists every pair and round.\n"
     "Exit codes: 0 ok, 1 an output could not be written, 2 bad arguments or input files.\n";
 
-bool parsePositive(const std::string& flag, const std::string& text, double& value) {
-  char* end = nullptr;
-  errno = 0;
-  value = std::strtod(text.c_str(), &end);
-  if (end == text.c_str() || *end != '\0' || errno == ERANGE || !std::isfinite(value) || value < 0.0) {
-    std::cerr << "sss-eval: " << flag << " expects a non-negative number, got '" << text << "'\n";
-    return false;
-  }
-  return true;
-}
-
 bool endsWith(const std::string& text, const std::string& suffix) {
   return text.size() >= suffix.size() && text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
@@ -76,108 +57,73 @@ int main(int argc, char** argv) {
   sss::eval::EvalRequest request;
   sss::eval::EvalOptions options;
   std::vector<std::string> labels, heightmap_labels, estimates, heightmaps;
-  int lce_flag = -1;  // -1: neither --lce nor --no-lce
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      std::cout << kUsage;
-      return 0;
-    }
-    if (arg == "--no-interpolation") {
-      options.trajectory.association.interpolate_truth = false;
-      continue;
-    }
-    if (arg == "--lce" || arg == "--no-lce") {
-      lce_flag = arg == "--lce" ? 1 : 0;  // the last one given wins
-      continue;
-    }
-    if (arg == "--closure-table") {
-      options.closure_table = true;
-      continue;
-    }
-    if (arg == "--match-table") {
-      options.match_table = true;
-      continue;
-    }
-    if (arg.rfind("--", 0) != 0 || i + 1 >= argc) {
-      std::cerr << "sss-eval: unexpected argument '" << arg << "' (or a flag without its value)\n" << kUsage;
+  sss::cli::CommandLine command_line(
+      "sss-eval",
+      "trajectory, loop-closure, heightmap and matching accuracy against the simulator's ground truth",
+      kExplanation);
+  command_line.add_option("--gt", request.truth_path, "ground truth (TUM)");
+  command_line.add_option("--est", estimates, "an estimate (TUM); repeatable, the first is the baseline");
+  command_line.add_option("--label", labels, "names of the estimates, in order");
+  command_line.add_option("--seabed", request.seabed_path, "the true seabed (seabed.yaml)");
+  command_line.add_option("--heightmap", heightmaps, "a heightmap to evaluate (YAML); repeatable");
+  command_line.add_option("--heightmap-label", heightmap_labels, "names of the heightmaps, in order");
+  command_line.add_option("--json", request.json_path, "write the report as JSON");
+  command_line.add_option("--plot", request.plot_path, "write the figures (a name ending in .png)");
+  command_line.add_option("--error-map", request.error_map_prefix, "write heightmap error maps with this prefix");
+  command_line.add_option("--closures", request.closures_path, "loop_closures.csv of sss-process");
+  command_line.add_option("--closures-dr", request.closures_dr_path, "DR (TUM) for the closures' DR comparison");
+  command_line.add_flag("--closure-table", options.closure_table, "also list every closure");
+  command_line.add_option("--matches", request.matches_path, "matches.csv of sss-process --write-matches");
+  command_line.add_option("--mission", request.mission_dir, "the sss-sim mission of --matches");
+  command_line.add_flag("--match-table", options.match_table, "also list every pair and round");
+  bool lce = false;
+  const CLI::Option* lce_flag = command_line.add_flag("--lce,!--no-lce", lce, "run LCE (--no-lce: do not)")
+                                    ->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);  // the last one wins
+  bool interpolate = true;
+  command_line.add_flag("!--no-interpolation", interpolate, "nearest truth pose instead of interpolation");
+  command_line.add_option("--time-tolerance-s", options.trajectory.association.max_time_difference_s,
+                          "nearest-pose tolerance")
+      ->check(sss::cli::nonNegative())
+      ->capture_default_str();
+  command_line.add_option("--max-gap-s", options.trajectory.association.max_interpolation_gap_s,
+                          "largest truth gap interpolated over")
+      ->check(sss::cli::nonNegative())
+      ->capture_default_str();
+  command_line.add_option("--rpe-windows-m", options.trajectory.rpe.windows_m, "RPE windows, e.g. 10,50,100")
+      ->delimiter(',')
+      ->check(sss::cli::positive());
+  std::vector<double> lce_swath_m;
+  command_line.add_option("--lce-swath-m", lce_swath_m, "MIN,MAX ground ranges of LCE sightings, e.g. 10,70")
+      ->delimiter(',')
+      ->expected(2)
+      ->check(sss::cli::nonNegative());
+  command_line.add_option("--lce-grid-m", options.lce.grid_m, "LCE seabed point spacing")
+      ->check(CLI::Range(0.1, 1e6))
+      ->capture_default_str();
+  command_line.add_option("--lce-max-pairs", options.lce.max_correspondences, "LCE pairs at most")
+      ->check(CLI::Range(size_t{1}, std::numeric_limits<size_t>::max()))
+      ->capture_default_str();
+  command_line.add_option("--lce-seabed-depth-m", options.lce_seabed_depth_m, "flat seabed depth for LCE")
+      ->check(sss::cli::nonNegative());
+  if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
+  options.trajectory.association.interpolate_truth = interpolate;
+  if (!lce_swath_m.empty()) {
+    if (!(lce_swath_m[1] > lce_swath_m[0])) {
+      std::cerr << "sss-eval: --lce-swath-m expects MIN,MAX ground ranges with MIN < MAX, e.g. 10,70\n";
       return 2;
     }
-    const std::string value = argv[++i];
-    double number = 0.0;
-    if (arg == "--gt") request.truth_path = value;
-    else if (arg == "--est") estimates.push_back(value);
-    else if (arg == "--label") labels.push_back(value);
-    else if (arg == "--seabed") request.seabed_path = value;
-    else if (arg == "--heightmap") heightmaps.push_back(value);
-    else if (arg == "--heightmap-label") heightmap_labels.push_back(value);
-    else if (arg == "--json") request.json_path = value;
-    else if (arg == "--plot") request.plot_path = value;
-    else if (arg == "--error-map") request.error_map_prefix = value;
-    else if (arg == "--closures") request.closures_path = value;
-    else if (arg == "--closures-dr") request.closures_dr_path = value;
-    else if (arg == "--matches") request.matches_path = value;
-    else if (arg == "--mission") request.mission_dir = value;
-    else if (arg == "--lce-swath-m") {
-      const size_t comma = value.find(',');
-      double max_m = 0.0;
-      if (comma == std::string::npos || !parsePositive(arg, value.substr(0, comma), number) ||
-          !parsePositive(arg, value.substr(comma + 1), max_m) || !(max_m > number)) {
-        std::cerr << "sss-eval: --lce-swath-m expects MIN,MAX ground ranges with MIN < MAX, e.g. 10,70\n";
-        return 2;
-      }
-      options.lce.min_ground_range_m = number;
-      options.lce.max_ground_range_m = max_m;
-    } else if (arg == "--lce-grid-m") {
-      if (!parsePositive(arg, value, number) || !(number >= 0.1)) {
-        std::cerr << "sss-eval: --lce-grid-m expects a spacing of at least 0.1 m\n";
-        return 2;
-      }
-      options.lce.grid_m = number;
-    } else if (arg == "--lce-max-pairs") {
-      if (!parsePositive(arg, value, number) || !(number >= 1.0) || number != std::floor(number)) {
-        std::cerr << "sss-eval: --lce-max-pairs expects a whole number of at least 1\n";
-        return 2;
-      }
-      options.lce.max_correspondences = static_cast<size_t>(number);
-    } else if (arg == "--lce-seabed-depth-m") {
-      if (!parsePositive(arg, value, number)) return 2;
-      options.lce_seabed_depth_m = number;
-    }
-    else if (arg == "--time-tolerance-s") {
-      if (!parsePositive(arg, value, number)) return 2;
-      options.trajectory.association.max_time_difference_s = number;
-    } else if (arg == "--max-gap-s") {
-      if (!parsePositive(arg, value, number)) return 2;
-      options.trajectory.association.max_interpolation_gap_s = number;
-    } else if (arg == "--rpe-windows-m") {
-      options.trajectory.rpe.windows_m.clear();
-      std::string item;
-      for (size_t k = 0; k <= value.size(); ++k) {
-        if (k < value.size() && value[k] != ',') {
-          item += value[k];
-          continue;
-        }
-        if (!parsePositive(arg, item, number) || number <= 0.0) {
-          if (number <= 0.0) std::cerr << "sss-eval: --rpe-windows-m expects positive lengths, e.g. 10,50,100\n";
-          return 2;
-        }
-        options.trajectory.rpe.windows_m.push_back(number);
-        item.clear();
-      }
-    } else {
-      std::cerr << "sss-eval: unknown flag " << arg << "\n" << kUsage;
-      return 2;
-    }
+    options.lce.min_ground_range_m = lce_swath_m[0];
+    options.lce.max_ground_range_m = lce_swath_m[1];
   }
+  const bool lce_given = lce_flag->count() > 0;
   // LCE by default with a truth and an estimate: it is the metric of what side-scan can see.
-  request.lce = lce_flag == 1 || (lce_flag == -1 && !request.truth_path.empty() && !estimates.empty());
-  request.lce_optional = lce_flag == -1;
+  request.lce = (lce_given && lce) || (!lce_given && !request.truth_path.empty() && !estimates.empty());
+  request.lce_optional = !lce_given;
   if (estimates.empty() && heightmaps.empty() && request.closures_path.empty() && !request.lce &&
       request.matches_path.empty()) {
     std::cerr << "sss-eval: nothing to evaluate: give --gt TRUTH.tum with --est EST.tum, --closures C.csv or --lce,\n"
                  "  and/or --seabed S.yaml --heightmap H.yaml, and/or --matches M.csv --mission DIR\n"
-              << kUsage;
+              << command_line.help();
     return 2;
   }
   if (request.matches_path.empty() != request.mission_dir.empty()) {

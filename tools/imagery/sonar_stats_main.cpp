@@ -3,6 +3,7 @@
 // nadir. Prints a few lines; --json FILE writes them as JSON.
 #include "drivers/edgetech/sonar_driver.hpp"
 #include "drivers/xtf/xtf_reader.hpp"
+#include "pipeline/transport/command_line.hpp"
 #include "tools/imagery/sonar_statistics.hpp"
 
 #include <opencv2/core.hpp>
@@ -18,10 +19,7 @@
 
 namespace {
 
-const char* kUsage =
-    "usage: sss-sonar-stats --sonar FILE.jsf|FILE.xtf [--json OUT.json] [--subsystem N] [--pair K] [--max-pings N]\n"
-    "                       [--block PINGS,SAMPLES] [--max-quarter-deviation F] [--far-range MIN,MAX]\n"
-    "                       [--waterfall OUT.png]\n"
+const char* kExplanation =
     "Image statistics of the raw envelope samples: speckle (median std/mean of homogeneous far-range\n"
     "blocks), dynamic range, across-track fall-off, water column and nadir re the seabed mean.\n"
     "--subsystem: JSF side-scan subsystem (20 low, 21 high; default 20); --pair: XTF channel pair\n"
@@ -86,51 +84,48 @@ bool writeWaterfall(const std::vector<sss::imagery::StatisticsPing>& pings, cons
   }
 }
 
-bool parseCount(const std::string& text, long& value) {
-  char* end = nullptr;
-  value = std::strtol(text.c_str(), &end, 10);
-  return end != text.c_str() && *end == '\0' && value >= 0;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   std::string sonar_path, json_path, waterfall_path;
-  long subsystem = sss::edgetech::kSubsystemSideScanLow, pair = 0, max_pings = 0;
+  int subsystem = sss::edgetech::kSubsystemSideScanLow, pair = 0;
+  long max_pings = 0;
   sss::imagery::SonarStatisticsOptions stats_options;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      std::cout << kUsage;
-      return 0;
-    }
-    if (i + 1 >= argc) {
-      std::cerr << "sss-sonar-stats: " << arg << " needs a value\n" << kUsage;
+  std::vector<int> block;
+  std::vector<double> far_range;
+  sss::cli::CommandLine command_line("sss-sonar-stats",
+                                     "the image statistics of a side-scan file (JSF or XTF) that a person compares "
+                                     "between simulated and real data",
+                                     kExplanation);
+  command_line.add_option("--sonar", sonar_path, "FILE.jsf or FILE.xtf")->required();
+  command_line.add_option("--json", json_path, "write the statistics as JSON");
+  command_line.add_option("--waterfall", waterfall_path, "write the raw slant-range waterfall (PNG)");
+  command_line.add_option("--subsystem", subsystem, "JSF side-scan subsystem")->check(CLI::Range(0, 255))
+      ->capture_default_str();
+  command_line.add_option("--pair", pair, "XTF channel pair")->check(sss::cli::nonNegative())->capture_default_str();
+  command_line.add_option("--max-pings", max_pings, "read at most this many pings (0: all)")
+      ->check(sss::cli::nonNegative());
+  command_line.add_option("--block", block, "PINGS,SAMPLES of a speckle block (each >= 2)")
+      ->delimiter(',')
+      ->expected(2)
+      ->check(CLI::Range(2, 1 << 20));
+  command_line.add_option("--far-range", far_range, "MIN,MAX fractions of the range for the far-range statistics")
+      ->delimiter(',')
+      ->expected(2)
+      ->check(CLI::Range(0.0, 1.0));
+  command_line.add_option("--max-quarter-deviation", stats_options.max_quarter_deviation,
+                          "largest deviation between a block's quarters for it to count as homogeneous")
+      ->check(sss::cli::positive())
+      ->capture_default_str();
+  if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
+  if (!block.empty()) stats_options.block_pings = block[0], stats_options.block_samples = block[1];
+  if (!far_range.empty()) {
+    if (far_range[0] >= far_range[1]) {
+      std::cerr << "sss-sonar-stats: --far-range MIN,MAX needs MIN < MAX, got " << far_range[0] << "," << far_range[1]
+                << "\n";
       return 2;
     }
-    const std::string value = argv[++i];
-    double a = 0.0, b = 0.0;
-    char tail = 0;
-    const bool two_numbers = std::sscanf(value.c_str(), "%lf,%lf%c", &a, &b, &tail) == 2;
-    if (arg == "--block" && two_numbers && a >= 2 && b >= 2) {
-      stats_options.block_pings = static_cast<int>(a), stats_options.block_samples = static_cast<int>(b);
-    } else if (arg == "--far-range" && two_numbers && a >= 0.0 && a < b && b <= 1.0) {
-      stats_options.far_range_min_fraction = a, stats_options.far_range_max_fraction = b;
-    } else if (arg == "--max-quarter-deviation" && std::sscanf(value.c_str(), "%lf%c", &a, &tail) == 1 && a > 0.0) {
-      stats_options.max_quarter_deviation = a;
-    } else if (arg == "--sonar") sonar_path = value;
-    else if (arg == "--json") json_path = value;
-    else if (arg == "--waterfall") waterfall_path = value;
-    else if ((arg == "--subsystem" && parseCount(value, subsystem) && subsystem < 256) ||
-             (arg == "--pair" && parseCount(value, pair)) || (arg == "--max-pings" && parseCount(value, max_pings))) {
-    } else {
-      std::cerr << "sss-sonar-stats: bad argument " << arg << " " << value << "\n" << kUsage;
-      return 2;
-    }
-  }
-  if (sonar_path.empty()) {
-    std::cerr << "sss-sonar-stats: --sonar FILE is required\n" << kUsage;
-    return 2;
+    stats_options.far_range_min_fraction = far_range[0], stats_options.far_range_max_fraction = far_range[1];
   }
 
   std::vector<sss::imagery::StatisticsPing> pings;

@@ -5,99 +5,68 @@
 // per stage that yielded nothing), 1 an output could not be written, 2 bad input, 3 nothing could
 // be processed (no ping got a pose, or no subframe: the reason is printed and in summary.json).
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <string>
 
+#include "pipeline/transport/command_line.hpp"
 #include "tools/process/offline_runner.hpp"
 
 namespace {
-void usage(std::FILE* out) {
-  std::fprintf(out,
-               "usage: sss-process --sonar FILE.jsf|FILE.xtf [--ins FILE.nmea] [--fixes FILE]... [--config FILE] --out DIR\n"
-               "                   [--write-corrected DIR] [--quiet]\n"
-               "                   [--write-matches] [--inject-false-closures FRACTION [--inject-seed N]]\n"
-               "       sss-process --lcm-log FILE [--ping-channel C] [--nav-channel C] [--config FILE] --out DIR\n"
-               "                   [--no-mosaics] [--quiet]\n"
-               "  --fixes [gnss:|usbl:]FILE  absolute position fixes, NMEA GGA (+ GST sigmas, ZDA/RMC dates); repeatable.\n"
-               "                         GNSS counts only at the surface; the talker says GNSS (GP, GN, ...) or USBL\n"
-               "                         (any other) unless the prefix does. Adds fixes.csv and dead_reckoning_fixed.tum\n"
-               "                         (the same fixes without side-scan)\n"
-               "  --write-corrected DIR  also write DIR/<sonar file name>: a copy of the sonar file with every ping's\n"
-               "                         navigation (position, depth, heading, pitch, roll) replaced by the SLAM pose,\n"
-               "                         every other byte unchanged, for the mosaicking software already in use\n"
-               "  --record-lcm-log FILE  also write the SSS_PING and SSS_NAV messages fed to the chain to an LCM log\n"
-               "  --write-matches        also write matches.csv: every dense match, subframe row and recall probe of\n"
-               "                         every pair the matcher tried (for sss-eval --matches FILE --mission DIR)\n"
-               "  --inject-false-closures FRACTION  evaluation: that fraction of the matched pairs (drawn with\n"
-               "                         --inject-seed, default 1) get a relative pose 3-10 m and 2-10 deg wrong\n"
-               "                         before the optimiser (summary.json: false_closures_injected)\n"
-               "Writes to DIR: dead_reckoning.tum, slam.tum (every ping, TUM, local NED of the mission origin),\n"
-               "navigation.csv and navigation.nmea (the corrected navigation per ping for other tools), track.geojson and\n"
-               "subframes.geojson (tracks and subframe footprints for GIS),\n"
-               "loop_closures.csv, bathymetry.ply (+ bathymetry_dr.ply), heightmap.yaml/.png (+ heightmap_dr),\n"
-               "mosaic_dr.png, mosaic_slam.png (+ .yaml geo-references), GeoTIFFs of the mosaics, heightmaps and coverage\n"
-               "(mosaic_dr.tif, mosaic_slam.tif, heightmap.tif, heightmap_dr.tif, coverage.tif: UTM zone of the origin,\n"
-               "or the file's grid with products.projected_crs) and summary.json (counts, where the pings\n"
-               "went, the mission origin and, when a stage yielded nothing, why).\n"
-               "Exit: 0 ok, 1 an output could not be written, 2 bad arguments or input, 3 nothing could be\n"
-               "processed (no ping got a pose, or no subframe).\n");
-}
+const char* kExplanation =
+    "Details:\n"
+    "  --fixes [gnss:|usbl:]FILE  absolute position fixes, NMEA GGA (+ GST sigmas, ZDA/RMC dates); repeatable.\n"
+    "                         GNSS counts only at the surface; the talker says GNSS (GP, GN, ...) or USBL\n"
+    "                         (any other) unless the prefix does. Adds fixes.csv and dead_reckoning_fixed.tum\n"
+    "                         (the same fixes without side-scan)\n"
+    "  --write-corrected DIR  also write DIR/<sonar file name>: a copy of the sonar file with every ping's\n"
+    "                         navigation (position, depth, heading, pitch, roll) replaced by the SLAM pose,\n"
+    "                         every other byte unchanged, for the mosaicking software already in use\n"
+    "  --record-lcm-log FILE  also write the SSS_PING and SSS_NAV messages fed to the chain to an LCM log\n"
+    "  --write-matches        also write matches.csv: every dense match, subframe row and recall probe of\n"
+    "                         every pair the matcher tried (for sss-eval --matches FILE --mission DIR)\n"
+    "  --inject-false-closures FRACTION  evaluation: that fraction of the matched pairs (drawn with\n"
+    "                         --inject-seed, default 1) get a relative pose 3-10 m and 2-10 deg wrong\n"
+    "                         before the optimiser (summary.json: false_closures_injected)\n"
+    "Writes to DIR: dead_reckoning.tum, slam.tum (every ping, TUM, local NED of the mission origin),\n"
+    "navigation.csv and navigation.nmea (the corrected navigation per ping for other tools), track.geojson and\n"
+    "subframes.geojson (tracks and subframe footprints for GIS),\n"
+    "loop_closures.csv, bathymetry.ply (+ bathymetry_dr.ply), heightmap.yaml/.png (+ heightmap_dr),\n"
+    "mosaic_dr.png, mosaic_slam.png (+ .yaml geo-references), GeoTIFFs of the mosaics, heightmaps and coverage\n"
+    "(mosaic_dr.tif, mosaic_slam.tif, heightmap.tif, heightmap_dr.tif, coverage.tif: UTM zone of the origin,\n"
+    "or the file's grid with products.projected_crs) and summary.json (counts, where the pings\n"
+    "went, the mission origin and, when a stage yielded nothing, why).\n"
+    "Exit: 0 ok, 1 an output could not be written, 2 bad arguments or input, 3 nothing could be\n"
+    "processed (no ping got a pose, or no subframe).\n";
 }  // namespace
 
 int main(int argc, char** argv) {
   sss::offline::OfflineRequest request;
   request.progress = stderr;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto value = [&](std::string& target) {
-      if (i + 1 >= argc) return false;
-      target = argv[++i];
-      return true;
-    };
-    bool ok = true;
-    if (arg == "--sonar") ok = value(request.sonar_path);
-    else if (arg == "--ins") ok = value(request.ins_path);
-    else if (arg == "--lcm-log") ok = value(request.lcm_log_path);
-    else if (arg == "--config") ok = value(request.config_path);
-    else if (arg == "--out") ok = value(request.out_dir);
-    else if (arg == "--ping-channel") ok = value(request.ping_channel);
-    else if (arg == "--nav-channel") ok = value(request.nav_channel);
-    else if (arg == "--record-lcm-log") ok = value(request.record_lcm_log_path);
-    else if (arg == "--write-corrected") ok = value(request.corrected_dir);
-    else if (arg == "--fixes") {
-      std::string spec;
-      ok = value(spec);
-      if (ok) request.fix_paths.push_back(spec);
-    }
-    else if (arg == "--no-mosaics") request.write_mosaics = false;
-    else if (arg == "--write-matches") request.write_matches = true;
-    else if (arg == "--inject-false-closures" || arg == "--inject-seed") {
-      std::string text;
-      char* end = nullptr;
-      ok = value(text);
-      if (ok && arg == "--inject-false-closures") {
-        request.false_closure_fraction = std::strtod(text.c_str(), &end);
-        ok = end != text.c_str() && *end == '\0' && request.false_closure_fraction >= 0.0 &&
-             request.false_closure_fraction <= 1.0;
-      } else if (ok) {
-        request.false_closure_seed = std::strtoull(text.c_str(), &end, 10);
-        ok = end != text.c_str() && *end == '\0' && text[0] != '-';
-      }
-    }
-    else if (arg == "--quiet") request.progress = nullptr;
-    else if (arg == "--help" || arg == "-h") {
-      usage(stdout);
-      return 0;
-    } else {
-      ok = false;
-    }
-    if (!ok) {
-      std::fprintf(stderr, "sss-process: bad argument '%s'\n", arg.c_str());
-      usage(stderr);
-      return 2;
-    }
-  }
+  sss::cli::CommandLine command_line("sss-process",
+                                     "post-processes a survey offline with the live chain's libraries, deterministically: "
+                                     "--sonar FILE.jsf|FILE.xtf [--ins FILE.nmea] or --lcm-log FILE, and --out DIR",
+                                     kExplanation);
+  command_line.add_option("--sonar", request.sonar_path, "the side-scan file (.jsf or .xtf)");
+  command_line.add_option("--ins", request.ins_path, "iXblue NMEA navigation (default: the sonar file's own)");
+  command_line.add_option("--lcm-log", request.lcm_log_path, "an LCM log of SSS_PING and SSS_NAV instead of files");
+  command_line.add_option("--config", request.config_path, "YAML configuration");
+  command_line.add_option("--out", request.out_dir, "output folder");
+  command_line.add_option("--ping-channel", request.ping_channel, "ping channel of --lcm-log");
+  command_line.add_option("--nav-channel", request.nav_channel, "nav channel of --lcm-log");
+  command_line.add_option("--record-lcm-log", request.record_lcm_log_path, "record the chain's input to this LCM log");
+  command_line.add_option("--write-corrected", request.corrected_dir, "write a corrected copy of the sonar file here");
+  command_line.add_option("--fixes", request.fix_paths, "[gnss:|usbl:]FILE of absolute fixes; repeatable");
+  bool no_mosaics = false, quiet = false;
+  command_line.add_flag("--no-mosaics", no_mosaics, "no mosaics");
+  command_line.add_flag("--write-matches", request.write_matches, "also write matches.csv");
+  command_line.add_option("--inject-false-closures", request.false_closure_fraction,
+                          "make this fraction of the matched pairs false")
+      ->check(CLI::Range(0.0, 1.0));
+  command_line.add_option("--inject-seed", request.false_closure_seed, "seed of the false closures")
+      ->capture_default_str();
+  command_line.add_flag("--quiet", quiet, "no progress on stderr");
+  if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
+  if (no_mosaics) request.write_mosaics = false;
+  if (quiet) request.progress = nullptr;
   const sss::offline::OfflineResult result = sss::offline::runOffline(request);
   if (!result.ok) {
     std::fprintf(stderr, "sss-process: %s\n", result.error.c_str());

@@ -1,23 +1,19 @@
 // sss-sim: renders a simulated side-scan mission (JSF, INS NMEA, ground truth, seabed, previews)
 // into --out DIR. Options: YAML `sim` section via --config, then command-line overrides.
 #include "pipeline/core/config.hpp"
+#include "pipeline/transport/command_line.hpp"
 #include "tools/sim/mission.hpp"
 #include "tools/sim/randomise.hpp"
 
 #include <cstdio>
-#include <cstdlib>
 #include <iostream>
-#include <map>
+#include <optional>
+#include <type_traits>
 #include <string>
 
 namespace {
 
-const char* kUsage =
-    "usage: sss-sim --out DIR [--config FILE] [--seed N] [--pattern lawnmower|loop|cross] [--lines N]\n"
-    "               [--cross-lines K] [--line-length-m M] [--line-spacing-m M] [--range-m M] [--altitude-m M]\n"
-    "               [--ping-rate-hz HZ] [--drift-scale K] [--heading-noise-rad S] [--duration-s S]\n"
-    "               [--origin-latitude-deg LAT --origin-longitude-deg LON] [--no-altitude]\n"
-    "               [--gnss-fixes none|start|start-end|lines] [--usbl-period-s S] [--randomise [--family NAME]]\n"
+const char* kExplanation =
     "--no-altitude: no altitude in ins.nmea nor in the JSF headers (a towed fish, no DVL).\n"
     "--gnss-fixes: the vehicle surfaces for GNSS fixes before the dive (start), also after the last line\n"
     "  (start-end), also half way through every turn (lines); --usbl-period-s S: a USBL fix every S s from a\n"
@@ -34,63 +30,53 @@ const char* kUsage =
     "  across the block at 1/(K+1) ... K/(K+1) of the line length, one spacing beyond the outer lines.\n"
     "The config file's `sim` section holds every other parameter (see mission.yaml of any run).\n";
 
-bool parseNumber(const std::string& flag, const std::string& text, double& value) {
-  char* end = nullptr;
-  value = std::strtod(text.c_str(), &end);
-  if (end == text.c_str() || *end != '\0') {
-    std::cerr << "sss-sim: " << flag << " expects a number, got '" << text << "'\n";
-    return false;
-  }
-  return true;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::map<std::string, std::string> flags;
+  std::string out_dir, config_path, family;
   bool randomise = false;
   bool no_altitude = false;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--help" || arg == "-h") {
-      std::cout << kUsage;
-      return 0;
-    }
-    if (arg == "--no-altitude") {
-      no_altitude = true;
-      continue;
-    }
-    if (arg == "--randomise") {
-      randomise = true;
-      continue;
-    }
-    if (arg.rfind("--", 0) != 0 || i + 1 >= argc) {
-      std::cerr << "sss-sim: unexpected argument '" << arg << "' (every flag takes a value)\n" << kUsage;
-      return 2;
-    }
-    flags[arg] = argv[++i];
-  }
-  if (!flags.count("--out")) {
-    std::cerr << "sss-sim: --out DIR is required\n" << kUsage;
-    return 2;
-  }
+  int64_t seed = 1;
+  // Every override is optional: the mission (drawn or default, then the config's) keeps its value
+  // unless the flag is given.
+  std::optional<int64_t> lines, cross_lines;
+  std::optional<double> line_length_m, line_spacing_m, range_m, altitude_m, ping_rate_hz, drift_scale,
+      heading_noise_rad, duration_s, origin_latitude_deg, origin_longitude_deg, usbl_period_s;
+  std::optional<std::string> pattern, gnss_fixes;
+  sss::cli::CommandLine command_line("sss-sim",
+                                     "renders a simulated side-scan mission (JSF, INS NMEA, ground truth, seabed, "
+                                     "previews) into --out DIR",
+                                     kExplanation);
+  command_line.add_option("--out", out_dir, "output folder")->required();
+  command_line.add_option("--config", config_path, "YAML file with a `sim` section");
+  const CLI::Option* seed_flag =
+      command_line.add_option("--seed", seed, "random seed")->check(sss::cli::nonNegative());
+  command_line.add_option("--pattern", pattern, "lawnmower | loop | cross");
+  command_line.add_option("--lines", lines, "survey lines")->check(sss::cli::nonNegative());
+  command_line.add_option("--cross-lines", cross_lines, "cross lines of --pattern cross")->check(sss::cli::nonNegative());
+  command_line.add_option("--line-length-m", line_length_m, "line length");
+  command_line.add_option("--line-spacing-m", line_spacing_m, "line spacing");
+  command_line.add_option("--range-m", range_m, "sonar range per side");
+  command_line.add_option("--altitude-m", altitude_m, "altitude above the seabed");
+  command_line.add_option("--ping-rate-hz", ping_rate_hz, "ping rate");
+  command_line.add_option("--drift-scale", drift_scale, "scale of the DR errors");
+  command_line.add_option("--heading-noise-rad", heading_noise_rad, "INS heading noise");
+  command_line.add_option("--duration-s", duration_s, "mission duration (0: the survey's)");
+  command_line.add_option("--origin-latitude-deg", origin_latitude_deg, "origin latitude");
+  command_line.add_option("--origin-longitude-deg", origin_longitude_deg, "origin longitude");
+  command_line.add_flag("--no-altitude", no_altitude, "no altitude in ins.nmea nor in the JSF headers");
+  command_line.add_option("--gnss-fixes", gnss_fixes, "none | start | start-end | lines");
+  command_line.add_option("--usbl-period-s", usbl_period_s, "a USBL fix every S s (0: none)");
+  command_line.add_flag("--randomise", randomise, "draw the whole mission from --seed");
+  command_line.add_option("--family", family, "the seabed family of --randomise")->needs("--randomise");
+  if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
 
   sss::sim::SimOptions options;
-  if (flags.count("--family") && !randomise) {
-    std::cerr << "sss-sim: --family needs --randomise\n";
-    return 2;
-  }
   if (randomise) {
     sss::sim::RandomiseOptions request;
-    double seed = 1.0;
-    if (flags.count("--seed") && (!parseNumber("--seed", flags["--seed"], seed) || seed < 0 ||
-                                  seed != static_cast<double>(static_cast<int64_t>(seed)))) {
-      std::cerr << "sss-sim: --seed expects a non-negative integer, got '" << flags["--seed"] << "'\n";
-      return 2;
-    }
-    request.seed = static_cast<int64_t>(seed);
-    if (flags.count("--family")) {
-      request.family = flags["--family"];
+    request.seed = seed;
+    if (!family.empty()) {
+      request.family = family;
       if (!sss::sim::isSeabedFamily(request.family)) {
         std::cerr << "sss-sim: --family " << request.family << " is not one of sand_ripples, mud, rock_outcrops, "
                   << "boulder_field, trawled, mixed\n";
@@ -99,56 +85,39 @@ int main(int argc, char** argv) {
     }
     options = sss::sim::randomiseMission(request);
   }
-  if (flags.count("--config")) {
-    sss::core::Config config = sss::core::Config::fromFile(flags["--config"]);
+  if (!config_path.empty()) {
+    sss::core::Config config = sss::core::Config::fromFile(config_path);
     // has() first: ConfigSection::section throws on an absent key (see tools/sim/mission.cpp).
     if (config.ok() && !config.root().has("sim")) {
-      std::cerr << "sss-sim: " << flags["--config"] << " has no `sim` section (see mission.yaml of any run)\n";
+      std::cerr << "sss-sim: " << config_path << " has no `sim` section (see mission.yaml of any run)\n";
       return 2;
     }
     if (config.ok()) sss::sim::readSimOptions(config.section("sim"), options);
     if (!config.ok()) {
-      std::cerr << "sss-sim: invalid configuration " << flags["--config"] << ":\n" << config.problemReport() << "\n";
+      std::cerr << "sss-sim: invalid configuration " << config_path << ":\n" << config.problemReport() << "\n";
       return 2;
     }
   }
-  const std::map<std::string, double*> numeric = {
-      {"--line-length-m", &options.trajectory.line_length_m},
-      {"--line-spacing-m", &options.trajectory.line_spacing_m},
-      {"--range-m", &options.sonar.range_m},
-      {"--altitude-m", &options.trajectory.altitude_m},
-      {"--ping-rate-hz", &options.sonar.ping_rate_hz},
-      {"--drift-scale", &options.dead_reckoning.drift_scale},
-      {"--heading-noise-rad", &options.dead_reckoning.heading_noise_rad},
-      {"--duration-s", &options.duration_s},
-      {"--origin-latitude-deg", &options.origin_latitude_deg},
-      {"--origin-longitude-deg", &options.origin_longitude_deg},
-      {"--usbl-period-s", &options.fixes.usbl_period_s},
-  };
   if (no_altitude) options.record_altitude = false;
-  for (const auto& [flag, value] : flags) {
-    if (flag == "--out" || flag == "--config" || flag == "--family") continue;
-    double number = 0.0;
-    if (flag == "--pattern") {
-      options.trajectory.pattern = value;
-    } else if (flag == "--gnss-fixes") {
-      options.fixes.gnss = value;
-    } else if (flag == "--seed" || flag == "--lines" || flag == "--cross-lines") {
-      if (!parseNumber(flag, value, number) || number < 0 || number != static_cast<double>(static_cast<int64_t>(number))) {
-        std::cerr << "sss-sim: " << flag << " expects a non-negative integer, got '" << value << "'\n";
-        return 2;
-      }
-      if (flag == "--seed") options.seed = static_cast<int64_t>(number);
-      else if (flag == "--lines") options.trajectory.lines = static_cast<int>(number);
-      else options.trajectory.cross_lines = static_cast<int>(number);
-    } else if (numeric.count(flag)) {
-      if (!parseNumber(flag, value, number)) return 2;
-      *numeric.at(flag) = number;
-    } else {
-      std::cerr << "sss-sim: unknown flag " << flag << "\n" << kUsage;
-      return 2;
-    }
-  }
+  const auto apply = [](const auto& flag, auto& target) {
+    if (flag) target = static_cast<std::decay_t<decltype(target)>>(*flag);
+  };
+  if (seed_flag->count() > 0) options.seed = seed;
+  apply(pattern, options.trajectory.pattern);
+  apply(gnss_fixes, options.fixes.gnss);
+  apply(lines, options.trajectory.lines);
+  apply(cross_lines, options.trajectory.cross_lines);
+  apply(line_length_m, options.trajectory.line_length_m);
+  apply(line_spacing_m, options.trajectory.line_spacing_m);
+  apply(range_m, options.sonar.range_m);
+  apply(altitude_m, options.trajectory.altitude_m);
+  apply(ping_rate_hz, options.sonar.ping_rate_hz);
+  apply(drift_scale, options.dead_reckoning.drift_scale);
+  apply(heading_noise_rad, options.dead_reckoning.heading_noise_rad);
+  apply(duration_s, options.duration_s);
+  apply(origin_latitude_deg, options.origin_latitude_deg);
+  apply(origin_longitude_deg, options.origin_longitude_deg);
+  apply(usbl_period_s, options.fixes.usbl_period_s);
   const std::vector<std::string> problems = sss::sim::validateSimOptions(options);
   if (!problems.empty()) {
     for (const std::string& problem : problems) std::cerr << "sss-sim: " << problem << "\n";
@@ -170,13 +139,13 @@ int main(int argc, char** argv) {
               << mission.seabed().rows() << " x " << mission.seabed().cols() << " cells\n";
     sss::sim::MissionReport report;
     std::string error;
-    if (!sss::sim::writeMission(mission, flags["--out"], report, error)) {
+    if (!sss::sim::writeMission(mission, out_dir, report, error)) {
       std::cerr << "sss-sim: " << error << "\n";
       return 1;
     }
     std::printf("sss-sim: wrote %s: %zu pings, %.0f m, DR error final %.2f m (%.3f %% of distance), max %.2f m; "
                 "render %.1f s, total %.1f s\n",
-                flags["--out"].c_str(), report.pings, report.distance_m, report.final_dr_error_m,
+                out_dir.c_str(), report.pings, report.distance_m, report.final_dr_error_m,
                 100.0 * report.final_dr_error_m / std::max(1.0, report.distance_m), report.max_dr_error_m,
                 report.render_wall_s, report.total_wall_s);
   } catch (const std::exception& e) {

@@ -19,6 +19,7 @@
 #include "pipeline/core/mission_origin.hpp"
 #include "pipeline/core/time.hpp"
 #include "pipeline/subframe/pictures.hpp"
+#include "pipeline/transport/command_line.hpp"
 #include "pipeline/subframe/subframe_buffer.hpp"
 #include "pipeline/messages/subframe_messages.hpp"
 #include "pipeline/messages/sensor_messages.hpp"
@@ -35,21 +36,14 @@ int64_t threadCpuUs() {
 
 int main(int argc, char** argv) {
   std::string sonar_path, ins_path, out_dir, config_path;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--sonar" && i + 1 < argc) sonar_path = argv[++i];
-    else if (arg == "--ins" && i + 1 < argc) ins_path = argv[++i];
-    else if (arg == "--out" && i + 1 < argc) out_dir = argv[++i];
-    else if (arg == "--config" && i + 1 < argc) config_path = argv[++i];
-    else {
-      std::fprintf(stderr, "usage: %s --sonar sonar.jsf --ins ins.nmea --out DIR [--config FILE]\n", argv[0]);
-      return arg == "--help" ? 0 : 2;
-    }
-  }
-  if (sonar_path.empty() || ins_path.empty() || out_dir.empty()) {
-    std::fprintf(stderr, "usage: %s --sonar sonar.jsf --ins ins.nmea --out DIR [--config FILE]\n", argv[0]);
-    return 2;
-  }
+  sss::cli::CommandLine command_line("sss-subframe-tool",
+                                     "runs the subframe buffer offline over a .jsf and an iXblue NMEA file, writes "
+                                     "waterfall and mosaic PNGs and prints the figures");
+  command_line.add_option("--sonar", sonar_path, "the JSF file")->required();
+  command_line.add_option("--ins", ins_path, "the iXblue NMEA file")->required();
+  command_line.add_option("--out", out_dir, "output folder")->required();
+  command_line.add_option("--config", config_path, "YAML configuration (subframe_buffer section)");
+  if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
   sss::subframe::SubframeBufferOptions options;
   sss::ins::InsBridgeOptions bridge_options;
   if (!config_path.empty()) {
