@@ -1,7 +1,7 @@
 // sss-eval runs: inputs -> metrics -> table, JSON, figures. See report.hpp.
 #include "tools/eval/report.hpp"
 
-#include "tools/eval/json_writer.hpp"
+#include "tools/eval/json_values.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -62,7 +62,7 @@
 #include "tools/eval/closure_metrics.hpp"
 #include "tools/eval/heightmap_metrics.hpp"
 #include "tools/eval/landmark_consistency.hpp"
-#include "tools/eval/json_writer.hpp"
+#include "tools/eval/json_values.hpp"
 #include "tools/eval/match_metrics.hpp"
 #include "tools/eval/plots.hpp"
 #include "tools/eval/trajectory_io.hpp"
@@ -184,10 +184,10 @@ std::string fileSafeLabel(const std::string& label);
 // Rows of cells as aligned text columns: first column left-aligned, the others right-aligned.
 std::string formatColumns(const std::vector<std::vector<std::string>>& rows);
 // {"count", "rmse", "mean", "median", "max"} under key (NaN as null).
-void writeErrorStatistics(JsonWriter& json, const std::string& key, const ErrorStatistics& stats);
+void writeErrorStatistics(Json& json, const std::string& key, const ErrorStatistics& stats);
 // Stats of |error| + "bias" (mean signed error) under key.
-void writeSignedStatistics(JsonWriter& json, const std::string& key, const SignedErrorStatistics& stats);
+void writeSignedStatistics(Json& json, const std::string& key, const SignedErrorStatistics& stats);
 // {"along_m", "lateral_m", "depth_m", "heading_deg": signed stats, "horizontal_m": stats} under key.
-void writeRelativePoseErrorStatistics(JsonWriter& json, const std::string& key, const RelativePoseErrorStatistics& stats);
+void writeRelativePoseErrorStatistics(Json& json, const std::string& key, const RelativePoseErrorStatistics& stats);
 
 }  // namespace sss::eval

@@ -5,264 +5,235 @@
 #include <cmath>
 #include <string>
 
-#include "tools/eval/json_writer.hpp"
+#include "tools/eval/json_values.hpp"
 
 namespace sss::eval {
 namespace {
 
-void writeRelativePoseError(JsonWriter& json, const std::string& key, bool present, const RelativePoseError& e) {
+void writeRelativePoseError(Json& json, const std::string& key, bool present, const RelativePoseError& e) {
   if (!present) {
-    json.key(key).null();
+    json[key] = nullptr;
     return;
   }
-  json.key(key).beginObject();
-  json.key("along_m").value(e.along_m);
-  json.key("lateral_m").value(e.lateral_m);
-  json.key("depth_m").value(e.depth_m);
-  json.key("heading_deg").value(e.heading_rad * 180.0 / M_PI);
-  json.endObject();
+  Json& error_json = (json[key] = Json::object());
+  error_json["along_m"] = jsonValue(e.along_m);
+  error_json["lateral_m"] = jsonValue(e.lateral_m);
+  error_json["depth_m"] = jsonValue(e.depth_m);
+  error_json["heading_deg"] = jsonValue(e.heading_rad * 180.0 / M_PI);
 }
 
-void writeClosuresJson(JsonWriter& json, const ClosureReport& closures) {
+void writeClosuresJson(Json& json, const ClosureReport& closures) {
   const ClosureEvaluation& ev = closures.evaluation;
-  json.key("closures").beginObject();
-  json.key("path").value(closures.path);
+  Json& closures_json = (json["closures"] = Json::object());
+  closures_json["path"] = jsonValue(closures.path);
   if (closures.dr.path.empty()) {
-    json.key("dr").null();
+    closures_json["dr"] = nullptr;
   } else {
-    json.key("dr").beginObject();
-    json.key("label").value(closures.dr.label);
-    json.key("path").value(closures.dr.path);
-    json.endObject();
+    Json& dr_json = (closures_json["dr"] = Json::object());
+    dr_json["label"] = jsonValue(closures.dr.label);
+    dr_json["path"] = jsonValue(closures.dr.path);
   }
-  json.key("count").value(static_cast<uint64_t>(ev.closures.size()));
-  json.key("without_truth").value(static_cast<uint64_t>(ev.without_truth));
-  json.key("without_dr").value(static_cast<uint64_t>(ev.without_dr));
-  json.key("groups").beginArray();
+  closures_json["count"] = jsonValue(static_cast<uint64_t>(ev.closures.size()));
+  closures_json["without_truth"] = jsonValue(static_cast<uint64_t>(ev.without_truth));
+  closures_json["without_dr"] = jsonValue(static_cast<uint64_t>(ev.without_dr));
+  Json& groups_json = (closures_json["groups"] = Json::array());
   for (const ClosureGroup& g : ev.groups) {
-    json.beginObject();
-    json.key("status").value(g.status);
-    json.key("count").value(static_cast<uint64_t>(g.count));
-    writeRelativePoseErrorStatistics(json, "closure", g.closure);
-    writeRelativePoseErrorStatistics(json, "dr", g.dr);
-    json.key("nees_count").value(static_cast<uint64_t>(g.nees_count));
-    json.key("mean_horizontal_nees");
+    Json& group_json = groups_json.emplace_back(Json::object());
+    group_json["status"] = jsonValue(g.status);
+    group_json["count"] = jsonValue(static_cast<uint64_t>(g.count));
+    writeRelativePoseErrorStatistics(group_json, "closure", g.closure);
+    writeRelativePoseErrorStatistics(group_json, "dr", g.dr);
+    group_json["nees_count"] = jsonValue(static_cast<uint64_t>(g.nees_count));
     if (g.nees_count) {
-      json.value(g.mean_horizontal_nees);
+      group_json["mean_horizontal_nees"] = jsonValue(g.mean_horizontal_nees);
     } else {
-      json.null();
+      group_json["mean_horizontal_nees"] = nullptr;
     }
-    json.endObject();
   }
-  json.endArray();
-  json.key("closures").beginArray();
+  Json& closure_list_json = (closures_json["closures"] = Json::array());
   for (const ClosureError& e : ev.closures) {
     const ClosureRecord& c = e.closure;
-    json.beginObject();
-    json.key("subframe_id_a").value(static_cast<int64_t>(c.subframe_id_a));
-    json.key("subframe_id_b").value(static_cast<int64_t>(c.subframe_id_b));
-    if (c.round < 0) json.key("round").null();
-    else json.key("round").value(c.round);
-    json.key("status").value(c.status);
-    json.key("rejection").value(c.rejection);
-    json.key("utime_a_us").value(static_cast<int64_t>(c.utime_a_us));
-    json.key("utime_b_us").value(static_cast<int64_t>(c.utime_b_us));
+    Json& closure_json = closure_list_json.emplace_back(Json::object());
+    closure_json["subframe_id_a"] = jsonValue(static_cast<int64_t>(c.subframe_id_a));
+    closure_json["subframe_id_b"] = jsonValue(static_cast<int64_t>(c.subframe_id_b));
+    if (c.round < 0) closure_json["round"] = nullptr;
+    else closure_json["round"] = jsonValue(c.round);
+    closure_json["status"] = jsonValue(c.status);
+    closure_json["rejection"] = jsonValue(c.rejection);
+    closure_json["utime_a_us"] = jsonValue(static_cast<int64_t>(c.utime_a_us));
+    closure_json["utime_b_us"] = jsonValue(static_cast<int64_t>(c.utime_b_us));
     if (e.has_truth) {
-      json.key("truth").beginObject();
-      json.key("dx_m").value(e.truth.translation_m.x());
-      json.key("dy_m").value(e.truth.translation_m.y());
-      json.key("dz_m").value(e.truth.translation_m.z());
-      json.key("dheading_deg").value(e.truth.heading_rad * 180.0 / M_PI);
-      json.endObject();
+      Json& truth_json = (closure_json["truth"] = Json::object());
+      truth_json["dx_m"] = jsonValue(e.truth.translation_m.x());
+      truth_json["dy_m"] = jsonValue(e.truth.translation_m.y());
+      truth_json["dz_m"] = jsonValue(e.truth.translation_m.z());
+      truth_json["dheading_deg"] = jsonValue(e.truth.heading_rad * 180.0 / M_PI);
     } else {
-      json.key("truth").null();
+      closure_json["truth"] = nullptr;
     }
-    writeRelativePoseError(json, "error", e.has_truth, e.closure_error);
-    writeRelativePoseError(json, "dr_error", e.has_dr, e.dr_error);
-    json.endObject();
+    writeRelativePoseError(closure_json, "error", e.has_truth, e.closure_error);
+    writeRelativePoseError(closure_json, "dr_error", e.has_dr, e.dr_error);
   }
-  json.endArray();
-  json.endObject();
 }
 
-void writeLceEntry(JsonWriter& json, const LceEntry& entry) {
+void writeLceEntry(Json& json, const LceEntry& entry) {
   writeErrorStatistics(json, "horizontal_m", entry.result.horizontal_m);
-  json.key("skipped").value(static_cast<uint64_t>(entry.result.skipped));
+  json["skipped"] = jsonValue(static_cast<uint64_t>(entry.result.skipped));
 }
 
-void writeLceJson(JsonWriter& json, const LceReport& lce, const TrueCorrespondenceOptions& options) {
-  json.key("lce").beginObject();
-  json.key("seabed_depth_m").value(lce.seabed_depth_m);
-  json.key("seabed_depth_source").value(lce.seabed_depth_source);
-  json.key("grid_m").value(options.grid_m);
-  json.key("min_ground_range_m").value(options.min_ground_range_m);
-  json.key("max_ground_range_m").value(options.max_ground_range_m);
-  json.key("max_correspondences").value(static_cast<uint64_t>(options.max_correspondences));
-  json.key("sightings").value(static_cast<uint64_t>(lce.correspondences.sightings));
-  json.key("seabed_points").value(static_cast<uint64_t>(lce.correspondences.seabed_points));
-  json.key("candidate_pairs").value(static_cast<uint64_t>(lce.correspondences.candidate_pairs));
-  json.key("correspondences").value(static_cast<uint64_t>(lce.correspondences.pairs.size()));
-  json.key("truth").beginObject();
-  writeLceEntry(json, lce.truth);
-  json.endObject();
-  json.key("estimates").beginArray();
+void writeLceJson(Json& json, const LceReport& lce, const TrueCorrespondenceOptions& options) {
+  Json& lce_json = (json["lce"] = Json::object());
+  lce_json["seabed_depth_m"] = jsonValue(lce.seabed_depth_m);
+  lce_json["seabed_depth_source"] = jsonValue(lce.seabed_depth_source);
+  lce_json["grid_m"] = jsonValue(options.grid_m);
+  lce_json["min_ground_range_m"] = jsonValue(options.min_ground_range_m);
+  lce_json["max_ground_range_m"] = jsonValue(options.max_ground_range_m);
+  lce_json["max_correspondences"] = jsonValue(static_cast<uint64_t>(options.max_correspondences));
+  lce_json["sightings"] = jsonValue(static_cast<uint64_t>(lce.correspondences.sightings));
+  lce_json["seabed_points"] = jsonValue(static_cast<uint64_t>(lce.correspondences.seabed_points));
+  lce_json["candidate_pairs"] = jsonValue(static_cast<uint64_t>(lce.correspondences.candidate_pairs));
+  lce_json["correspondences"] = jsonValue(static_cast<uint64_t>(lce.correspondences.pairs.size()));
+  Json& truth_json = (lce_json["truth"] = Json::object());
+  writeLceEntry(truth_json, lce.truth);
+  Json& estimates_json = (lce_json["estimates"] = Json::array());
   for (const LceEntry& e : lce.estimates) {
-    json.beginObject();
-    json.key("label").value(e.label);
-    writeLceEntry(json, e);
-    json.endObject();
+    Json& estimate_json = estimates_json.emplace_back(Json::object());
+    estimate_json["label"] = jsonValue(e.label);
+    writeLceEntry(estimate_json, e);
   }
-  json.endArray();
-  json.endObject();
 }
 
 
-void writeMatchTotals(JsonWriter& json, const MatchEvaluation& e) {
-  json.key("matches").value(static_cast<int64_t>(e.matches));
-  json.key("evaluated").value(static_cast<int64_t>(e.evaluated));
-  json.key("within_2px").value(e.evaluated ? e.withinFraction() : std::numeric_limits<double>::quiet_NaN());
-  json.key("recall_2px").value(e.matchable ? e.recall() : std::numeric_limits<double>::quiet_NaN());
-  json.key("mean_error_px").value(e.evaluated ? e.meanErrorPx() : std::numeric_limits<double>::quiet_NaN());
-  json.key("mean_error_m").value(e.evaluated ? e.meanErrorM() : std::numeric_limits<double>::quiet_NaN());
-  json.key("probes").value(static_cast<int64_t>(e.probes));
-  json.key("matchable").value(static_cast<int64_t>(e.matchable));
+void writeMatchTotals(Json& json, const MatchEvaluation& e) {
+  json["matches"] = jsonValue(static_cast<int64_t>(e.matches));
+  json["evaluated"] = jsonValue(static_cast<int64_t>(e.evaluated));
+  json["within_2px"] = jsonValue(e.evaluated ? e.withinFraction() : std::numeric_limits<double>::quiet_NaN());
+  json["recall_2px"] = jsonValue(e.matchable ? e.recall() : std::numeric_limits<double>::quiet_NaN());
+  json["mean_error_px"] = jsonValue(e.evaluated ? e.meanErrorPx() : std::numeric_limits<double>::quiet_NaN());
+  json["mean_error_m"] = jsonValue(e.evaluated ? e.meanErrorM() : std::numeric_limits<double>::quiet_NaN());
+  json["probes"] = jsonValue(static_cast<int64_t>(e.probes));
+  json["matchable"] = jsonValue(static_cast<int64_t>(e.matchable));
 }
 
-void writeMatchesJson(JsonWriter& json, const MatchFileEvaluation& m) {
-  json.key("matches").beginObject();
-  json.key("path").value(m.path);
-  json.key("mission").value(m.mission_dir);
-  json.key("decimation").value(m.decimation);
-  json.key("stride").value(m.stride);
-  json.key("probe_step").value(m.probe_step);
-  json.key("matching_pixel_m").value(m.matching_pixel_m);
-  json.key("subframes").value(static_cast<uint64_t>(m.subframes));
-  json.key("overall").beginObject();
-  json.key("pairs").value(static_cast<uint64_t>(m.pairs.size()));
-  writeMatchTotals(json, m.overall);
-  json.endObject();
+void writeMatchesJson(Json& json, const MatchFileEvaluation& m) {
+  Json& matches_json = (json["matches"] = Json::object());
+  matches_json["path"] = jsonValue(m.path);
+  matches_json["mission"] = jsonValue(m.mission_dir);
+  matches_json["decimation"] = jsonValue(m.decimation);
+  matches_json["stride"] = jsonValue(m.stride);
+  matches_json["probe_step"] = jsonValue(m.probe_step);
+  matches_json["matching_pixel_m"] = jsonValue(m.matching_pixel_m);
+  matches_json["subframes"] = jsonValue(static_cast<uint64_t>(m.subframes));
+  Json& overall_json = (matches_json["overall"] = Json::object());
+  overall_json["pairs"] = jsonValue(static_cast<uint64_t>(m.pairs.size()));
+  writeMatchTotals(overall_json, m.overall);
   for (int t = 0; t < kPairTypes; ++t) {
-    json.key(pairTypeName(static_cast<PairType>(t))).beginObject();
-    json.key("pairs").value(static_cast<int64_t>(m.pairs_by_type[t]));
-    writeMatchTotals(json, m.by_type[t]);
-    json.endObject();
+    Json& pair_type_json = (matches_json[pairTypeName(static_cast<PairType>(t))] = Json::object());
+    pair_type_json["pairs"] = jsonValue(static_cast<int64_t>(m.pairs_by_type[t]));
+    writeMatchTotals(pair_type_json, m.by_type[t]);
   }
-  json.key("pairs").beginArray();
+  Json& pairs_json = (matches_json["pairs"] = Json::array());
   for (const PairMatchReport& p : m.pairs) {
-    json.beginObject();
-    json.key("subframe_id_a").value(p.subframe_a);
-    json.key("subframe_id_b").value(p.subframe_b);
-    json.key("round").value(p.round);
-    json.key("type").value(pairTypeName(p.type));
-    json.key("heading_difference_deg")
-        .value(std::abs(sss::core::wrapAngle(p.heading_b_rad - p.heading_a_rad)) * 180.0 / 3.14159265358979323846);
-    writeMatchTotals(json, p.evaluation);
-    json.endObject();
+    Json& pair_json = pairs_json.emplace_back(Json::object());
+    pair_json["subframe_id_a"] = jsonValue(p.subframe_a);
+    pair_json["subframe_id_b"] = jsonValue(p.subframe_b);
+    pair_json["round"] = jsonValue(p.round);
+    pair_json["type"] = jsonValue(pairTypeName(p.type));
+    pair_json["heading_difference_deg"] =
+        jsonValue(std::abs(sss::core::wrapAngle(p.heading_b_rad - p.heading_a_rad)) * 180.0 / 3.14159265358979323846);
+    writeMatchTotals(pair_json, p.evaluation);
   }
-  json.endArray();
-  json.endObject();
 }
 
 
 }  // namespace
 
 std::string reportJson(const EvalReport& report) {
-  JsonWriter json;
-  json.beginObject();
-  json.key("schema").value("sss-eval/1");
+  Json json = Json::object();
+  json["schema"] = jsonValue("sss-eval/1");
 
-  json.key("truth").beginObject();
-  json.key("path").value(report.truth_path);
-  json.key("poses").value(static_cast<uint64_t>(report.truth.size()));
+  Json& truth_json = (json["truth"] = Json::object());
+  truth_json["path"] = jsonValue(report.truth_path);
+  truth_json["poses"] = jsonValue(static_cast<uint64_t>(report.truth.size()));
   if (report.truth.empty()) {
-    json.key("start_utime_us").null();
-    json.key("duration_s").null();
+    truth_json["start_utime_us"] = nullptr;
+    truth_json["duration_s"] = nullptr;
   } else {
-    json.key("start_utime_us").value(static_cast<int64_t>(report.truth.front().utime_us));
-    json.key("duration_s").value(static_cast<double>(report.truth.back().utime_us - report.truth.front().utime_us) * 1e-6);
+    truth_json["start_utime_us"] = jsonValue(static_cast<int64_t>(report.truth.front().utime_us));
+    truth_json["duration_s"] = jsonValue(static_cast<double>(report.truth.back().utime_us - report.truth.front().utime_us) * 1e-6);
   }
-  json.key("distance_m").value(report.truth_distance_m);
-  json.key("lines").beginArray();
+  truth_json["distance_m"] = jsonValue(report.truth_distance_m);
+  Json& lines_json = (truth_json["lines"] = Json::array());
   for (const SurveyLine& line : report.lines) {
-    json.beginObject();
-    json.key("index").value(line.index);
-    json.key("start_utime_us").value(static_cast<int64_t>(line.start_utime_us));
-    json.key("end_utime_us").value(static_cast<int64_t>(line.end_utime_us));
-    json.key("length_m").value(line.length_m);
-    json.key("heading_deg").value(line.heading_deg);
-    json.endObject();
+    Json& line_json = lines_json.emplace_back(Json::object());
+    line_json["index"] = jsonValue(line.index);
+    line_json["start_utime_us"] = jsonValue(static_cast<int64_t>(line.start_utime_us));
+    line_json["end_utime_us"] = jsonValue(static_cast<int64_t>(line.end_utime_us));
+    line_json["length_m"] = jsonValue(line.length_m);
+    line_json["heading_deg"] = jsonValue(line.heading_deg);
   }
-  json.endArray();
-  json.endObject();
 
   const TrajectoryEvaluationOptions& o = report.options.trajectory;
-  json.key("options").beginObject();
-  json.key("interpolate_truth").value(o.association.interpolate_truth);
-  json.key("max_interpolation_gap_s").value(o.association.max_interpolation_gap_s);
-  json.key("max_time_difference_s").value(o.association.max_time_difference_s);
-  json.key("rpe_windows_m").numbers(o.rpe.windows_m, 10);
-  json.key("line_course_window_m").value(o.lines.course_window_m);
-  json.key("line_max_turn_rate_deg_per_m").value(o.lines.max_turn_rate_deg_per_m);
-  json.key("line_max_heading_change_deg").value(o.lines.max_heading_change_deg);
-  json.key("line_min_length_m").value(o.lines.min_line_length_m);
-  json.endObject();
+  Json& options_json = (json["options"] = Json::object());
+  options_json["interpolate_truth"] = jsonValue(o.association.interpolate_truth);
+  options_json["max_interpolation_gap_s"] = jsonValue(o.association.max_interpolation_gap_s);
+  options_json["max_time_difference_s"] = jsonValue(o.association.max_time_difference_s);
+  options_json["rpe_windows_m"] = jsonNumbers(o.rpe.windows_m, 10);
+  options_json["line_course_window_m"] = jsonValue(o.lines.course_window_m);
+  options_json["line_max_turn_rate_deg_per_m"] = jsonValue(o.lines.max_turn_rate_deg_per_m);
+  options_json["line_max_heading_change_deg"] = jsonValue(o.lines.max_heading_change_deg);
+  options_json["line_min_length_m"] = jsonValue(o.lines.min_line_length_m);
 
-  json.key("estimates").beginArray();
+  Json& estimates_json = (json["estimates"] = Json::array());
   for (const EstimateReport& e : report.estimates) {
     const TrajectoryEvaluation& ev = e.evaluation;
-    json.beginObject();
-    json.key("label").value(e.input.label);
-    json.key("path").value(e.input.path);
-    json.key("poses").value(static_cast<uint64_t>(ev.estimate_poses));
-    json.key("matched").value(static_cast<uint64_t>(ev.association.pairs.size()));
-    json.key("exact").value(static_cast<uint64_t>(ev.association.exact));
-    json.key("interpolated").value(static_cast<uint64_t>(ev.association.interpolated));
-    json.key("nearest").value(static_cast<uint64_t>(ev.association.nearest));
-    json.key("unmatched").value(static_cast<uint64_t>(ev.association.unmatched));
+    Json& estimate_json = estimates_json.emplace_back(Json::object());
+    estimate_json["label"] = jsonValue(e.input.label);
+    estimate_json["path"] = jsonValue(e.input.path);
+    estimate_json["poses"] = jsonValue(static_cast<uint64_t>(ev.estimate_poses));
+    estimate_json["matched"] = jsonValue(static_cast<uint64_t>(ev.association.pairs.size()));
+    estimate_json["exact"] = jsonValue(static_cast<uint64_t>(ev.association.exact));
+    estimate_json["interpolated"] = jsonValue(static_cast<uint64_t>(ev.association.interpolated));
+    estimate_json["nearest"] = jsonValue(static_cast<uint64_t>(ev.association.nearest));
+    estimate_json["unmatched"] = jsonValue(static_cast<uint64_t>(ev.association.unmatched));
 
-    json.key("ate").beginObject();
-    writeErrorStatistics(json, "position_m", ev.ate.position_m);
-    writeErrorStatistics(json, "horizontal_m", ev.ate.horizontal_m);
-    writeErrorStatistics(json, "vertical_m", ev.ate.vertical_m);
-    writeErrorStatistics(json, "rotation_deg", ev.ate.rotation_deg);
-    writeErrorStatistics(json, "aligned_position_m", ev.ate.aligned_position_m);
-    writeErrorStatistics(json, "aligned_horizontal_m", ev.ate.aligned_horizontal_m);
-    json.key("alignment").beginObject();
+    Json& ate_json = (estimate_json["ate"] = Json::object());
+    writeErrorStatistics(ate_json, "position_m", ev.ate.position_m);
+    writeErrorStatistics(ate_json, "horizontal_m", ev.ate.horizontal_m);
+    writeErrorStatistics(ate_json, "vertical_m", ev.ate.vertical_m);
+    writeErrorStatistics(ate_json, "rotation_deg", ev.ate.rotation_deg);
+    writeErrorStatistics(ate_json, "aligned_position_m", ev.ate.aligned_position_m);
+    writeErrorStatistics(ate_json, "aligned_horizontal_m", ev.ate.aligned_horizontal_m);
+    Json& alignment_json = (ate_json["alignment"] = Json::object());
     const Eigen::Vector3d& t = ev.ate.T_truth_estimate.translation;
     const Eigen::Quaterniond& q = ev.ate.T_truth_estimate.rotation;
-    json.key("translation_m").numbers({t.x(), t.y(), t.z()}, 10);
-    json.key("quaternion_xyzw").numbers({q.x(), q.y(), q.z(), q.w()}, 10);
-    json.key("rotation_deg").value(ev.ate.alignment_rotation_deg);
-    json.key("heading_deg").value(ev.ate.alignment_heading_deg);
-    json.endObject();
-    writeErrorStatistics(json, "gauge_free_horizontal_m", ev.ate.gauge_free_horizontal_m);
-    writeErrorStatistics(json, "gauge_horizontal_m", ev.ate.gauge_horizontal_m);
-    json.key("gauge_free_scale").value(ev.ate.gauge_free_scale);
-    json.key("gauge_free_rotation_deg").value(ev.ate.gauge_free_rotation_deg);
-    json.endObject();
+    alignment_json["translation_m"] = jsonNumbers({t.x(), t.y(), t.z()}, 10);
+    alignment_json["quaternion_xyzw"] = jsonNumbers({q.x(), q.y(), q.z(), q.w()}, 10);
+    alignment_json["rotation_deg"] = jsonValue(ev.ate.alignment_rotation_deg);
+    alignment_json["heading_deg"] = jsonValue(ev.ate.alignment_heading_deg);
+    writeErrorStatistics(ate_json, "gauge_free_horizontal_m", ev.ate.gauge_free_horizontal_m);
+    writeErrorStatistics(ate_json, "gauge_horizontal_m", ev.ate.gauge_horizontal_m);
+    ate_json["gauge_free_scale"] = jsonValue(ev.ate.gauge_free_scale);
+    ate_json["gauge_free_rotation_deg"] = jsonValue(ev.ate.gauge_free_rotation_deg);
 
-    json.key("rpe").beginArray();
+    Json& rpe_json = (estimate_json["rpe"] = Json::array());
     for (const RpeResult& rpe : ev.rpe) {
-      json.beginObject();
-      json.key("window_m").value(rpe.window_m);
-      writeErrorStatistics(json, "translation_percent", rpe.translation_percent);
-      writeErrorStatistics(json, "translation_m", rpe.translation_m);
-      writeErrorStatistics(json, "rotation_deg", rpe.rotation_deg);
-      json.endObject();
+      Json& rpe_window_json = rpe_json.emplace_back(Json::object());
+      rpe_window_json["window_m"] = jsonValue(rpe.window_m);
+      writeErrorStatistics(rpe_window_json, "translation_percent", rpe.translation_percent);
+      writeErrorStatistics(rpe_window_json, "translation_m", rpe.translation_m);
+      writeErrorStatistics(rpe_window_json, "rotation_deg", rpe.rotation_deg);
     }
-    json.endArray();
 
-    json.key("lines").beginArray();
+    Json& estimate_lines_json = (estimate_json["lines"] = Json::array());
     for (const LineError& line : ev.lines) {
-      json.beginObject();
-      json.key("index").value(line.line);
-      writeErrorStatistics(json, "horizontal_m", line.horizontal_m);
-      writeErrorStatistics(json, "position_m", line.position_m);
-      writeErrorStatistics(json, "aligned_horizontal_m", line.aligned_horizontal_m);
-      json.endObject();
+      Json& line_json = estimate_lines_json.emplace_back(Json::object());
+      line_json["index"] = jsonValue(line.line);
+      writeErrorStatistics(line_json, "horizontal_m", line.horizontal_m);
+      writeErrorStatistics(line_json, "position_m", line.position_m);
+      writeErrorStatistics(line_json, "aligned_horizontal_m", line.aligned_horizontal_m);
     }
-    json.endArray();
-    json.key("improvement_vs_first_percent").value(e.improvement_vs_first_percent);
+    estimate_json["improvement_vs_first_percent"] = jsonValue(e.improvement_vs_first_percent);
 
     std::vector<double> time, distance, position, horizontal, aligned, gauge_free, along, across, line;
     const int64_t t0 = report.truth.front().utime_us;
@@ -277,90 +248,79 @@ std::string reportJson(const EvalReport& report) {
       across.push_back(s.across_track_m);
       line.push_back(s.line);
     }
-    json.key("series").beginObject();
-    json.key("time_s").numbers(time, 10);
-    json.key("distance_m").numbers(distance, 7);
-    json.key("position_m").numbers(position, 5);
-    json.key("horizontal_m").numbers(horizontal, 5);
-    json.key("aligned_horizontal_m").numbers(aligned, 5);
-    json.key("gauge_free_horizontal_m").numbers(gauge_free, 5);
-    json.key("along_track_m").numbers(along, 5);
-    json.key("across_track_m").numbers(across, 5);
-    json.key("line").numbers(line, 5);
-    json.endObject();
-    json.endObject();
+    Json& series_json = (estimate_json["series"] = Json::object());
+    series_json["time_s"] = jsonNumbers(time, 10);
+    series_json["distance_m"] = jsonNumbers(distance, 7);
+    series_json["position_m"] = jsonNumbers(position, 5);
+    series_json["horizontal_m"] = jsonNumbers(horizontal, 5);
+    series_json["aligned_horizontal_m"] = jsonNumbers(aligned, 5);
+    series_json["gauge_free_horizontal_m"] = jsonNumbers(gauge_free, 5);
+    series_json["along_track_m"] = jsonNumbers(along, 5);
+    series_json["across_track_m"] = jsonNumbers(across, 5);
+    series_json["line"] = jsonNumbers(line, 5);
   }
-  json.endArray();
 
-  json.key("heightmaps").beginArray();
+  Json& heightmaps_json = (json["heightmaps"] = Json::array());
   for (const HeightmapReport& h : report.heightmaps) {
     const HeightmapErrorResult& r = h.result;
-    json.beginObject();
-    json.key("label").value(h.input.label);
-    json.key("path").value(h.input.path);
-    json.key("estimate_cells").value(static_cast<uint64_t>(r.estimate_cells));
-    json.key("cells_with_data").value(static_cast<uint64_t>(r.cells_with_data));
-    json.key("compared_cells").value(static_cast<uint64_t>(r.compared_cells));
-    json.key("coverage_fraction").value(r.coverage_fraction);
-    json.key("covered_area_m2").value(r.covered_area_m2);
-    writeErrorStatistics(json, "abs_error_m", r.abs_error_m);
-    json.key("mean_signed_error_m").value(r.mean_signed_error_m);
-    if (h.error_map_yaml.empty()) json.key("error_map_yaml").null();
-    else json.key("error_map_yaml").value(h.error_map_yaml);
-    if (h.error_map_png.empty()) json.key("error_map_png").null();
-    else json.key("error_map_png").value(h.error_map_png);
-    json.endObject();
+    Json& heightmaps_entry = heightmaps_json.emplace_back(Json::object());
+    heightmaps_entry["label"] = jsonValue(h.input.label);
+    heightmaps_entry["path"] = jsonValue(h.input.path);
+    heightmaps_entry["estimate_cells"] = jsonValue(static_cast<uint64_t>(r.estimate_cells));
+    heightmaps_entry["cells_with_data"] = jsonValue(static_cast<uint64_t>(r.cells_with_data));
+    heightmaps_entry["compared_cells"] = jsonValue(static_cast<uint64_t>(r.compared_cells));
+    heightmaps_entry["coverage_fraction"] = jsonValue(r.coverage_fraction);
+    heightmaps_entry["covered_area_m2"] = jsonValue(r.covered_area_m2);
+    writeErrorStatistics(heightmaps_entry, "abs_error_m", r.abs_error_m);
+    heightmaps_entry["mean_signed_error_m"] = jsonValue(r.mean_signed_error_m);
+    if (h.error_map_yaml.empty()) heightmaps_entry["error_map_yaml"] = nullptr;
+    else heightmaps_entry["error_map_yaml"] = jsonValue(h.error_map_yaml);
+    if (h.error_map_png.empty()) heightmaps_entry["error_map_png"] = nullptr;
+    else heightmaps_entry["error_map_png"] = jsonValue(h.error_map_png);
   }
-  json.endArray();
 
   if (report.has_closures) writeClosuresJson(json, report.closures);
-  else json.key("closures").null();
+  else json["closures"] = nullptr;
   if (report.has_lce) writeLceJson(json, report.lce, report.options.lce);
-  else json.key("lce").null();
-  if (report.lce_skipped.empty()) json.key("lce_skipped").null();
-  else json.key("lce_skipped").value(report.lce_skipped);
+  else json["lce"] = nullptr;
+  if (report.lce_skipped.empty()) json["lce_skipped"] = nullptr;
+  else json["lce_skipped"] = jsonValue(report.lce_skipped);
   if (report.has_matches) writeMatchesJson(json, report.matches);
-  else json.key("matches").null();
+  else json["matches"] = nullptr;
 
-  json.key("outputs").beginObject();
-  json.key("json").value(report.json_path);
-  json.key("plots").beginArray();
-  for (const std::string& plot : report.plots) json.value(plot);
-  json.endArray();
-  json.endObject();
-  json.endObject();
-  return json.str();
+  Json& outputs_json = (json["outputs"] = Json::object());
+  outputs_json["json"] = jsonValue(report.json_path);
+  Json& plots_json = (outputs_json["plots"] = Json::array());
+  for (const std::string& plot : report.plots) plots_json.push_back(jsonValue(plot));
+  return json.dump(2);
 }
 
-void writeErrorStatistics(JsonWriter& json, const std::string& key, const ErrorStatistics& stats) {
-  json.key(key).beginObject();
-  json.key("count").value(static_cast<uint64_t>(stats.count));
-  json.key("rmse").value(stats.rmse);
-  json.key("mean").value(stats.mean);
-  json.key("median").value(stats.median);
-  json.key("max").value(stats.max);
-  json.endObject();
+void writeErrorStatistics(Json& json, const std::string& key, const ErrorStatistics& stats) {
+  Json& stats_json = (json[key] = Json::object());
+  stats_json["count"] = jsonValue(static_cast<uint64_t>(stats.count));
+  stats_json["rmse"] = jsonValue(stats.rmse);
+  stats_json["mean"] = jsonValue(stats.mean);
+  stats_json["median"] = jsonValue(stats.median);
+  stats_json["max"] = jsonValue(stats.max);
 }
 
-void writeSignedStatistics(JsonWriter& json, const std::string& key, const SignedErrorStatistics& stats) {
-  json.key(key).beginObject();
-  json.key("count").value(static_cast<uint64_t>(stats.abs.count));
-  json.key("rmse").value(stats.abs.rmse);
-  json.key("mean").value(stats.abs.mean);
-  json.key("median").value(stats.abs.median);
-  json.key("max").value(stats.abs.max);
-  json.key("bias").value(stats.bias);
-  json.endObject();
+void writeSignedStatistics(Json& json, const std::string& key, const SignedErrorStatistics& stats) {
+  Json& stats_json = (json[key] = Json::object());
+  stats_json["count"] = jsonValue(static_cast<uint64_t>(stats.abs.count));
+  stats_json["rmse"] = jsonValue(stats.abs.rmse);
+  stats_json["mean"] = jsonValue(stats.abs.mean);
+  stats_json["median"] = jsonValue(stats.abs.median);
+  stats_json["max"] = jsonValue(stats.abs.max);
+  stats_json["bias"] = jsonValue(stats.bias);
 }
 
-void writeRelativePoseErrorStatistics(JsonWriter& json, const std::string& key, const RelativePoseErrorStatistics& s) {
-  json.key(key).beginObject();
-  writeSignedStatistics(json, "along_m", s.along_m);
-  writeSignedStatistics(json, "lateral_m", s.lateral_m);
-  writeSignedStatistics(json, "depth_m", s.depth_m);
-  writeSignedStatistics(json, "heading_deg", s.heading_deg);
-  writeErrorStatistics(json, "horizontal_m", s.horizontal_m);
-  json.endObject();
+void writeRelativePoseErrorStatistics(Json& json, const std::string& key, const RelativePoseErrorStatistics& s) {
+  Json& stats_json = (json[key] = Json::object());
+  writeSignedStatistics(stats_json, "along_m", s.along_m);
+  writeSignedStatistics(stats_json, "lateral_m", s.lateral_m);
+  writeSignedStatistics(stats_json, "depth_m", s.depth_m);
+  writeSignedStatistics(stats_json, "heading_deg", s.heading_deg);
+  writeErrorStatistics(stats_json, "horizontal_m", s.horizontal_m);
 }
 
 }  // namespace sss::eval

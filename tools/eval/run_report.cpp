@@ -410,152 +410,135 @@ std::string formatRunTable(const RunReport& report) {
 }
 
 std::string runReportJson(const RunReport& report, const RunReportRequest& request) {
-  JsonWriter json;
-  json.beginObject();
-  json.key("schema").value("sss-report/1");
-  json.key("title").value(report.title);
-  json.key("mission_dir").value(request.mission_dir);
-  json.key("run_dir").value(request.run_dir);
-  json.key("out_dir").value(request.out_dir);
-  json.key("verdict").value(report.verdict);
-  json.key("outcome").value(report.outcome);
+  Json json = Json::object();
+  json["schema"] = jsonValue("sss-report/1");
+  json["title"] = jsonValue(report.title);
+  json["mission_dir"] = jsonValue(request.mission_dir);
+  json["run_dir"] = jsonValue(request.run_dir);
+  json["out_dir"] = jsonValue(request.out_dir);
+  json["verdict"] = jsonValue(report.verdict);
+  json["outcome"] = jsonValue(report.outcome);
 
-  json.key("trajectory").beginObject();
-  json.key("truth_path").value(report.truth_path);
-  json.key("truth_poses").value(static_cast<uint64_t>(report.truth_poses));
-  json.key("duration_s").value(report.duration_s);
-  json.key("distance_m").value(report.distance_m);
-  json.key("lines").beginArray();
+  Json& trajectory_json = (json["trajectory"] = Json::object());
+  trajectory_json["truth_path"] = jsonValue(report.truth_path);
+  trajectory_json["truth_poses"] = jsonValue(static_cast<uint64_t>(report.truth_poses));
+  trajectory_json["duration_s"] = jsonValue(report.duration_s);
+  trajectory_json["distance_m"] = jsonValue(report.distance_m);
+  Json& lines_json = (trajectory_json["lines"] = Json::array());
   for (const SurveyLine& line : report.lines) {
-    json.beginObject();
-    json.key("index").value(line.index);
-    json.key("length_m").value(line.length_m);
-    json.key("heading_deg").value(line.heading_deg);
-    json.endObject();
+    Json& line_json = lines_json.emplace_back(Json::object());
+    line_json["index"] = jsonValue(line.index);
+    line_json["length_m"] = jsonValue(line.length_m);
+    line_json["heading_deg"] = jsonValue(line.heading_deg);
   }
-  json.endArray();
-  json.key("rpe_window_m").value(report.rpe_window_m);
+  trajectory_json["rpe_window_m"] = jsonValue(report.rpe_window_m);
   for (const auto& [key, path, evaluation] :
        {std::tuple{"dr", report.dr_path, &report.dr}, std::tuple{"slam", report.slam_path, &report.slam}}) {
-    json.key(key).beginObject();
-    json.key("path").value(path);
-    json.key("poses").value(static_cast<uint64_t>(evaluation->estimate_poses));
-    json.key("matched").value(static_cast<uint64_t>(evaluation->association.pairs.size()));
-    writeErrorStatistics(json, "ate_horizontal_m", evaluation->ate.horizontal_m);
-    writeErrorStatistics(json, "ate_aligned_horizontal_m", evaluation->ate.aligned_horizontal_m);
-    writeErrorStatistics(json, "ate_gauge_free_horizontal_m", evaluation->ate.gauge_free_horizontal_m);
-    json.key("gauge_free_scale").value(evaluation->ate.gauge_free_scale);
-    json.key("gauge_free_rotation_deg").value(evaluation->ate.gauge_free_rotation_deg);
-    writeErrorStatistics(json, "ate_position_m", evaluation->ate.position_m);
+    Json& estimate_json = (trajectory_json[key] = Json::object());
+    estimate_json["path"] = jsonValue(path);
+    estimate_json["poses"] = jsonValue(static_cast<uint64_t>(evaluation->estimate_poses));
+    estimate_json["matched"] = jsonValue(static_cast<uint64_t>(evaluation->association.pairs.size()));
+    writeErrorStatistics(estimate_json, "ate_horizontal_m", evaluation->ate.horizontal_m);
+    writeErrorStatistics(estimate_json, "ate_aligned_horizontal_m", evaluation->ate.aligned_horizontal_m);
+    writeErrorStatistics(estimate_json, "ate_gauge_free_horizontal_m", evaluation->ate.gauge_free_horizontal_m);
+    estimate_json["gauge_free_scale"] = jsonValue(evaluation->ate.gauge_free_scale);
+    estimate_json["gauge_free_rotation_deg"] = jsonValue(evaluation->ate.gauge_free_rotation_deg);
+    writeErrorStatistics(estimate_json, "ate_position_m", evaluation->ate.position_m);
     const bool has_rpe = report.rpe_index < evaluation->rpe.size();
-    json.key("rpe_translation_percent").value(has_rpe ? evaluation->rpe[report.rpe_index].translation_percent.mean : kNaN);
-    json.key("rpe_rotation_deg").value(has_rpe ? evaluation->rpe[report.rpe_index].rotation_deg.mean : kNaN);
-    json.key("lines").beginArray();
+    estimate_json["rpe_translation_percent"] = jsonValue(has_rpe ? evaluation->rpe[report.rpe_index].translation_percent.mean : kNaN);
+    estimate_json["rpe_rotation_deg"] = jsonValue(has_rpe ? evaluation->rpe[report.rpe_index].rotation_deg.mean : kNaN);
+    Json& estimate_lines_json = (estimate_json["lines"] = Json::array());
     for (const LineError& line : evaluation->lines) {
-      json.beginObject();
-      json.key("index").value(line.line);
-      json.key("horizontal_rmse_m").value(line.horizontal_m.rmse);
-      json.endObject();
+      Json& line_json = estimate_lines_json.emplace_back(Json::object());
+      line_json["index"] = jsonValue(line.line);
+      line_json["horizontal_rmse_m"] = jsonValue(line.horizontal_m.rmse);
     }
-    json.endArray();
-    json.endObject();
   }
-  json.key("ate_horizontal_rmse_improvement_percent").value(report.ate_improvement_percent);
-  json.key("ate_aligned_horizontal_rmse_improvement_percent").value(report.aligned_ate_improvement_percent);
-  json.key("ate_gauge_free_horizontal_rmse_improvement_percent").value(report.gauge_free_ate_improvement_percent);
-  json.endObject();
+  trajectory_json["ate_horizontal_rmse_improvement_percent"] = jsonValue(report.ate_improvement_percent);
+  trajectory_json["ate_aligned_horizontal_rmse_improvement_percent"] = jsonValue(report.aligned_ate_improvement_percent);
+  trajectory_json["ate_gauge_free_horizontal_rmse_improvement_percent"] = jsonValue(report.gauge_free_ate_improvement_percent);
 
   if (report.heightmap_dr.present || report.heightmap_slam.present) {
-    json.key("heightmap").beginObject();
-    json.key("seabed_path").value(report.seabed_path);
+    Json& heightmap_json = (json["heightmap"] = Json::object());
+    heightmap_json["seabed_path"] = jsonValue(report.seabed_path);
     for (const auto& [key, entry] : {std::pair{"dr", &report.heightmap_dr}, std::pair{"slam", &report.heightmap_slam}}) {
       if (!entry->present) {
-        json.key(key).null();
+        heightmap_json[key] = nullptr;
         continue;
       }
       const HeightmapErrorResult& r = entry->error;
-      json.key(key).beginObject();
-      json.key("path").value(entry->path);
-      json.key("mae_m").value(r.abs_error_m.mean);
-      json.key("rmse_m").value(r.abs_error_m.rmse);
-      json.key("median_m").value(r.abs_error_m.median);
-      json.key("max_m").value(r.abs_error_m.max);
-      json.key("bias_m").value(r.mean_signed_error_m);
-      json.key("coverage_fraction").value(r.coverage_fraction);
-      json.key("compared_cells").value(static_cast<uint64_t>(r.compared_cells));
-      json.endObject();
+      Json& heightmap_entry_json = (heightmap_json[key] = Json::object());
+      heightmap_entry_json["path"] = jsonValue(entry->path);
+      heightmap_entry_json["mae_m"] = jsonValue(r.abs_error_m.mean);
+      heightmap_entry_json["rmse_m"] = jsonValue(r.abs_error_m.rmse);
+      heightmap_entry_json["median_m"] = jsonValue(r.abs_error_m.median);
+      heightmap_entry_json["max_m"] = jsonValue(r.abs_error_m.max);
+      heightmap_entry_json["bias_m"] = jsonValue(r.mean_signed_error_m);
+      heightmap_entry_json["coverage_fraction"] = jsonValue(r.coverage_fraction);
+      heightmap_entry_json["compared_cells"] = jsonValue(static_cast<uint64_t>(r.compared_cells));
     }
-    json.key("mae_improvement_percent").value(report.heightmap_improvement_percent);
-    json.endObject();
+    heightmap_json["mae_improvement_percent"] = jsonValue(report.heightmap_improvement_percent);
   } else {
-    json.key("heightmap").null();
+    json["heightmap"] = nullptr;
   }
 
   if (report.has_closures) {
     const LoopClosureCounts& c = report.closure_counts;
-    json.key("closures").beginObject();
-    json.key("path").value(report.closures_path);
-    json.key("accepted").value(static_cast<uint64_t>(c.accepted));
-    json.key("rejected").value(static_cast<uint64_t>(c.rejected));
-    json.key("pending").value(static_cast<uint64_t>(c.pending));
-    json.key("superseded").value(static_cast<uint64_t>(c.superseded));
-    json.key("total").value(static_cast<uint64_t>(c.total()));
-    json.key("rejection_reasons").beginObject();
-    for (const auto& [reason, n] : c.rejection_reasons) json.key(reason).value(static_cast<uint64_t>(n));
-    json.endObject();
-    json.endObject();
+    Json& closures_json = (json["closures"] = Json::object());
+    closures_json["path"] = jsonValue(report.closures_path);
+    closures_json["accepted"] = jsonValue(static_cast<uint64_t>(c.accepted));
+    closures_json["rejected"] = jsonValue(static_cast<uint64_t>(c.rejected));
+    closures_json["pending"] = jsonValue(static_cast<uint64_t>(c.pending));
+    closures_json["superseded"] = jsonValue(static_cast<uint64_t>(c.superseded));
+    closures_json["total"] = jsonValue(static_cast<uint64_t>(c.total()));
+    Json& rejection_reasons_json = (closures_json["rejection_reasons"] = Json::object());
+    for (const auto& [reason, n] : c.rejection_reasons) rejection_reasons_json[reason] = jsonValue(static_cast<uint64_t>(n));
   } else {
-    json.key("closures").null();
+    json["closures"] = nullptr;
   }
 
   if (report.has_closure_errors) {
-    json.key("closure_errors").beginObject();
-    json.key("accepted").value(static_cast<uint64_t>(report.closure_errors_accepted));
-    writeRelativePoseErrorStatistics(json, "closure", report.closure_errors);
-    writeRelativePoseErrorStatistics(json, "dr", report.closure_errors_dr);
-    json.endObject();
+    Json& closure_errors_json = (json["closure_errors"] = Json::object());
+    closure_errors_json["accepted"] = jsonValue(static_cast<uint64_t>(report.closure_errors_accepted));
+    writeRelativePoseErrorStatistics(closure_errors_json, "closure", report.closure_errors);
+    writeRelativePoseErrorStatistics(closure_errors_json, "dr", report.closure_errors_dr);
   } else {
-    json.key("closure_errors").null();
+    json["closure_errors"] = nullptr;
   }
   if (report.has_lce) {
-    json.key("lce").beginObject();
-    json.key("seabed_depth_m").value(report.lce_seabed_depth_m);
-    json.key("seabed_depth_source").value(report.lce_seabed_depth_source);
-    json.key("correspondences").value(static_cast<uint64_t>(report.lce_correspondences));
-    json.key("truth_max_m").value(report.lce_truth_max_m);
-    writeErrorStatistics(json, "dr", report.lce_dr);
-    writeErrorStatistics(json, "slam", report.lce_slam);
-    json.key("mean_improvement_percent").value(improvementPercent(report.lce_dr.mean, report.lce_slam.mean));
-    json.endObject();
+    Json& lce_json = (json["lce"] = Json::object());
+    lce_json["seabed_depth_m"] = jsonValue(report.lce_seabed_depth_m);
+    lce_json["seabed_depth_source"] = jsonValue(report.lce_seabed_depth_source);
+    lce_json["correspondences"] = jsonValue(static_cast<uint64_t>(report.lce_correspondences));
+    lce_json["truth_max_m"] = jsonValue(report.lce_truth_max_m);
+    writeErrorStatistics(lce_json, "dr", report.lce_dr);
+    writeErrorStatistics(lce_json, "slam", report.lce_slam);
+    lce_json["mean_improvement_percent"] = jsonValue(improvementPercent(report.lce_dr.mean, report.lce_slam.mean));
   } else {
-    json.key("lce").null();
+    json["lce"] = nullptr;
   }
 
   if (report.has_summary) {
     const RunSummary& s = report.summary;
-    json.key("run").beginObject();
-    json.key("pings").value(s.pings);
-    json.key("subframes").value(s.subframes);
-    json.key("pairs_attempted").value(s.pairs_attempted);
-    json.key("closures_accepted").value(s.closures_accepted);
-    json.key("closures_rejected").value(s.closures_rejected);
-    json.key("wall_s").value(s.wall_s);
-    json.key("mission_s").value(s.mission_s);
-    json.key("real_time_factor").value(s.real_time_factor);
-    json.key("peak_rss_mib").value(s.peak_rss_mib);
-    json.endObject();
+    Json& run_json = (json["run"] = Json::object());
+    run_json["pings"] = jsonValue(s.pings);
+    run_json["subframes"] = jsonValue(s.subframes);
+    run_json["pairs_attempted"] = jsonValue(s.pairs_attempted);
+    run_json["closures_accepted"] = jsonValue(s.closures_accepted);
+    run_json["closures_rejected"] = jsonValue(s.closures_rejected);
+    run_json["wall_s"] = jsonValue(s.wall_s);
+    run_json["mission_s"] = jsonValue(s.mission_s);
+    run_json["real_time_factor"] = jsonValue(s.real_time_factor);
+    run_json["peak_rss_mib"] = jsonValue(s.peak_rss_mib);
   } else {
-    json.key("run").null();
+    json["run"] = nullptr;
   }
 
-  json.key("notes").beginArray();
-  for (const std::string& note : report.notes) json.value(note);
-  json.endArray();
-  json.key("files").beginArray();
-  for (const std::string& file : report.files) json.value(file);
-  json.endArray();
-  json.endObject();
-  return json.str() + "\n";
+  Json& notes_json = (json["notes"] = Json::array());
+  for (const std::string& note : report.notes) notes_json.push_back(jsonValue(note));
+  Json& files_json = (json["files"] = Json::array());
+  for (const std::string& file : report.files) files_json.push_back(jsonValue(file));
+  return json.dump(2) + "\n";
 }
 
 }  // namespace sss::eval

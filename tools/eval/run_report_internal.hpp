@@ -4,7 +4,7 @@
 
 #include "tools/eval/run_report.hpp"
 #include "tools/eval/csv_fields.hpp"
-#include "tools/eval/json_writer.hpp"
+#include "tools/eval/json_values.hpp"
 #include "tools/eval/plots.hpp"
 #include "tools/eval/report.hpp"
 

@@ -48,7 +48,7 @@
 #include "products/survey_rasters.hpp"
 #include "pipeline/subframe/subframe_buffer.hpp"
 #include "pipeline/messages/sensor_messages.hpp"
-#include "tools/eval/json_writer.hpp"
+#include "tools/eval/json_values.hpp"
 #include "products/coverage.hpp"
 #include "products/footprints.hpp"
 #include "tools/process/match_writer.hpp"

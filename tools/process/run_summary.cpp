@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <fstream>
 
-#include "tools/eval/json_writer.hpp"
+#include "tools/eval/json_values.hpp"
 
 namespace sss::offline {
 
@@ -191,28 +191,27 @@ std::vector<std::string> explainFixes(const FixSummary& f, const Options& option
 
 bool writeSummaryJson(const std::string& path, const OfflineRequest& request, const OfflineSummary& s,
                       std::string& error) {
-  sss::eval::JsonWriter json;
-  json.beginObject();
-  json.key("schema").value("sss-process/1");
-  json.key("inputs").beginObject();
-  json.key("sonar").value(request.sonar_path);
-  json.key("ins").value(request.ins_path);
-  json.key("lcm_log").value(request.lcm_log_path);
-  json.key("config").value(request.config_path);
-  json.endObject();
+  using sss::eval::Json;
+  using sss::eval::jsonValue;
+  Json json = Json::object();
+  json["schema"] = jsonValue("sss-process/1");
+  Json& inputs_json = (json["inputs"] = Json::object());
+  inputs_json["sonar"] = jsonValue(request.sonar_path);
+  inputs_json["ins"] = jsonValue(request.ins_path);
+  inputs_json["lcm_log"] = jsonValue(request.lcm_log_path);
+  inputs_json["config"] = jsonValue(request.config_path);
   // The frame of every trajectory, heightmap and point cloud of the run (local NED of this point).
-  json.key("origin").beginObject();
+  Json& origin_json = (json["origin"] = Json::object());
   if (s.origin) {
-    json.key("latitude_deg").value(s.origin->latitude_deg, 13);
-    json.key("longitude_deg").value(s.origin->longitude_deg, 13);
+    origin_json["latitude_deg"] = jsonValue(s.origin->latitude_deg, 13);
+    origin_json["longitude_deg"] = jsonValue(s.origin->longitude_deg, 13);
   }
   if (s.origin_source == "projected_first_fix") {
-    json.key("projected_easting_m").value(s.projected_origin_easting_m, 12);
-    json.key("projected_northing_m").value(s.projected_origin_northing_m, 12);
+    origin_json["projected_easting_m"] = jsonValue(s.projected_origin_easting_m, 12);
+    origin_json["projected_northing_m"] = jsonValue(s.projected_origin_northing_m, 12);
   }
-  json.key("source").value(s.origin_source);
-  json.key("detail").value(s.origin_detail);
-  json.endObject();
+  origin_json["source"] = jsonValue(s.origin_source);
+  origin_json["detail"] = jsonValue(s.origin_detail);
   const std::pair<const char*, uint64_t> counts[] = {
       {"nav_samples", s.nav_samples},         {"pings", s.pings},
       {"pings_with_pose", s.pings_with_pose}, {"subframes", s.subframes},
@@ -221,14 +220,13 @@ bool writeSummaryJson(const std::string& path, const OfflineRequest& request, co
       {"closures_accepted", s.closures_accepted}, {"closures_rejected", s.closures_rejected},
       {"closures_superseded", s.closures_superseded}, {"seabed_points", s.seabed_points},
       {"input_faults", s.input_faults}};
-  for (const auto& [name, value] : counts) json.key(name).value(value);
+  for (const auto& [name, value] : counts) json[name] = jsonValue(value);
   const auto& fusion = s.buffer.fusion;
-  json.key("navigation").beginObject();
-  json.key("ping_headers_without_position").value(s.pings_without_position);
-  json.key("samples_from_nav_packets").value(s.nav_from_packets);  // XTF attitude/navigation packets
-  json.key("samples_without_position").value(fusion.nav_without_position);
-  json.endObject();
-  json.key("pings_dropped").beginObject();
+  Json& navigation_json = (json["navigation"] = Json::object());
+  navigation_json["ping_headers_without_position"] = jsonValue(s.pings_without_position);
+  navigation_json["samples_from_nav_packets"] = jsonValue(s.nav_from_packets);  // XTF attitude/navigation packets
+  navigation_json["samples_without_position"] = jsonValue(fusion.nav_without_position);
+  Json& pings_dropped_json = (json["pings_dropped"] = Json::object());
   const std::pair<const char*, uint64_t> drops[] = {
       {"before_first_fix", fusion.dropped_before_first_fix},
       {"no_nav", fusion.dropped_no_nav},
@@ -237,107 +235,92 @@ bool writeSummaryJson(const std::string& path, const OfflineRequest& request, co
       {"no_altitude", fusion.dropped_no_altitude},
       {"duplicate", fusion.pings_duplicate},
       {"out_of_order", fusion.pings_out_of_order}};
-  for (const auto& [name, value] : drops) json.key(name).value(value);
-  json.endObject();
-  json.key("altitude_sources").beginObject();
-  json.key("nav").value(fusion.altitude_from_nav);
-  json.key("ping_header").value(fusion.altitude_from_ping);
-  json.key("bottom_track").value(fusion.altitude_from_bottom_track);
-  json.key("implausible_rejected").value(fusion.altitude_implausible);
-  json.endObject();
-  json.key("bottom_track").beginObject();
-  json.key("pings").value(s.bottom_track.pings);
-  json.key("detected").value(s.bottom_track.detected);
-  json.key("one_side_only").value(s.bottom_track.one_side_only);
-  json.key("outliers").value(s.bottom_track.outliers);
-  json.key("scale_applied").value(fusion.bottom_track_scale, 6);
-  json.endObject();
-  json.key("variance_factors").beginObject();  // what the graph learnt of its own weights
-  json.key("closure").value(s.variance_factors.closure, 6);
-  json.key("odometry").value(s.variance_factors.odometry, 6);
-  json.key("closure_redundancy").value(s.variance_factors.closure_redundancy, 4);
-  json.key("odometry_redundancy").value(s.variance_factors.odometry_redundancy, 4);
-  json.key("odometry_strain").value(s.variance_factors.odometry_strain, 4);
-  json.key("closures").value(static_cast<uint64_t>(s.variance_factors.closures));
-  json.key("iterations").value(static_cast<uint64_t>(s.variance_factors.iterations));
-  json.endObject();
-  json.key("separation_bias").beginObject();  // how much closer opposite-side closures put the lines
-  json.key("estimate_m").value(s.separation_bias.tested_m, 4);
-  json.key("sigma_m").value(s.separation_bias.sigma_m, 4);
-  json.key("significant").value(s.separation_bias.significant);
-  json.key("applied").value(s.separation_bias.applied);
-  json.key("closures").value(static_cast<uint64_t>(s.separation_bias.closures));
-  json.endObject();
-  json.key("fixes").beginObject();  // absolute fixes (--fixes): what was read and what became of it
-  json.key("files").value(s.fixes.files);
-  json.key("read").value(s.fixes.read);
-  json.key("gnss").value(s.fixes.gnss);
-  json.key("usbl").value(s.fixes.usbl);
-  json.key("sentences_skipped").value(s.fixes.sentences_skipped);
-  json.key("first_problem").value(s.fixes.first_problem);
-  json.key("below_surface").value(s.fixes.below_surface);
-  json.key("outside_navigation").value(s.fixes.outside_navigation);
-  json.key("no_geographic_frame").value(s.fixes.no_frame);
-  json.key("fed").value(s.fixes.fed);
-  json.key("accepted").value(s.fixes.accepted);
-  json.key("rejected_gate").value(s.fixes.rejected_gate);
-  json.key("refused").value(s.fixes.refused);
-  json.key("rms_residual_m").value(s.fixes.rms_residual_m, 4);
-  json.endObject();
-  json.key("coverage").beginObject();  // coverage.yaml: how many lines saw each 5 m cell (SLAM poses)
-  json.key("covered_m2").value(s.coverage_covered_m2, 8);
-  json.key("seen_twice_m2").value(s.coverage_seen_twice_m2, 8);
-  json.key("fraction_seen_twice").value(s.coverage_covered_m2 > 0.0 ? s.coverage_seen_twice_m2 / s.coverage_covered_m2 : 0.0, 4);
-  json.endObject();
+  for (const auto& [name, value] : drops) pings_dropped_json[name] = jsonValue(value);
+  Json& altitude_sources_json = (json["altitude_sources"] = Json::object());
+  altitude_sources_json["nav"] = jsonValue(fusion.altitude_from_nav);
+  altitude_sources_json["ping_header"] = jsonValue(fusion.altitude_from_ping);
+  altitude_sources_json["bottom_track"] = jsonValue(fusion.altitude_from_bottom_track);
+  altitude_sources_json["implausible_rejected"] = jsonValue(fusion.altitude_implausible);
+  Json& bottom_track_json = (json["bottom_track"] = Json::object());
+  bottom_track_json["pings"] = jsonValue(s.bottom_track.pings);
+  bottom_track_json["detected"] = jsonValue(s.bottom_track.detected);
+  bottom_track_json["one_side_only"] = jsonValue(s.bottom_track.one_side_only);
+  bottom_track_json["outliers"] = jsonValue(s.bottom_track.outliers);
+  bottom_track_json["scale_applied"] = jsonValue(fusion.bottom_track_scale, 6);
+  Json& variance_factors_json = (json["variance_factors"] = Json::object());  // what the graph learnt of its own weights
+  variance_factors_json["closure"] = jsonValue(s.variance_factors.closure, 6);
+  variance_factors_json["odometry"] = jsonValue(s.variance_factors.odometry, 6);
+  variance_factors_json["closure_redundancy"] = jsonValue(s.variance_factors.closure_redundancy, 4);
+  variance_factors_json["odometry_redundancy"] = jsonValue(s.variance_factors.odometry_redundancy, 4);
+  variance_factors_json["odometry_strain"] = jsonValue(s.variance_factors.odometry_strain, 4);
+  variance_factors_json["closures"] = jsonValue(static_cast<uint64_t>(s.variance_factors.closures));
+  variance_factors_json["iterations"] = jsonValue(static_cast<uint64_t>(s.variance_factors.iterations));
+  Json& separation_bias_json = (json["separation_bias"] = Json::object());  // how much closer opposite-side closures put the lines
+  separation_bias_json["estimate_m"] = jsonValue(s.separation_bias.tested_m, 4);
+  separation_bias_json["sigma_m"] = jsonValue(s.separation_bias.sigma_m, 4);
+  separation_bias_json["significant"] = jsonValue(s.separation_bias.significant);
+  separation_bias_json["applied"] = jsonValue(s.separation_bias.applied);
+  separation_bias_json["closures"] = jsonValue(static_cast<uint64_t>(s.separation_bias.closures));
+  Json& fixes_json = (json["fixes"] = Json::object());  // absolute fixes (--fixes): what was read and what became of it
+  fixes_json["files"] = jsonValue(s.fixes.files);
+  fixes_json["read"] = jsonValue(s.fixes.read);
+  fixes_json["gnss"] = jsonValue(s.fixes.gnss);
+  fixes_json["usbl"] = jsonValue(s.fixes.usbl);
+  fixes_json["sentences_skipped"] = jsonValue(s.fixes.sentences_skipped);
+  fixes_json["first_problem"] = jsonValue(s.fixes.first_problem);
+  fixes_json["below_surface"] = jsonValue(s.fixes.below_surface);
+  fixes_json["outside_navigation"] = jsonValue(s.fixes.outside_navigation);
+  fixes_json["no_geographic_frame"] = jsonValue(s.fixes.no_frame);
+  fixes_json["fed"] = jsonValue(s.fixes.fed);
+  fixes_json["accepted"] = jsonValue(s.fixes.accepted);
+  fixes_json["rejected_gate"] = jsonValue(s.fixes.rejected_gate);
+  fixes_json["refused"] = jsonValue(s.fixes.refused);
+  fixes_json["rms_residual_m"] = jsonValue(s.fixes.rms_residual_m, 4);
+  Json& coverage_json = (json["coverage"] = Json::object());  // coverage.yaml: how many lines saw each 5 m cell (SLAM poses)
+  coverage_json["covered_m2"] = jsonValue(s.coverage_covered_m2, 8);
+  coverage_json["seen_twice_m2"] = jsonValue(s.coverage_seen_twice_m2, 8);
+  coverage_json["fraction_seen_twice"] = jsonValue(s.coverage_covered_m2 > 0.0 ? s.coverage_seen_twice_m2 / s.coverage_covered_m2 : 0.0, 4);
   // INS heading error (closures and fixes observe it) and DVL scale (with fixes only; else 0, sigma null)
-  json.key("calibration").beginObject();
-  json.key("estimated").value(s.calibration.estimated);
-  json.key("dvl_scale_estimated").value(s.calibration.scale_estimated);
-  json.key("dvl_scale").value(s.calibration.dvl_scale, 6);
-  json.key("dvl_scale_sigma").value(s.calibration.sigma(0), 6);
-  json.key("heading_bias_rad").value(s.calibration.heading_bias_rad, 6);
-  json.key("heading_bias_sigma_rad").value(s.calibration.sigma(1), 6);
-  json.key("heading_cos_rad").value(s.calibration.heading_cos_rad, 6);
-  json.key("heading_cos_sigma_rad").value(s.calibration.sigma(2), 6);
-  json.key("heading_sin_rad").value(s.calibration.heading_sin_rad, 6);
-  json.key("heading_sin_sigma_rad").value(s.calibration.sigma(3), 6);
-  json.endObject();
-  json.key("lines").beginObject();
-  json.key("survey_lines").value(s.survey_lines);
-  json.key("turn_pings").value(s.buffer.builder.turn_pings);
-  json.key("short_tail_pings").value(s.buffer.builder.dropped_tail_pings);
-  json.key("nearest_other_line_m").value(s.nearest_other_line_m, 6);
-  json.key("canonical_swath_m").value(s.canonical_swath_m, 6);
-  json.endObject();
-  json.key("pairs_rejected").beginObject();
-  json.key("few_dense_matches").value(s.pairs_few_matches);
-  json.key("relative_pose").value(s.pairs_pose_rejected);
-  json.key("first_reason").value(s.first_pair_rejection);
-  json.endObject();
+  Json& calibration_json = (json["calibration"] = Json::object());
+  calibration_json["estimated"] = jsonValue(s.calibration.estimated);
+  calibration_json["dvl_scale_estimated"] = jsonValue(s.calibration.scale_estimated);
+  calibration_json["dvl_scale"] = jsonValue(s.calibration.dvl_scale, 6);
+  calibration_json["dvl_scale_sigma"] = jsonValue(s.calibration.sigma(0), 6);
+  calibration_json["heading_bias_rad"] = jsonValue(s.calibration.heading_bias_rad, 6);
+  calibration_json["heading_bias_sigma_rad"] = jsonValue(s.calibration.sigma(1), 6);
+  calibration_json["heading_cos_rad"] = jsonValue(s.calibration.heading_cos_rad, 6);
+  calibration_json["heading_cos_sigma_rad"] = jsonValue(s.calibration.sigma(2), 6);
+  calibration_json["heading_sin_rad"] = jsonValue(s.calibration.heading_sin_rad, 6);
+  calibration_json["heading_sin_sigma_rad"] = jsonValue(s.calibration.sigma(3), 6);
+  Json& lines_json = (json["lines"] = Json::object());
+  lines_json["survey_lines"] = jsonValue(s.survey_lines);
+  lines_json["turn_pings"] = jsonValue(s.buffer.builder.turn_pings);
+  lines_json["short_tail_pings"] = jsonValue(s.buffer.builder.dropped_tail_pings);
+  lines_json["nearest_other_line_m"] = jsonValue(s.nearest_other_line_m, 6);
+  lines_json["canonical_swath_m"] = jsonValue(s.canonical_swath_m, 6);
+  Json& pairs_rejected_json = (json["pairs_rejected"] = Json::object());
+  pairs_rejected_json["few_dense_matches"] = jsonValue(s.pairs_few_matches);
+  pairs_rejected_json["relative_pose"] = jsonValue(s.pairs_pose_rejected);
+  pairs_rejected_json["first_reason"] = jsonValue(s.first_pair_rejection);
   // The GeoTIFFs written and their CRS (QGIS and gdalinfo read it from the files too).
-  json.key("corrected_copy").beginObject();
-  json.key("path").value(s.corrected_copy);
-  json.key("pings_corrected").value(s.corrected_records);
-  json.key("pings_without_pose").value(s.corrected_records_without_pose);
-  json.endObject();
-  json.key("geotiff").beginObject();
-  json.key("crs").value(s.geotiff_crs);
-  json.key("epsg").value(static_cast<uint64_t>(s.geotiff_epsg));
-  json.key("files").beginArray();
-  for (const std::string& file : s.geotiffs) json.value(file);
-  json.endArray();
-  json.endObject();
-  json.key("findings").beginArray();
-  for (const std::string& finding : s.findings) json.value(finding);
-  json.endArray();
+  Json& corrected_copy_json = (json["corrected_copy"] = Json::object());
+  corrected_copy_json["path"] = jsonValue(s.corrected_copy);
+  corrected_copy_json["pings_corrected"] = jsonValue(s.corrected_records);
+  corrected_copy_json["pings_without_pose"] = jsonValue(s.corrected_records_without_pose);
+  Json& geotiff_json = (json["geotiff"] = Json::object());
+  geotiff_json["crs"] = jsonValue(s.geotiff_crs);
+  geotiff_json["epsg"] = jsonValue(static_cast<uint64_t>(s.geotiff_epsg));
+  Json& files_json = (geotiff_json["files"] = Json::array());
+  for (const std::string& file : s.geotiffs) files_json.push_back(jsonValue(file));
+  Json& findings_json = (json["findings"] = Json::array());
+  for (const std::string& finding : s.findings) findings_json.push_back(jsonValue(finding));
   const std::pair<const char*, double> figures[] = {
       {"mission_s", s.mission_s},     {"wall_s", s.wall_s},
       {"matcher_s", s.matcher_s},     {"optimiser_s", s.optimiser_s},
       {"real_time_factor", s.real_time_factor}, {"peak_rss_mib", s.peak_rss_mib}};
-  for (const auto& [name, value] : figures) json.key(name).value(value, 6);
-  json.endObject();
+  for (const auto& [name, value] : figures) json[name] = jsonValue(value, 6);
   std::ofstream out(path);
-  out << json.str() << "\n";
+  out << json.dump(2) << "\n";
   if (!out) {
     error = "cannot write " + path;
     return false;
