@@ -163,6 +163,7 @@ struct Solved {
   std::optional<sss::core::Matrix6d> covariance;        // model-based: Ceres, the assumed sigmas
   std::optional<sss::core::Matrix6d> robust_covariance; // cluster-robust sandwich (from residuals)
   sss::core::Vector6d per_seabed_offset = sss::core::Vector6d::Zero();
+  sss::core::Vector6d per_seabed_tilt = sss::core::Vector6d::Zero();
   int clusters = 0;
 };
 
@@ -182,6 +183,8 @@ struct ClusterRobust {
   // says, all landmarks alike (d pose / d depth offset, tangent [dt, dr]). Relief between two lines
   // moves every match the same way, so no spread between clusters shows it; see seabedReliefSigma.
   sss::core::Vector6d per_seabed_offset = sss::core::Vector6d::Zero();
+  // The same per unit slope of the seabed along A's track (offset (x - mean x) per landmark).
+  sss::core::Vector6d per_seabed_tilt = sss::core::Vector6d::Zero();
   int clusters = 0;
   bool ok = false;
 };
@@ -198,6 +201,9 @@ ClusterRobust clusterRobustCovariance(const std::vector<Measurement>& measuremen
   std::map<std::pair<long, long>, Vector6d> gradient_by_cluster;
   Matrix6d information = Matrix6d::Zero();
   Vector6d seabed_offset_gradient = Vector6d::Zero();  // d (reduced gradient) / d (prior depth offset)
+  Vector6d seabed_tilt_gradient = Vector6d::Zero();    // d (reduced gradient) / d (prior slope along x)
+  double mean_along_m = 0.0;
+  for (size_t i = 0; i < subset.size(); ++i) mean_along_m += landmarks[i].x() / static_cast<double>(subset.size());
   std::unique_ptr<ceres::LossFunction> loss;
   if (robust && options.robust_loss_scale > 0.0) loss = std::make_unique<ceres::CauchyLoss>(options.robust_loss_scale);
   // sqrt(rho'(|r|^2)): the iteratively reweighted least-squares weight of a robustified block.
@@ -254,8 +260,11 @@ ClusterRobust clusterRobustCovariance(const std::vector<Measurement>& measuremen
     information += J_pose.transpose() * J_pose - A_pl * ldlt.solve(A_pl.transpose());
     const Vector6d gradient = J_pose.transpose() * r - A_pl * ldlt.solve(J_landmark.transpose() * r);
     // The seabed row is (down . x - depth - offset) / sigma and does not involve the pose.
-    if (options.use_seabed_prior)
-      seabed_offset_gradient += A_pl * ldlt.solve(m.down_a) / (options.seabed_sigma_m * options.seabed_sigma_m);
+    if (options.use_seabed_prior) {
+      const Vector6d per_offset = A_pl * ldlt.solve(m.down_a) / (options.seabed_sigma_m * options.seabed_sigma_m);
+      seabed_offset_gradient += per_offset;
+      seabed_tilt_gradient += (landmarks[i].x() - mean_along_m) * per_offset;
+    }
     // Without clusters (cluster_m 0: only the seabed sensitivity is wanted) every match is one cell.
     const std::pair<long, long> cell =
         cluster_m > 0.0 ? std::pair<long, long>{static_cast<long>(std::floor(landmarks[i].x() / cluster_m)),
@@ -279,6 +288,7 @@ ClusterRobust clusterRobustCovariance(const std::vector<Measurement>& measuremen
   const Eigen::LLT<Matrix6d> bread(information);
   if (bread.info() != Eigen::Success) return out;
   out.per_seabed_offset = -bread.solve(seabed_offset_gradient);
+  out.per_seabed_tilt = -bread.solve(seabed_tilt_gradient);
   out.clusters = static_cast<int>(gradient_by_cluster.size());
   if (out.clusters < 2) return out;
   Matrix6d meat = Matrix6d::Zero();
@@ -396,6 +406,7 @@ Solved solve(const std::vector<Measurement>& measurements, const std::vector<int
       const ClusterRobust cluster_robust =
           clusterRobustCovariance(measurements, subset, landmarks, &anchor, dr, sqrt_information, options, robust);
       out.per_seabed_offset = cluster_robust.per_seabed_offset;
+      out.per_seabed_tilt = cluster_robust.per_seabed_tilt;
       if (options.covariance_cluster_m > 0.0) {
         out.clusters = cluster_robust.clusters;
         if (cluster_robust.ok) out.robust_covariance = cluster_robust.covariance;
@@ -499,6 +510,22 @@ double seabedReliefSigma(const RelativePoseInput& input) {
   addLine(input.dr_poses_a, input.altitude_a_m);
   addLine(input.dr_poses_b, input.altitude_b_m);
   return count > 0 ? std::sqrt(sum_squares / count) : 0.0;
+}
+
+// How much the seabed under the matches may tilt along track against the prior: relief of the
+// size both lines' altimetry shows about a straight line along the subframes (seabedReliefSigma),
+// taken as a ramp over the subframe's length L, the shape of it that turns the pose: a ramp of RMS
+// sigma over L has the slope sigma sqrt(12) / L. Relief at the scale of the subframe (an
+// undulation of about its length) does turn closures between lines far apart this way; a flat or
+// evenly sloping seabed costs nothing.
+double seabedTiltSigma(const RelativePoseInput& input, double relief_sigma_m) {
+  auto length = [](const std::vector<Pose>& poses) {
+    double along_m = 0.0;
+    for (size_t i = 1; i < poses.size(); ++i) along_m += (poses[i].translation - poses[i - 1].translation).head<2>().norm();
+    return along_m;
+  };
+  const double length_m = 0.5 * (length(input.dr_poses_a) + length(input.dr_poses_b));
+  return length_m > 1.0 ? relief_sigma_m * std::sqrt(12.0) / length_m : 0.0;
 }
 
 }  // namespace
@@ -703,6 +730,11 @@ RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const Re
     result.seabed_relief_sigma_m = seabedReliefSigma(input);
     const double sigma = result.seabed_relief_sigma_m;
     result.relief_covariance = sigma * sigma * refined.per_seabed_offset * refined.per_seabed_offset.transpose();
+    if (options.seabed_tilt_covariance) {
+      result.seabed_tilt_sigma = seabedTiltSigma(input, sigma);
+      const double tilt = result.seabed_tilt_sigma;
+      result.relief_covariance += tilt * tilt * refined.per_seabed_tilt * refined.per_seabed_tilt.transpose();
+    }
     result.covariance += result.relief_covariance;
   }
 
@@ -778,6 +810,7 @@ void readRelativePoseOptions(sss::core::ConfigSection& section, RelativePoseOpti
   section.optional("covariance_cluster_m", options.covariance_cluster_m, {sss::core::atLeast(0.0)});
   section.optional("min_covariance_clusters", options.min_covariance_clusters, {inRange(2, 100000)});
   section.optional("seabed_relief_covariance", options.seabed_relief_covariance);
+  section.optional("seabed_tilt_covariance", options.seabed_tilt_covariance);
   if (options.max_correspondences < options.ransac_subset)
     section.addProblem("max_correspondences", std::to_string(options.max_correspondences),
                        "must be >= ransac_subset (" + std::to_string(options.ransac_subset) + ")");

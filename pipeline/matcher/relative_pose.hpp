@@ -68,6 +68,12 @@ struct RelativePoseOptions {
   // themselves triangulate was tried as well: at the randomised missions' altitudes (7-27 m) the
   // seabed prior holds them and it never exceeded the altimetry's.
   bool seabed_relief_covariance = true;
+  // The same for a tilt of the seabed along the strip both lines see: relief that rises along the
+  // strip is a lateral ramp in the ranges, so a heading error of h k (1/g_a + 1/g_b), and at far
+  // range an along-track error as well; nothing in the residuals shows it. Its size is the relief
+  // the altimetry shows (as above) taken as a ramp over the subframe's length L: slope
+  // sigma sqrt(12) / L. Not scaled by covariance_scale either.
+  bool seabed_tilt_covariance = true;
 };
 
 // Everything the estimator needs from the two subframes, in each subframe's own DR frame.
@@ -95,6 +101,7 @@ struct RelativePoseResult {
   sss::core::Matrix6d model_covariance = sss::core::Matrix6d::Zero();  // Ceres, the assumed sigmas
   int covariance_clusters = 0;              // seabed patches of the refined inliers (0 unless covariance_cluster_m > 0)
   double seabed_relief_sigma_m = 0.0;       // from both lines' altimetry (seabed_relief_covariance)
+  double seabed_tilt_sigma = 0.0;           // slope along track, m per m (seabed_tilt_covariance)
   // The relief part of `covariance` (already in it): a caller that scales the model covariance
   // (PairMatcherOptions::covariance_scale) scales covariance - relief_covariance only.
   sss::core::Matrix6d relief_covariance = sss::core::Matrix6d::Zero();

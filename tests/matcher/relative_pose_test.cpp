@@ -53,6 +53,7 @@ struct PatchErrors {
   double patch_m = 20.0;
   double east_min_m = 20.0;     // the overlap strip the matches are drawn from (A's starboard)
   double east_max_m = 40.0;
+  double strip_slope = 0.0;     // the seabed under the matches rises this much per metre north
 };
 
 SyntheticPair makePair(bool anti_parallel, std::uint64_t seed, int num_matches = 1000, double outlier_fraction = 0.2,
@@ -105,7 +106,7 @@ SyntheticPair makePair(bool anti_parallel, std::uint64_t seed, int num_matches =
       shared_error_m = it->second;
     }
     // Seabed relief about the flat seabed, what the landmark depth prior allows for.
-    const double height_m = kAltitudeM + relief(rng);
+    const double height_m = kAltitudeM + relief(rng) - patch_errors.strip_slope * north;
     // The canonical image's column is the flat-seabed ground range of the true slant range.
     auto canonicalGroundRange = [&](double across_m) {
       return std::sqrt(across_m * across_m + height_m * height_m - kAltitudeM * kAltitudeM);
@@ -387,6 +388,43 @@ TEST(RelativePose, RoughSeabedWidensCeresCovarianceToo) {
               expected_lateral_m, std::sqrt(on_rough.covariance(1, 1)));
   EXPECT_NEAR(std::sqrt(on_rough.relief_covariance(1, 1)), expected_lateral_m, 0.1 * expected_lateral_m + 0.04);
   EXPECT_GT(on_rough.covariance(1, 1), 4.0 * on_rough.model_covariance(1, 1));
+}
+
+// Relief between the lines that rises along the strip they share (an undulation of about the
+// subframe's length) is a lateral ramp in the ranges, so a heading error, and nothing in the
+// residuals shows it: the tilt term widens the heading (and, through it, the along-track) sigma
+// by the slope the altimetry's relief allows over the subframe, relief sqrt(12) / L.
+TEST(RelativePose, SeabedRisingAlongTheStripWidensTheHeadingSigma) {
+  PatchErrors strip;
+  const double relief_m = 0.5 / std::sqrt(2.0);                   // RMS of the altimetry's undulation
+  const double length_m = (kPings - 1) * kPingSpacingM;
+  strip.strip_slope = relief_m * std::sqrt(12.0) / length_m;      // a one-sigma ramp of that relief
+  SyntheticPair pair = makePair(false, 13, 1000, 0.2, false, strip);
+  for (int i = 0; i < kPings; ++i) {
+    const double undulation_m = 0.5 * std::sin(2.0 * M_PI * i * kPingSpacingM / 40.0);
+    pair.input.altitude_a_m[i] += undulation_m;
+    pair.input.altitude_b_m[i] -= undulation_m;
+  }
+  RelativePoseOptions options = testOptions();
+  ASSERT_TRUE(options.seabed_tilt_covariance) << "on by default";
+  const RelativePoseResult with = estimateRelativePose(pair.input, options);
+  options.seabed_tilt_covariance = false;
+  const RelativePoseResult without = estimateRelativePose(pair.input, options);
+  ASSERT_TRUE(without.accepted) << without.reason;
+  ASSERT_TRUE(with.accepted) << with.reason;
+  const double heading_error_rad = sss::core::boxMinus(pair.T_a_b_true, with.T_a_b)(5);
+  // Each line places a point dz higher h dz / g nearer its nadir: the strip's ramp k turns B by
+  // h k (1 / g_a + 1 / g_b) = 18 x k x 2 / 30 (matches 20-40 m from either line).
+  const double expected_heading_rad = kAltitudeM * strip.strip_slope * (2.0 / 30.0);
+  std::printf("strip slope %.4f: heading error %.4f rad (expected about %.4f); heading sigma %.4f rad without the "
+              "tilt term, %.4f with it (tilt sigma %.4f)\n",
+              strip.strip_slope, heading_error_rad, expected_heading_rad, std::sqrt(without.covariance(5, 5)),
+              std::sqrt(with.covariance(5, 5)), with.seabed_tilt_sigma);
+  EXPECT_NEAR(with.seabed_tilt_sigma, strip.strip_slope, 0.1 * strip.strip_slope);
+  EXPECT_NEAR(std::abs(heading_error_rad), expected_heading_rad, 0.3 * expected_heading_rad);
+  EXPECT_GT(std::abs(heading_error_rad), 3.0 * std::sqrt(without.covariance(5, 5)));  // overconfident without
+  EXPECT_LT(std::abs(heading_error_rad), 2.0 * std::sqrt(with.covariance(5, 5)));     // covered with it
+  EXPECT_NEAR(std::sqrt(with.relief_covariance(5, 5)), expected_heading_rad, 0.3 * expected_heading_rad);
 }
 
 TEST(RelativePose, TooFewPatchesOfSeabedAreRejectedWithAReason) {
