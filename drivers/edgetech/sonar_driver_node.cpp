@@ -8,7 +8,6 @@
 #include <cstdlib>
 #include <deque>
 #include <fstream>
-#include <optional>
 #include <string>
 
 #include "drivers/edgetech/ping_message.hpp"
@@ -125,11 +124,8 @@ int main(int argc, char** argv) {
                                      "EdgeTech 2205 JSF from the sonar processor's TCP data port, or a .jsf/.xtf file "
                                      "replayed -> SSS_PING");
   sss::transport::addNodeFlags(command_line, arguments);
-  // The flags win over the configuration file's keys (replay_file, replay_speed).
-  std::optional<std::string> replay_file;
-  std::optional<double> replay_speed;
-  command_line.add_option("--file", replay_file, "replay this .jsf or .xtf file instead of TCP");
-  command_line.add_option("--speed", replay_speed, "replay speed (0: as fast as possible)")->check(CLI::Range(0.0, 1000.0));
+  sss::transport::ReplayFlags replay_flags;
+  sss::transport::addReplayFlags(command_line, "replay this .jsf or .xtf file instead of TCP", replay_flags);
   if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
   const std::string& config_path = arguments.config_path;
   const std::string& lcm_url_override = arguments.lcm_url_override;
@@ -154,8 +150,8 @@ int main(int argc, char** argv) {
     section.rejectUnknownKeys();
     config_problems = config.problemReport();
   }
-  if (replay_file) options.replay_file = *replay_file;
-  if (replay_speed) options.replay_speed = *replay_speed;
+  options.replay_file = replay_flags.file.value_or(options.replay_file);
+  options.replay_speed = replay_flags.speed.value_or(options.replay_speed);
   if (const int code = sss::transport::configVerdict("sss-sonar-driver", config_problems, config_path, check_config_only); code >= 0) {
     return code;
   }

@@ -16,7 +16,6 @@
 #include <cstring>
 #include <deque>
 #include <fstream>
-#include <optional>
 #include <string>
 
 #include "drivers/ins/bridge_state.hpp"
@@ -182,20 +181,17 @@ int main(int argc, char** argv) {
                                      "iXblue NMEA ($PIXSE) over UDP, TCP, a serial line or a file -> SSS_NAV; "
                                      "absolute fixes -> SSS_FIX");
   sss::transport::addNodeFlags(command_line, arguments);
-  // The flags win over the configuration file's keys (source/file, replay_speed).
-  std::optional<std::string> replay_file;
-  std::optional<double> replay_speed;
-  command_line.add_option("--file", replay_file, "replay this NMEA file (source: file)");
-  command_line.add_option("--speed", replay_speed, "replay speed (0: as fast as possible)")->check(CLI::Range(0.0, 1000.0));
+  sss::transport::ReplayFlags replay_flags;
+  sss::transport::addReplayFlags(command_line, "replay this NMEA file (source: file)", replay_flags);
   if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
   const std::string& config_path = arguments.config_path;
   const std::string& lcm_url_override = arguments.lcm_url_override;
   const std::string config_problems = readNodeOptions(config_path, options);
-  if (replay_file) {
-    options.file = *replay_file;
+  if (replay_flags.file) {
+    options.file = *replay_flags.file;
     options.source = "file";
   }
-  if (replay_speed) options.replay_speed = *replay_speed;
+  options.replay_speed = replay_flags.speed.value_or(options.replay_speed);
   if (const int code = sss::transport::configVerdict("sss-ins-bridge", config_problems, config_path,
                                                       arguments.check_config_only);
       code >= 0) {

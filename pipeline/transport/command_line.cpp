@@ -3,7 +3,9 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <sstream>
 #include <string>
+#include <vector>
 
 namespace sss::cli {
 
@@ -35,6 +37,26 @@ CLI::Validator nonNegative() {
 
 CLI::Validator positive() {
   return numberCheck("> 0", [](double value) { return value > 0.0; }, "> 0");
+}
+
+CLI::Option* addIncreasingPair(CLI::App& app, const std::string& name, double& min, double& max,
+                               const std::string& description, const CLI::Validator& check) {
+  return app
+      .add_option_function<std::vector<double>>(
+          name,
+          [name, &min, &max](const std::vector<double>& values) {
+            if (!(values[0] < values[1])) {
+              std::ostringstream text;
+              text << "MIN,MAX needs MIN < MAX, got " << values[0] << "," << values[1];
+              throw CLI::ValidationError(name, text.str());
+            }
+            min = values[0];
+            max = values[1];
+          },
+          description)
+      ->delimiter(',')
+      ->expected(2)
+      ->check(check);
 }
 
 int parseCommandLine(CLI::App& app, int argc, const char* const* argv) {

@@ -34,6 +34,11 @@ int parseNodeArguments(const std::string& process_name, const std::string& descr
   return sss::cli::parseCommandLine(command_line, argc, argv);
 }
 
+void addReplayFlags(sss::cli::CommandLine& command_line, const std::string& file_help, ReplayFlags& flags) {
+  command_line.add_option("--file", flags.file, file_help);
+  command_line.add_option("--speed", flags.speed, "replay speed (0: as fast as possible)")->check(CLI::Range(0.0, 1000.0));
+}
+
 int configVerdict(const std::string& process_name, const std::string& problems, const std::string& config_path,
                   bool check_config_only) {
   if (!problems.empty()) {

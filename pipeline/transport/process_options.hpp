@@ -1,6 +1,7 @@
 // Options every process shares: its name, the LCM URL, the status channel and period, logging.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "pipeline/core/config.hpp"
@@ -37,6 +38,14 @@ void addNodeFlags(sss::cli::CommandLine& command_line, NodeArguments& arguments)
 // to return (command_line.hpp: 0 for --help, 2 for bad flags).
 int parseNodeArguments(const std::string& process_name, const std::string& description, int argc, char** argv,
                        NodeArguments& arguments);
+
+// The drivers' replay flags, --file FILE and --speed X (0: as fast as possible). Set only when
+// given: they win over the configuration file's keys, which are still read (and so still known).
+struct ReplayFlags {
+  std::optional<std::string> file;
+  std::optional<double> speed;
+};
+void addReplayFlags(sss::cli::CommandLine& command_line, const std::string& file_help, ReplayFlags& flags);
 
 // The end of every process's configuration step. problems: Config::problemReport() (empty when
 // valid). Prints them and returns 2 when there are any; with --check-config says the file is valid

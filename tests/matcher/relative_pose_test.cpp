@@ -327,17 +327,23 @@ TEST(RelativePose, ClusterRobustCovarianceAgreesWithCeresForIndependentMatches) 
   EXPECT_LT(ratio, 2.0);
 }
 
+// The seabed under both lines undulates by +-0.5 m over 40 m (RMS 0.354 m), as their altimetry
+// records it; the matches' seabed is left as it was.
+void addUndulatingAltimetry(SyntheticPair& pair) {
+  for (int i = 0; i < kPings; ++i) {
+    const double undulation_m = 0.5 * std::sin(2.0 * M_PI * i * kPingSpacingM / 40.0);
+    pair.input.altitude_a_m[i] += undulation_m;
+    pair.input.altitude_b_m[i] -= undulation_m;
+  }
+}
+
 // Relief between two lines moves every landmark alike, which no spread between clusters shows:
 // the altimetry of both lines says how rough the seabed is, and the lateral sigma widens with it.
 // A flat seabed (constant altitude at constant depth) adds nothing.
 TEST(RelativePose, RoughSeabedUnderTheLinesWidensTheLateralSigma) {
   const SyntheticPair flat = makePair(false, 13);
   SyntheticPair rough = flat;
-  for (int i = 0; i < kPings; ++i) {  // the seabed under both lines undulates by +-0.5 m over 40 m
-    const double undulation_m = 0.5 * std::sin(2.0 * M_PI * i * kPingSpacingM / 40.0);
-    rough.input.altitude_a_m[i] += undulation_m;
-    rough.input.altitude_b_m[i] -= undulation_m;
-  }
+  addUndulatingAltimetry(rough);
   RelativePoseOptions options = clusterRobustOptions();
   const RelativePoseResult on_flat = estimateRelativePose(flat.input, options);
   const RelativePoseResult on_rough = estimateRelativePose(rough.input, options);
@@ -367,11 +373,7 @@ TEST(RelativePose, RoughSeabedUnderTheLinesWidensTheLateralSigma) {
 TEST(RelativePose, RoughSeabedWidensCeresCovarianceToo) {
   const SyntheticPair flat = makePair(false, 13);
   SyntheticPair rough = flat;
-  for (int i = 0; i < kPings; ++i) {
-    const double undulation_m = 0.5 * std::sin(2.0 * M_PI * i * kPingSpacingM / 40.0);
-    rough.input.altitude_a_m[i] += undulation_m;
-    rough.input.altitude_b_m[i] -= undulation_m;
-  }
+  addUndulatingAltimetry(rough);
   RelativePoseOptions options = testOptions();
   ASSERT_TRUE(options.seabed_relief_covariance) << "on by default";
   const RelativePoseResult on_flat = estimateRelativePose(flat.input, options);
@@ -400,11 +402,7 @@ TEST(RelativePose, SeabedRisingAlongTheStripWidensTheHeadingSigma) {
   const double length_m = (kPings - 1) * kPingSpacingM;
   strip.strip_slope = relief_m * std::sqrt(12.0) / length_m;      // a one-sigma ramp of that relief
   SyntheticPair pair = makePair(false, 13, 1000, 0.2, false, strip);
-  for (int i = 0; i < kPings; ++i) {
-    const double undulation_m = 0.5 * std::sin(2.0 * M_PI * i * kPingSpacingM / 40.0);
-    pair.input.altitude_a_m[i] += undulation_m;
-    pair.input.altitude_b_m[i] -= undulation_m;
-  }
+  addUndulatingAltimetry(pair);
   RelativePoseOptions options = testOptions();
   ASSERT_TRUE(options.seabed_tilt_covariance) << "on by default";
   const RelativePoseResult with = estimateRelativePose(pair.input, options);

@@ -20,6 +20,7 @@ struct Parsed {
   int count = 3;
   bool verbose = false;
   std::vector<double> pair;
+  double min_m = -1.0, max_m = -1.0;
 };
 
 Parsed parse(std::vector<std::string> arguments) {
@@ -30,6 +31,7 @@ Parsed parse(std::vector<std::string> arguments) {
   command_line.add_option("--count", parsed.count, "a count")->check(nonNegative());
   command_line.add_flag("--verbose", parsed.verbose, "say more");
   command_line.add_option("--pair", parsed.pair, "A,B")->delimiter(',')->expected(2);
+  addIncreasingPair(command_line, "--range-m", parsed.min_m, parsed.max_m, "MIN,MAX", nonNegative());
   arguments.insert(arguments.begin(), "sss-test");
   std::vector<const char*> argv;
   for (const std::string& argument : arguments) argv.push_back(argument.c_str());
@@ -49,11 +51,14 @@ TEST(CommandLine, ValuesLandWhereDeclared) {
   EXPECT_EQ(parsed.count, 0);
   EXPECT_TRUE(parsed.verbose);
   EXPECT_EQ(parsed.pair, (std::vector<double>{1.0, -2.0}));
+  EXPECT_DOUBLE_EQ(parse({"--path", "x", "--range-m", "10,70.5"}).max_m, 70.5);
+  EXPECT_DOUBLE_EQ(parse({"--path", "x", "--range-m", "10,70.5"}).min_m, 10.0);
   EXPECT_EQ(parsed.out + parsed.err, "");
   const Parsed defaults = parse({"--path", "x"});
   EXPECT_DOUBLE_EQ(defaults.speed_m_s, 1.0);  // what the program set stays unless given
   EXPECT_EQ(defaults.count, 3);
   EXPECT_FALSE(defaults.verbose);
+  EXPECT_EQ(defaults.min_m, -1.0);
 }
 
 TEST(CommandLine, HelpGoesToStdoutWithExitZero) {
@@ -83,6 +88,8 @@ TEST(CommandLine, EveryBadCommandLineExitsTwoAndSaysWhy) {
       {{"--path", "x", "--count", "1.5"}, "1.5"},                // not an integer
       {{"--path", "x", "--count", "1", "--count", "2"}, "--count"},  // given twice
       {{"--path", "x", "--pair", "1,2,3"}, "--pair"},            // three values for two
+      {{"--path", "x", "--range-m", "70,10"}, "MIN < MAX, got 70,10"},
+      {{"--path", "x", "--range-m", "-1,10"}, "must be >= 0, got -1"},
   };
   for (const Case& c : cases) {
     const Parsed parsed = parse(c.arguments);

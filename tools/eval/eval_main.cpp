@@ -92,11 +92,9 @@ int main(int argc, char** argv) {
   command_line.add_option("--rpe-windows-m", options.trajectory.rpe.windows_m, "RPE windows, e.g. 10,50,100")
       ->delimiter(',')
       ->check(sss::cli::positive());
-  std::vector<double> lce_swath_m;
-  command_line.add_option("--lce-swath-m", lce_swath_m, "MIN,MAX ground ranges of LCE sightings, e.g. 10,70")
-      ->delimiter(',')
-      ->expected(2)
-      ->check(sss::cli::nonNegative());
+  sss::cli::addIncreasingPair(command_line, "--lce-swath-m", options.lce.min_ground_range_m,
+                              options.lce.max_ground_range_m, "MIN,MAX ground ranges of LCE sightings, e.g. 10,70",
+                              sss::cli::nonNegative());
   command_line.add_option("--lce-grid-m", options.lce.grid_m, "LCE seabed point spacing")
       ->check(CLI::Range(0.1, 1e6))
       ->capture_default_str();
@@ -107,14 +105,6 @@ int main(int argc, char** argv) {
       ->check(sss::cli::nonNegative());
   if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
   options.trajectory.association.interpolate_truth = interpolate;
-  if (!lce_swath_m.empty()) {
-    if (!(lce_swath_m[1] > lce_swath_m[0])) {
-      std::cerr << "sss-eval: --lce-swath-m expects MIN,MAX ground ranges with MIN < MAX, e.g. 10,70\n";
-      return 2;
-    }
-    options.lce.min_ground_range_m = lce_swath_m[0];
-    options.lce.max_ground_range_m = lce_swath_m[1];
-  }
   const bool lce_given = lce_flag->count() > 0;
   // LCE by default with a truth and an estimate: it is the metric of what side-scan can see.
   request.lce = (lce_given && lce) || (!lce_given && !request.truth_path.empty() && !estimates.empty());

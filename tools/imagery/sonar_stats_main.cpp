@@ -92,7 +92,6 @@ int main(int argc, char** argv) {
   long max_pings = 0;
   sss::imagery::SonarStatisticsOptions stats_options;
   std::vector<int> block;
-  std::vector<double> far_range;
   sss::cli::CommandLine command_line("sss-sonar-stats",
                                      "the image statistics of a side-scan file (JSF or XTF) that a person compares "
                                      "between simulated and real data",
@@ -109,24 +108,15 @@ int main(int argc, char** argv) {
       ->delimiter(',')
       ->expected(2)
       ->check(CLI::Range(2, 1 << 20));
-  command_line.add_option("--far-range", far_range, "MIN,MAX fractions of the range for the far-range statistics")
-      ->delimiter(',')
-      ->expected(2)
-      ->check(CLI::Range(0.0, 1.0));
+  sss::cli::addIncreasingPair(command_line, "--far-range", stats_options.far_range_min_fraction,
+                              stats_options.far_range_max_fraction,
+                              "MIN,MAX fractions of the range for the far-range statistics", CLI::Range(0.0, 1.0));
   command_line.add_option("--max-quarter-deviation", stats_options.max_quarter_deviation,
                           "largest deviation between a block's quarters for it to count as homogeneous")
       ->check(sss::cli::positive())
       ->capture_default_str();
   if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
   if (!block.empty()) stats_options.block_pings = block[0], stats_options.block_samples = block[1];
-  if (!far_range.empty()) {
-    if (far_range[0] >= far_range[1]) {
-      std::cerr << "sss-sonar-stats: --far-range MIN,MAX needs MIN < MAX, got " << far_range[0] << "," << far_range[1]
-                << "\n";
-      return 2;
-    }
-    stats_options.far_range_min_fraction = far_range[0], stats_options.far_range_max_fraction = far_range[1];
-  }
 
   std::vector<sss::imagery::StatisticsPing> pings;
   const auto full = [&] { return max_pings > 0 && pings.size() >= static_cast<size_t>(max_pings); };

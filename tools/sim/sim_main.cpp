@@ -36,10 +36,9 @@ int main(int argc, char** argv) {
   std::string out_dir, config_path, family;
   bool randomise = false;
   bool no_altitude = false;
-  int64_t seed = 1;
   // Every override is optional: the mission (drawn or default, then the config's) keeps its value
   // unless the flag is given.
-  std::optional<int64_t> lines, cross_lines;
+  std::optional<int64_t> seed, lines, cross_lines;
   std::optional<double> line_length_m, line_spacing_m, range_m, altitude_m, ping_rate_hz, drift_scale,
       heading_noise_rad, duration_s, origin_latitude_deg, origin_longitude_deg, usbl_period_s;
   std::optional<std::string> pattern, gnss_fixes;
@@ -49,8 +48,7 @@ int main(int argc, char** argv) {
                                      kExplanation);
   command_line.add_option("--out", out_dir, "output folder")->required();
   command_line.add_option("--config", config_path, "YAML file with a `sim` section");
-  const CLI::Option* seed_flag =
-      command_line.add_option("--seed", seed, "random seed")->check(sss::cli::nonNegative());
+  command_line.add_option("--seed", seed, "random seed (default 1)")->check(sss::cli::nonNegative());
   command_line.add_option("--pattern", pattern, "lawnmower | loop | cross");
   command_line.add_option("--lines", lines, "survey lines")->check(sss::cli::nonNegative());
   command_line.add_option("--cross-lines", cross_lines, "cross lines of --pattern cross")->check(sss::cli::nonNegative());
@@ -68,21 +66,16 @@ int main(int argc, char** argv) {
   command_line.add_option("--gnss-fixes", gnss_fixes, "none | start | start-end | lines");
   command_line.add_option("--usbl-period-s", usbl_period_s, "a USBL fix every S s (0: none)");
   command_line.add_flag("--randomise", randomise, "draw the whole mission from --seed");
-  command_line.add_option("--family", family, "the seabed family of --randomise")->needs("--randomise");
+  command_line.add_option("--family", family, "the seabed family of --randomise")
+      ->check(CLI::IsMember(sss::sim::seabedFamilies()))
+      ->needs("--randomise");
   if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
 
   sss::sim::SimOptions options;
   if (randomise) {
     sss::sim::RandomiseOptions request;
-    request.seed = seed;
-    if (!family.empty()) {
-      request.family = family;
-      if (!sss::sim::isSeabedFamily(request.family)) {
-        std::cerr << "sss-sim: --family " << request.family << " is not one of sand_ripples, mud, rock_outcrops, "
-                  << "boulder_field, trawled, mixed\n";
-        return 2;
-      }
-    }
+    request.seed = seed.value_or(1);
+    request.family = family;
     options = sss::sim::randomiseMission(request);
   }
   if (!config_path.empty()) {
@@ -102,7 +95,7 @@ int main(int argc, char** argv) {
   const auto apply = [](const auto& flag, auto& target) {
     if (flag) target = static_cast<std::decay_t<decltype(target)>>(*flag);
   };
-  if (seed_flag->count() > 0) options.seed = seed;
+  apply(seed, options.seed);
   apply(pattern, options.trajectory.pattern);
   apply(gnss_fixes, options.fixes.gnss);
   apply(lines, options.trajectory.lines);
