@@ -2,26 +2,18 @@
 // staleness in the message flags and in SSS_STATUS; and, when fix_udp_port is set, absolute position
 // fixes (GNSS at the surface, USBL relayed by the modem: NMEA GGA + GST + ZDA on their own UDP port)
 // -> SSS_FIX, placed in the mission frame with the DR state at their time. Translation only; the
-// logic is in InsBridge, PositionFixReader and FixAligner.
+// logic is in InsInputSource, InsBridge, PositionFixReader and FixAligner.
 //   sss-ins-bridge [--config FILE] [--file ins.nmea [--speed X]] [--lcm-url URL]
-#include <arpa/inet.h>
-#include <fcntl.h>
-#include <netinet/in.h>
-#include <sys/socket.h>
-#include <termios.h>
-#include <unistd.h>
-
-#include <cerrno>
 #include <cstdlib>
-#include <cstring>
 #include <deque>
-#include <fstream>
 #include <string>
+#include <string_view>
 
 #include "drivers/ins/bridge_state.hpp"
 #include "drivers/ins/fix_aligner.hpp"
 #include "drivers/ins/fix_message.hpp"
 #include "drivers/ins/ins_bridge.hpp"
+#include "drivers/ins/ins_input_source.hpp"
 #include "drivers/ins/position_fix.hpp"
 #include "drivers/ins/nav_message.hpp"
 #include "pipeline/core/mission_origin.hpp"
@@ -30,7 +22,6 @@
 #include "pipeline/transport/logging.hpp"
 #include "pipeline/transport/process_loop.hpp"
 #include "pipeline/transport/replay_pacer.hpp"
-#include "pipeline/transport/tcp_client.hpp"
 
 namespace {
 
@@ -39,13 +30,7 @@ using sss::core::monotonicUtime;
 struct NodeOptions {
   sss::transport::ProcessOptions process;
   sss::ins::InsBridgeOptions bridge;
-  std::string source = "udp";  // udp | tcp | serial | file
-  std::string bind_address = "0.0.0.0";
-  int udp_port = 8110;
-  sss::transport::TcpClientOptions tcp;
-  std::string serial_device = "/dev/ttyS0";
-  int serial_baud = 115200;
-  std::string file;
+  sss::ins::InsInputOptions input;
   double replay_speed = 1.0;
   std::string nav_channel = "SSS_NAV";
   // Absolute fixes on their own UDP port (0: none): not mixed into the INS stream, whose assembler
@@ -71,17 +56,17 @@ std::string readNodeOptions(const std::string& config_path, NodeOptions& options
   ConfigSection section = config.section("ins_bridge");
   sss::transport::readProcessOptions(section, options.process);
   sss::ins::readInsBridgeOptions(section, options.bridge);
-  section.optional("source", options.source, {oneOf({"udp", "tcp", "serial", "file"})});
-  section.optional("bind_address", options.bind_address, {nonEmpty()});
-  section.optional("udp_port", options.udp_port, {inRange(1, 65535)});
-  section.optional("host", options.tcp.host, {nonEmpty()});
-  section.optional("port", options.tcp.port, {inRange(1, 65535)});
-  section.optional("serial_device", options.serial_device, {nonEmpty()});
-  section.optional("serial_baud", options.serial_baud,
+  section.optional("source", options.input.source, {oneOf({"udp", "tcp", "serial", "file"})});
+  section.optional("bind_address", options.input.bind_address, {nonEmpty()});
+  section.optional("udp_port", options.input.udp_port, {inRange(1, 65535)});
+  section.optional("host", options.input.tcp.host, {nonEmpty()});
+  section.optional("port", options.input.tcp.port, {inRange(1, 65535)});
+  section.optional("serial_device", options.input.serial_device, {nonEmpty()});
+  section.optional("serial_baud", options.input.serial_baud,
                    {satisfies<int>([](int b) { return b == 9600 || b == 19200 || b == 38400 || b == 57600 ||
                                                       b == 115200 || b == 230400 || b == 460800; },
                                    "a standard baud rate (9600 ... 460800)")});
-  section.optional("file", options.file);
+  section.optional("file", options.input.file);
   section.optional("replay_speed", options.replay_speed, {inRange(0.0, 1000.0)});
   section.optional("nav_channel", options.nav_channel, {nonEmpty()});
   section.optional("fix_udp_port", options.fix_udp_port, {inRange(0, 65535)});
@@ -128,55 +113,52 @@ void setStatusCounters(const sss::ins::InsBridge& bridge, const sss::ins::Bridge
   }
 }
 
-speed_t baudConstant(int baud) {
-  switch (baud) {
-    case 9600: return B9600;
-    case 19200: return B19200;
-    case 38400: return B38400;
-    case 57600: return B57600;
-    case 230400: return B230400;
-    case 460800: return B460800;
-    default: return B115200;
-  }
+// The fixes' own UDP port, on the INS input's address.
+sss::ins::InsInputOptions fixInputOptions(const NodeOptions& options) {
+  sss::ins::InsInputOptions fix_input;
+  fix_input.bind_address = options.input.bind_address;
+  fix_input.udp_port = options.fix_udp_port;
+  return fix_input;
 }
 
-int openUdp(const std::string& bind_address, int port, std::string& error) {
-  const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-  const int one = 1;
-  ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof(one));
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_port = htons(static_cast<uint16_t>(port));
-  ::inet_pton(AF_INET, bind_address.c_str(), &address.sin_addr);
-  if (::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0) {
-    error = "cannot bind UDP " + bind_address + ":" + std::to_string(port) + ": " + std::strerror(errno);
-    ::close(fd);
-    return -1;
+// Puts the INS input on the loop: its descriptor watched (it changes as a serial port comes back or
+// the TCP link reconnects) and the source serviced as often as it asks.
+class InputOnLoop {
+ public:
+  InputOnLoop(sss::ins::InsInputSource& input, sss::transport::ProcessLoop& loop) : input_(input), loop_(loop) {
+    watch();
+    if (input_.servicePeriodS() > 0.0) {
+      loop_.addTimer(input_.servicePeriodS(), [this] {
+        input_.service(monotonicUtime());
+        watch();
+      });
+    }
   }
-  return fd;
-}
+  InputOnLoop(const InputOnLoop&) = delete;  // the loop's callbacks hold this
+  InputOnLoop& operator=(const InputOnLoop&) = delete;
 
-int openSerial(const NodeOptions& options, std::string& error) {
-  const int fd = ::open(options.serial_device.c_str(), O_RDONLY | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) {
-    error = "cannot open serial port '" + options.serial_device + "': " + std::strerror(errno);
-    return -1;
+ private:
+  void watch() {
+    if (input_.fd() == watched_fd_) return;
+    if (watched_fd_ >= 0) loop_.removeFileDescriptor(watched_fd_);
+    watched_fd_ = input_.fd();
+    if (watched_fd_ >= 0) {
+      loop_.addFileDescriptor(watched_fd_, [this] {
+        input_.read(0.0);
+        watch();
+      });
+    }
   }
-  termios tty{};
-  if (::tcgetattr(fd, &tty) == 0) {
-    ::cfmakeraw(&tty);
-    ::cfsetispeed(&tty, baudConstant(options.serial_baud));
-    tty.c_cflag |= CLOCAL | CREAD;
-    ::tcsetattr(fd, TCSANOW, &tty);
-  }
-  return fd;
-}
 
-}  // namespace
+  sss::ins::InsInputSource& input_;
+  sss::transport::ProcessLoop& loop_;
+  int watched_fd_ = -1;
+};
 
-int main(int argc, char** argv) {
+// The command line over the configuration file: an exit code when the process ends here (--help, a
+// bad flag or configuration, --check-config), else -1.
+int parseOptions(int argc, char** argv, NodeOptions& options) {
   sss::transport::NodeArguments arguments;
-  NodeOptions options;
   sss::cli::CommandLine command_line("sss-ins-bridge",
                                      "iXblue NMEA ($PIXSE) over UDP, TCP, a serial line or a file -> SSS_NAV; "
                                      "absolute fixes -> SSS_FIX");
@@ -184,20 +166,26 @@ int main(int argc, char** argv) {
   sss::transport::ReplayFlags replay_flags;
   sss::transport::addReplayFlags(command_line, "replay this NMEA file (source: file)", replay_flags);
   if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
-  const std::string& config_path = arguments.config_path;
-  const std::string& lcm_url_override = arguments.lcm_url_override;
-  const std::string config_problems = readNodeOptions(config_path, options);
+  const std::string config_problems = readNodeOptions(arguments.config_path, options);
   if (replay_flags.file) {
-    options.file = *replay_flags.file;
-    options.source = "file";
+    options.input.file = *replay_flags.file;
+    options.input.source = "file";
   }
   options.replay_speed = replay_flags.speed.value_or(options.replay_speed);
-  if (const int code = sss::transport::configVerdict("sss-ins-bridge", config_problems, config_path,
+  if (const int code = sss::transport::configVerdict("sss-ins-bridge", config_problems, arguments.config_path,
                                                       arguments.check_config_only);
       code >= 0) {
     return code;
   }
-  if (!lcm_url_override.empty()) options.process.lcm_url = lcm_url_override;
+  if (!arguments.lcm_url_override.empty()) options.process.lcm_url = arguments.lcm_url_override;
+  return -1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  NodeOptions options;
+  if (const int code = parseOptions(argc, argv, options); code >= 0) return code;
 
   sss::transport::initLogging(options.process.process_name, options.process.log_level);
   sss::transport::ProcessLoop loop(options.process);
@@ -207,7 +195,7 @@ int main(int argc, char** argv) {
 
   // The odometer and the mission origin across restarts (bridge_state.hpp). A file replay is
   // offline: nothing kept.
-  sss::ins::BridgeStateStore state(options.source == "file" ? std::string()
+  sss::ins::BridgeStateStore state(options.input.source == "file" ? std::string()
       : sss::core::resolveSystemdDirectory(options.state_directory, std::getenv("STATE_DIRECTORY")));
   // Runs one step of the store and writes what it says.
   auto logged = [](const auto& step) {
@@ -254,137 +242,63 @@ int main(int argc, char** argv) {
     loop.reportFaults("ins_input", bridge.takeNewFaultMessages());
   });
 
-  std::string error;
-  int input_fd = -1;
-  std::unique_ptr<sss::transport::TcpClient> tcp;
-  int tcp_registered_fd = -1;
-  std::ifstream file;
-  std::deque<sss::ins::NavSample> replay_queue;
-  sss::transport::ReplayPacer pacer(options.replay_speed);
-  bool replay_eof = false;
-
-  int fix_fd = -1;
+  sss::ins::InsInputHooks fix_hooks;
+  fix_hooks.chunk = [&](const sss::ins::InsInputChunk& chunk) {
+    fix_reader.feed(std::string_view(reinterpret_cast<const char*>(chunk.data), chunk.size));
+    for (const sss::ins::PositionFix& fix : fix_reader.take()) fix_aligner.addFix(fix);
+  };
+  sss::ins::InsInputSource fix_input(fixInputOptions(options), fix_hooks);
   if (options.fix_udp_port > 0) {
-    fix_fd = openUdp(options.bind_address, options.fix_udp_port, error);
-    if (fix_fd < 0) {
+    if (const std::string error = fix_input.open(); !error.empty()) {
       spdlog::critical("fixes: {}", error);
       return 1;
     }
-    spdlog::info("absolute fixes (NMEA GGA + GST + ZDA) on UDP {}:{} -> {}", options.bind_address, options.fix_udp_port,
-                 options.fix_channel);
-    loop.addFileDescriptor(fix_fd, [&] {
-      char datagram[65536];
-      ssize_t n;
-      while ((n = ::recv(fix_fd, datagram, sizeof(datagram), 0)) > 0) {
-        fix_reader.feed(std::string_view(datagram, static_cast<size_t>(n)));
-        for (const sss::ins::PositionFix& fix : fix_reader.take()) fix_aligner.addFix(fix);
-      }
-      publishFixes(monotonicUtime());
-    });
+    spdlog::info("absolute fixes (NMEA GGA + GST + ZDA) on UDP {}:{} -> {}", options.input.bind_address,
+                 options.fix_udp_port, options.fix_channel);
+    loop.addFileDescriptor(fix_input.fd(), [&] { fix_input.read(0.0); publishFixes(monotonicUtime()); });
   }
 
-  if (options.source == "udp") {
-    input_fd = openUdp(options.bind_address, options.udp_port, error);
-    if (input_fd < 0) {
-      spdlog::critical("{}", error);
-      return 1;
-    }
-    loop.addFileDescriptor(input_fd, [&] {
-      uint8_t datagram[65536];
-      ssize_t n;
-      while ((n = ::recv(input_fd, datagram, sizeof(datagram), 0)) > 0) {
-        const int64_t now = monotonicUtime();
-        bridge.onBytes(datagram, static_cast<size_t>(n), now, samples);
-        bridge.onChunkEnd(now, samples);
-        publishAll(now);
-      }
-    });
-  } else if (options.source == "serial") {
-    // A serial port can vanish (USB adapter): reopen every 2 s until it is back.
-    auto tryOpen = [&] {
-      if (input_fd >= 0) return;
-      input_fd = openSerial(options, error);
-      if (input_fd < 0) {
-        if (health.recordError("serial_open", error, sss::core::nowUtime())) spdlog::warn("{}; retrying", error);
-        return;
-      }
-      spdlog::info("reading INS from {}", options.serial_device);
-      loop.addFileDescriptor(input_fd, [&] {
-        uint8_t buffer[4096];
-        const ssize_t n = ::read(input_fd, buffer, sizeof(buffer));
-        if (n > 0) {
-          const int64_t now = monotonicUtime();
-          bridge.onBytes(buffer, static_cast<size_t>(n), now, samples);
-          publishAll(now);
-        } else if (n == 0 || (errno != EAGAIN && errno != EINTR)) {
-          spdlog::warn("serial port '{}' closed; reopening", options.serial_device);
-          loop.removeFileDescriptor(input_fd);
-          ::close(input_fd);
-          input_fd = -1;
-        }
-      });
-    };
-    tryOpen();
-    loop.addTimer(2.0, tryOpen);
-  } else if (options.source == "tcp") {
-    tcp = std::make_unique<sss::transport::TcpClient>(
-        options.tcp,
-        [&](const uint8_t* data, size_t size) {
-          const int64_t now = monotonicUtime();
-          bridge.onBytes(data, size, now, samples);
-          publishAll(now);
-        },
-        [&](sss::transport::LinkState state, const std::string& reason) {
-          if (state == sss::transport::LinkState::kDisconnected) {
-            spdlog::warn("INS link: {}", reason);
-            bridge.onChunkEnd(monotonicUtime(), samples);
-            publishAll(monotonicUtime());
-          } else if (state == sss::transport::LinkState::kConnected) {
-            spdlog::info("INS link: {}", reason);
-          }
-        });
-    loop.addTimer(0.05, [&] {
-      tcp->service(monotonicUtime());
-      if (tcp->fd() != tcp_registered_fd) {
-        if (tcp_registered_fd >= 0) loop.removeFileDescriptor(tcp_registered_fd);
-        tcp_registered_fd = tcp->fd();
-        if (tcp_registered_fd >= 0) loop.addFileDescriptor(tcp_registered_fd, [&] { tcp->onReadable(monotonicUtime()); });
-      }
-    });
-  } else {
-    file.open(options.file, std::ios::binary);
-    if (!file) {
-      spdlog::critical("cannot open INS file '{}'", options.file);
-      return 1;
-    }
+  // The INS bytes: samples go out as they come, or, replaying a file, wait in a queue for the
+  // recorded pace.
+  const bool replay = options.input.source == "file";
+  std::deque<sss::ins::NavSample> replay_queue;
+  sss::transport::ReplayPacer pacer(options.replay_speed);
+  sss::ins::InsInputHooks hooks;
+  hooks.chunk = [&](const sss::ins::InsInputChunk& chunk) {
+    bridge.onBytes(chunk.data, chunk.size, chunk.arrival_us, samples);
+    if (chunk.end_of_file) bridge.finish(chunk.arrival_us, samples);
+    else if (chunk.stream_break) bridge.onChunkEnd(chunk.arrival_us, samples);
+    if (!replay) return publishAll(chunk.arrival_us);
+    replay_queue.insert(replay_queue.end(), samples.begin(), samples.end());
+    samples.clear();
+  };
+  hooks.info = [](const std::string& line) { spdlog::info("{}", line); };
+  hooks.warning = [](const std::string& line) { spdlog::warn("{}", line); };
+  hooks.open_failed = [&](const std::string& error) {
+    if (health.recordError("serial_open", error, sss::core::nowUtime())) spdlog::warn("{}; retrying", error);
+  };
+  sss::ins::InsInputSource input(options.input, hooks);
+  if (const std::string error = input.open(); !error.empty()) {
+    spdlog::critical("{}", error);
+    return 1;
+  }
+  InputOnLoop input_on_loop(input, loop);
+  if (replay) {
     loop.addTimer(0.002, [&] {
-      char chunk[16384];
-      while (!replay_eof && replay_queue.size() < 256) {
-        file.read(chunk, sizeof(chunk));
-        const size_t n = static_cast<size_t>(file.gcount());
-        std::vector<sss::ins::NavSample> read;
-        bridge.onBytes(reinterpret_cast<const uint8_t*>(chunk), n, monotonicUtime(), read);
-        if (n < sizeof(chunk)) {
-          bridge.finish(monotonicUtime(), read);
-          replay_eof = true;
-        }
-        replay_queue.insert(replay_queue.end(), read.begin(), read.end());
-      }
+      while (!input.atEnd() && replay_queue.size() < 256) input.read(0.0);
       const int64_t now = monotonicUtime();
       for (int budget = 500; budget > 0 && !replay_queue.empty() && pacer.due(replay_queue.front().ins.utime_us, now); --budget) {
         samples.push_back(replay_queue.front());
         replay_queue.pop_front();
         publishAll(now);
       }
-      if (replay_eof && replay_queue.empty()) {
-        spdlog::info("replay of '{}' finished: {} epochs", options.file, bridge.assemblerCounters().epochs);
+      if (input.atEnd() && replay_queue.empty()) {
+        spdlog::info("replay of '{}' finished: {} epochs", options.input.file, bridge.assemblerCounters().epochs);
         loop.stop();
       }
     });
   }
   const int code = loop.run();
   saveOdometerIfMoved();
-  if (input_fd >= 0) ::close(input_fd);
-  if (fix_fd >= 0) ::close(fix_fd);
   return code;
 }
