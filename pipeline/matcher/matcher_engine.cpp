@@ -22,11 +22,13 @@ bool wellFormed(const sss::core::Subframe& s) {
 
 void readMatcherEngineOptions(sss::core::ConfigSection& section, MatcherEngineOptions& options) {
   using sss::core::inRange;
+  using sss::core::greaterThan;
   sss::core::ConfigSection overlap = section.section("overlap");
   readOverlapOptions(overlap, options.overlap);
   overlap.rejectUnknownKeys();
   readPairMatcherOptions(section, options.pair);
   section.optional("max_stored_subframes", options.max_stored_subframes, {inRange(2, 100000)});
+  section.optional("max_stored_mib", options.max_stored_mib, {greaterThan(0.0)});
   section.optional("max_association_rounds", options.max_association_rounds, {inRange(0, 10)});
   section.optional("reassociation_translation_m", options.reassociation_translation_m, {inRange(0.0, 1000.0)});
   section.optional("reassociation_rotation_rad", options.reassociation_rotation_rad, {inRange(0.0, 3.2)});
@@ -37,6 +39,7 @@ std::vector<std::string> validateMatcherEngineOptions(const MatcherEngineOptions
   std::vector<std::string> problems = validateOverlapOptions(o.overlap);
   for (const std::string& p : validatePairMatcherOptions(o.pair)) problems.push_back(p);
   if (o.max_stored_subframes < 2) problems.push_back("max_stored_subframes must be >= 2");
+  if (!(o.max_stored_mib > 0.0)) problems.push_back("max_stored_mib must be > 0");
   if (o.max_association_rounds < 0) problems.push_back("max_association_rounds must be >= 0");
   if (!(o.reassociation_translation_m >= 0.0)) problems.push_back("reassociation_translation_m must be >= 0");
   if (!(o.reassociation_rotation_rad >= 0.0)) problems.push_back("reassociation_rotation_rad must be >= 0");
@@ -174,7 +177,9 @@ std::vector<PairOutcome> MatcherEngine::matchNewSubframe(int64_t id, const std::
 
 void MatcherEngine::evictBeyondLimit() {
   // Bounded memory and disk: drop the oldest subframes, their pairs and their files.
-  while (static_cast<int>(stored_.size()) > options_.max_stored_subframes) {
+  const double max_bytes = options_.max_stored_mib * 1024.0 * 1024.0;
+  while (static_cast<int>(stored_.size()) > options_.max_stored_subframes ||
+         (stored_.size() > 2 && static_cast<double>(memoryBytes()) > max_bytes)) {
     const int64_t oldest = stored_.begin()->first;
     stored_.erase(stored_.begin());
     for (auto it = pairs_.begin(); it != pairs_.end();) {

@@ -29,6 +29,10 @@ struct MatcherEngineOptions {
   // Subframes kept for matching (oldest dropped first). A 200-ping subframe of 2 x 1250 bins holds
   // ~2.5 MB: 240 of them (~3.3 h of survey at 50 s each) take ~600 MB.
   int max_stored_subframes = 240;
+  // The same bound in memory, whichever is reached first: a swath that follows the sonar's range
+  // (canonical.swath_from_range) makes every subframe larger (150 m a side: ~5 MB), and the
+  // vehicle's memory does not grow with it. At least two subframes are always kept.
+  double max_stored_mib = 600.0;
   // Paper: 2 rounds of data association with optimised poses after the DR one.
   int max_association_rounds = 2;
   // A pair is re-matched when the optimiser moved its two subframes relative to each other by

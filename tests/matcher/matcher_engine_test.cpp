@@ -130,6 +130,42 @@ TEST(MatcherEngine, StoredSubframesAreBoundedAndMalformedOnesRejected) {
   EXPECT_EQ(engine.counters().subframes_rejected, 2u);
 }
 
+TEST(MatcherEngine, StoredSubframesAreBoundedByMemoryWhateverTheirCount) {
+  const auto& survey = test::threeLineSurvey();
+  ASSERT_GE(survey.subframes.size(), 5u);
+  const auto mib = [](size_t bytes) { return static_cast<double>(bytes) / (1024.0 * 1024.0); };
+  MatcherEngineOptions options;
+  options.overlap.min_overlap_fraction = 0.99;  // no matching: this test is about storage
+  // What the whole survey takes when nothing bounds it, and the largest subframe (a full one).
+  MatcherEngine unbounded(options);
+  for (const auto& s : survey.subframes) unbounded.addSubframe(s);
+  ASSERT_EQ(unbounded.storedSubframes(), survey.subframes.size());
+  MatcherEngine one(options);
+  one.addSubframe(survey.subframes.front());
+  ASSERT_EQ(survey.subframes.front().rows(), 200);
+  const double largest_mib = mib(one.memoryBytes());
+
+  // Half the survey's memory: the count would allow them all, the memory does not.
+  options.max_stored_subframes = 1000;
+  options.max_stored_mib = 0.5 * mib(unbounded.memoryBytes());
+  MatcherEngine engine(options);
+  for (const auto& s : survey.subframes) engine.addSubframe(s);
+  EXPECT_LT(engine.storedSubframes(), survey.subframes.size());
+  EXPECT_EQ(engine.counters().subframes_evicted, survey.subframes.size() - engine.storedSubframes());
+  EXPECT_LE(mib(engine.memoryBytes()), options.max_stored_mib);
+  // Only what had to go went: one more subframe would not have fitted.
+  EXPECT_GT(mib(engine.memoryBytes()) + largest_mib, options.max_stored_mib);
+
+  // A budget below two subframes still keeps two (a pair needs them).
+  options.max_stored_mib = 0.5 * largest_mib;
+  MatcherEngine tight(options);
+  for (const auto& s : survey.subframes) tight.addSubframe(s);
+  EXPECT_EQ(tight.storedSubframes(), 2u);
+
+  options.max_stored_mib = 0.0;
+  EXPECT_THROW(MatcherEngine{options}, std::invalid_argument);
+}
+
 // ---- restarts ---------------------------------------------------------------------------------
 
 namespace fs = std::filesystem;
