@@ -32,10 +32,11 @@ struct CanonicalTransformOptions {
   // the first ping with a pose widens it to the ground range of its last sample (a 120 m range
   // must not be cut at 75 m, where lines 200 m apart would share no pixel). Fixed from then on:
   // every subframe of a mission has the same ground-range axis (the matcher needs that).
-  // Off by default for now: on 3 randomised missions whose lines the 75 m swath cannot pair it
-  // gave one +63 % and one -91 % (far-range closures over rock relief, up to 4 m off and accepted:
-  // the closures' covariance does not yet say how weak the far range is).
-  bool swath_from_range = false;
+  // On by default: over 15 randomised missions it pairs lines the 75 m swath cannot and helps on
+  // balance (README, "Swath"), though far-range closures over rock can still be more wrong than
+  // their covariance says. The matcher's store is bounded in memory (matcher.max_stored_mib), so
+  // the larger subframes cannot outgrow the vehicle.
+  bool swath_from_range = true;
   int max_bins_per_side = 16384;
   // Lambertian correction: divide by cos^2 of the flat-seabed incidence angle, floored here so the
   // nadir (cos -> 1) and grazing (cos -> 0) ends stay finite.
