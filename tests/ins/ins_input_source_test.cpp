@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "pipeline/core/time.hpp"
+#include "tests/support/poll_until.hpp"
 
 namespace sss::ins {
 namespace {
@@ -55,17 +56,7 @@ struct Recorder {
   }
 };
 
-// Calls step until done() or a second has passed (loopback and pseudo-terminals deliver within
-// milliseconds; the second only bounds a failing test).
-template <typename Step, typename Done>
-bool within1s(Step step, Done done) {
-  const int64_t deadline_us = sss::core::monotonicUtime() + 1'000'000;
-  while (!done()) {
-    if (sss::core::monotonicUtime() > deadline_us) return false;
-    step();
-  }
-  return true;
-}
+using sss::test::within1s;
 
 sockaddr_in loopback(int port) {
   sockaddr_in address{};
