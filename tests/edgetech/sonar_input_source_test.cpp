@@ -17,6 +17,7 @@
 
 #include "jsf_test_data.hpp"
 #include "pipeline/core/time.hpp"
+#include "tests/support/loopback_socket.hpp"
 #include "tests/support/poll_until.hpp"
 #include "tests/xtf/xtf_test_data.hpp"
 
@@ -241,33 +242,13 @@ TEST_F(SonarInputFileTest, MissingXtfFileSaysWhichAndWhy) {
   EXPECT_TRUE(recorder.info.empty());
 }
 
-sockaddr_in loopback(int port) {
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_port = htons(static_cast<uint16_t>(port));
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  return address;
-}
-
-int boundPort(int fd) {
-  sockaddr_in address{};
-  socklen_t length = sizeof(address);
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length);
-  return ntohs(address.sin_port);
-}
-
-// A TCP socket bound to a free loopback port (no SO_REUSEADDR: the port stays taken).
-int boundSocket() {
-  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  const sockaddr_in address = loopback(0);
-  EXPECT_EQ(::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)), 0);
-  return fd;
-}
+using sss::test::boundPort;
+using sss::test::boundSocket;
 
 class SonarInputLinkTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    listener_ = boundSocket();
+    listener_ = boundSocket(SOCK_STREAM);
     ASSERT_EQ(::listen(listener_, 4), 0);
     options_.tcp.host = "127.0.0.1";
     options_.tcp.port = boundPort(listener_);
@@ -361,7 +342,7 @@ TEST_F(SonarInputLinkTest, HandsOverALoneSideAfterTheMissingSideTimeout) {
 }
 
 TEST_F(SonarInputLinkTest, RefusedConnectionIsAWarningNamingTheLink) {
-  const int closed = boundSocket();  // bound, not listening: connections are refused
+  const int closed = boundSocket(SOCK_STREAM);  // bound, not listening: connections are refused
   options_.tcp.port = boundPort(closed);
   Recorder recorder;
   SonarInputSource input(options_, health_, recorder.hooks());

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "pipeline/core/time.hpp"
+#include "tests/support/loopback_socket.hpp"
 #include "tests/support/poll_until.hpp"
 
 namespace sss::ins {
@@ -58,28 +59,9 @@ struct Recorder {
 
 using sss::test::within1s;
 
-sockaddr_in loopback(int port) {
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_port = htons(static_cast<uint16_t>(port));
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  return address;
-}
-
-int boundPort(int fd) {
-  sockaddr_in address{};
-  socklen_t length = sizeof(address);
-  ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length);
-  return ntohs(address.sin_port);
-}
-
-// A socket of `type` bound to a free loopback port (no SO_REUSEADDR: the port stays taken).
-int boundSocket(int type) {
-  const int fd = ::socket(AF_INET, type | SOCK_CLOEXEC, 0);
-  const sockaddr_in address = loopback(0);
-  EXPECT_EQ(::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)), 0);
-  return fd;
-}
+using sss::test::boundPort;
+using sss::test::boundSocket;
+using sss::test::loopback;
 
 TEST(InsInputSource, UdpHandsOverEachDatagramWithAStreamBreakAfterIt) {
   InsInputOptions options;
