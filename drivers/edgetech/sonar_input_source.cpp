@@ -57,6 +57,7 @@ std::string SonarInputSource::open() {
     case Kind::kJsfFile:
       jsf_file_.open(options_.replay_file, std::ios::binary);
       if (!jsf_file_.is_open()) return "cannot open sonar file '" + options_.replay_file + "'";
+      jsf_chunk_.resize(1 << 16);
       return {};
     case Kind::kXtfFile: {
       sss::xtf::XtfReaderOptions xtf_options;
@@ -92,14 +93,16 @@ bool SonarInputSource::done() const { return kind_ != Kind::kTcp && end_of_file_
 
 void SonarInputSource::stepJsf() {
   if (!jsf_file_.is_open()) return;
-  // The file goes through the same byte path as TCP.
-  std::vector<char> chunk(1 << 16);
+  // The file goes through the same byte path as TCP, in a buffer allocated once (this runs every
+  // replay_step_period_s).
   while (!end_of_file_ && queue_.size() < options_.replay_read_ahead_pings) {
-    jsf_file_.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+    jsf_file_.read(jsf_chunk_.data(), static_cast<std::streamsize>(jsf_chunk_.size()));
     const size_t n = static_cast<size_t>(jsf_file_.gcount());
     pings_.clear();
-    if (n > 0) driver_.onBytes(reinterpret_cast<const uint8_t*>(chunk.data()), n, nowUtime(), monotonicUtime(), pings_);
-    if (n < chunk.size()) {
+    if (n > 0) {
+      driver_.onBytes(reinterpret_cast<const uint8_t*>(jsf_chunk_.data()), n, nowUtime(), monotonicUtime(), pings_);
+    }
+    if (n < jsf_chunk_.size()) {
       driver_.finish(nowUtime(), monotonicUtime(), pings_);
       end_of_file_ = true;
     }

@@ -95,6 +95,7 @@ class SonarInputSource {
   std::vector<DriverPing> pings_;  // reused between calls
   std::unique_ptr<sss::transport::TcpClient> tcp_;
   std::ifstream jsf_file_;
+  std::vector<char> jsf_chunk_;  // the replay's read buffer (64 KiB once the file is open)
   std::unique_ptr<sss::xtf::XtfReader> xtf_reader_;
   sss::transport::ReplayPacer pacer_;
   std::deque<DriverPing> queue_;  // decoded, waiting for their time
