@@ -678,10 +678,12 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
         }
         if (coherent < o.min_coherent_neighbours) continue;
       }
-      float fr = 0.0f, fc = 0.0f;
+      float fr = 0.0f, fc = 0.0f, curvature_col = 0.0f;
       if (o.subpixel && tr > half && tc > half && tr + 1 < grid_rows - half && tc + 1 < grid_cols - half) {
         fr = parabolaPeak(score_ab(sr, sc, tr - 1, tc), forward.score[k], score_ab(sr, sc, tr + 1, tc));
-        fc = parabolaPeak(score_ab(sr, sc, tr, tc - 1), forward.score[k], score_ab(sr, sc, tr, tc + 1));
+        const float left = score_ab(sr, sc, tr, tc - 1), right = score_ab(sr, sc, tr, tc + 1);
+        fc = parabolaPeak(left, forward.score[k], right);
+        if (left > kNoScore && right > kNoScore) curvature_col = std::max(1e-6f, 2.0f * forward.score[k] - left - right);
       }
       // Grid position -> B pixel through the resampling map (bilinear; the map is smooth).
       const float gr = tr + fr, gc = tc + fc;
@@ -706,6 +708,7 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
       match.row_b = m[0];
       match.col_b = m[1];
       match.zncc = forward.score[k];
+      match.peak_curvature_col = curvature_col;
       matches.push_back(match);
     }
   }

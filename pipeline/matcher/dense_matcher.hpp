@@ -72,6 +72,11 @@ struct Correspondence {
   float row_b = 0.0f;
   float col_b = 0.0f;
   float zncc = 0.0f;
+  // How sharply the ZNCC score falls across range either side of the peak: 2 s(0) - s(-1) - s(+1),
+  // in matching-grid columns (0 when not measured: no sub-pixel step or a peak at the grid's edge).
+  // A sharp peak locates the match in range better than a flat one (measured on simulated
+  // missions: the median range error halves from the flattest to the sharpest quarter).
+  float peak_curvature_col = 0.0f;
 };
 
 // Wall-clock seconds of each stage of one match() call and the pixel counts behind them.

@@ -38,7 +38,33 @@ struct Measurement {
   Eigen::Vector3d landmark_init_a;  // flat-seabed geo-reference in A (frame a)
   Eigen::Vector3d down_a;           // world down in frame a
   double seabed_depth_a_m = 0.0;    // down_a . x of the seabed under A's ping (frame a)
+  double range_sigma_m = 0.0;       // of both slant ranges (rangeSigmasFromPeaks)
+  double peak_curvature_col = 0.0;  // of the match's ZNCC peak across range (0: not measured)
 };
+
+// Each match's slant-range sigma from the sharpness of its ZNCC peak across range: a match located
+// by a sharp peak has a smaller range error than one on a flat peak (curvature k, sigma ~ 1/sqrt(k),
+// the Gauss-Newton precision of a peak's position). Relative to the pair's median curvature, so the
+// median match keeps range_sigma_m and the closure's overall scale (and covariance_scale) holds;
+// within [min, max] of range_sigma_m so no match dominates or vanishes. Matches without a measured
+// curvature keep range_sigma_m.
+void rangeSigmasFromPeaks(std::vector<Measurement>& measurements, const RelativePoseOptions& options) {
+  for (Measurement& m : measurements) m.range_sigma_m = options.range_sigma_m;
+  if (!options.range_sigma_from_peak) return;
+  std::vector<double> curvatures;
+  for (const Measurement& m : measurements)
+    if (m.peak_curvature_col > 0.0) curvatures.push_back(m.peak_curvature_col);
+  if (curvatures.size() < 2) return;
+  auto middle = curvatures.begin() + static_cast<std::ptrdiff_t>(curvatures.size() / 2);
+  std::nth_element(curvatures.begin(), middle, curvatures.end());
+  const double median = *middle;
+  if (!(median > 0.0)) return;
+  for (Measurement& m : measurements) {
+    if (!(m.peak_curvature_col > 0.0)) continue;
+    const double factor = std::sqrt(median / m.peak_curvature_col);
+    m.range_sigma_m = options.range_sigma_m * std::clamp(factor, options.peak_sigma_min_factor, options.peak_sigma_max_factor);
+  }
+}
 
 // The pose of a fractional row: slerp/lerp between the neighbouring pings.
 std::optional<std::pair<Pose, double>> pingAt(const std::vector<Pose>& poses, const std::vector<double>& altitude_m,
@@ -224,7 +250,7 @@ ClusterRobust clusterRobustCovariance(const std::vector<Measurement>& measuremen
     const double* x = landmarks[i].data();
     {
       ceres::AutoDiffCostFunction<BinResidualA, 2, 3> cost(
-          new BinResidualA{m.a, options.range_sigma_m, m.a.slant_range_m * options.beam_width_rad});
+          new BinResidualA{m.a, m.range_sigma_m, m.a.slant_range_m * options.beam_width_rad});
       Eigen::Matrix<double, 2, 3, Eigen::RowMajor> J_l;
       double* jacobians[1] = {J_l.data()};
       const double* parameters[1] = {x};
@@ -235,7 +261,7 @@ ClusterRobust clusterRobustCovariance(const std::vector<Measurement>& measuremen
     }
     {
       ceres::AutoDiffCostFunction<BinResidualB, 2, 6, 3> cost(
-          new BinResidualB{m.b, anchor, options.range_sigma_m, m.b.slant_range_m * options.beam_width_rad});
+          new BinResidualB{m.b, anchor, m.range_sigma_m, m.b.slant_range_m * options.beam_width_rad});
       Eigen::Matrix<double, 2, 6, Eigen::RowMajor> J_p;
       Eigen::Matrix<double, 2, 3, Eigen::RowMajor> J_l;
       double* jacobians[2] = {J_p.data(), J_l.data()};
@@ -338,10 +364,10 @@ Solved solve(const std::vector<Measurement>& measurements, const std::vector<int
       return robust && options.robust_loss_scale > 0.0 ? new ceres::CauchyLoss(options.robust_loss_scale) : nullptr;
     };
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BinResidualA, 2, 3>(new BinResidualA{
-                                 m.a, options.range_sigma_m, m.a.slant_range_m * options.beam_width_rad}),
+                                 m.a, m.range_sigma_m, m.a.slant_range_m * options.beam_width_rad}),
                              loss(), x);
     problem.AddResidualBlock(new ceres::AutoDiffCostFunction<BinResidualB, 2, 6, 3>(new BinResidualB{
-                                 m.b, &anchor, options.range_sigma_m, m.b.slant_range_m * options.beam_width_rad}),
+                                 m.b, &anchor, m.range_sigma_m, m.b.slant_range_m * options.beam_width_rad}),
                              loss(), delta, x);
     if (options.use_seabed_prior) {
       problem.AddResidualBlock(new ceres::AutoDiffCostFunction<SeabedResidual, 1, 3>(
@@ -377,10 +403,10 @@ Solved solve(const std::vector<Measurement>& measurements, const std::vector<int
     for (size_t i = 0; i < subset.size(); ++i) {
       const Measurement& m = measurements[subset[i]];
       double r[2];
-      BinResidualA{m.a, options.range_sigma_m, m.a.slant_range_m * options.beam_width_rad}(landmarks[i].data(), r);
+      BinResidualA{m.a, m.range_sigma_m, m.a.slant_range_m * options.beam_width_rad}(landmarks[i].data(), r);
       range_sum += r[0] * r[0];
       plane_sum += r[1] * r[1];
-      BinResidualB{m.b, &anchor, options.range_sigma_m, m.b.slant_range_m * options.beam_width_rad}(
+      BinResidualB{m.b, &anchor, m.range_sigma_m, m.b.slant_range_m * options.beam_width_rad}(
           delta, landmarks[i].data(), r);
       range_sum += r[0] * r[0];
       plane_sum += r[1] * r[1];
@@ -453,8 +479,8 @@ Score scoreHypothesis(const std::vector<Measurement>& measurements, const std::v
         const Eigen::Vector3d d = x - bins[o].sonar;
         const double range = d.norm();
         const double plane_sigma = ranges[o] * options.beam_width_rad;
-        r(2 * o) = (range - ranges[o]) / options.range_sigma_m;  // paper eq. (1), (4)
-        J.row(2 * o) = d.transpose() / (range * options.range_sigma_m);
+        r(2 * o) = (range - ranges[o]) / m.range_sigma_m;  // paper eq. (1), (4)
+        J.row(2 * o) = d.transpose() / (range * m.range_sigma_m);
         r(2 * o + 1) = bins[o].normal.dot(d) / plane_sigma;
         J.row(2 * o + 1) = bins[o].normal.transpose() / plane_sigma;
       }
@@ -607,9 +633,11 @@ RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const Re
         m.seabed_depth_a_m += u * (depth_b - m.seabed_depth_a_m);
       }
     }
+    m.peak_curvature_col = c.peak_curvature_col;
     measurements.push_back(m);
     match_index.push_back(static_cast<int>(k));
   }
+  rangeSigmasFromPeaks(measurements, options);
   const int n = static_cast<int>(measurements.size());
   if (n < std::max(options.ransac_subset, options.min_inliers)) {
     std::ostringstream text;
@@ -760,60 +788,6 @@ RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const Re
   result.accepted = result.reason.empty();
   result.seconds = elapsed();
   return result;
-}
-
-std::vector<std::string> validateRelativePoseOptions(const RelativePoseOptions& o) {
-  std::vector<std::string> problems;
-  if (!(o.range_sigma_m > 0.0)) problems.push_back("range_sigma_m must be > 0");
-  if (!(o.beam_width_rad > 0.0)) problems.push_back("beam_width_rad must be > 0");
-  if (!(o.seabed_sigma_m > 0.0)) problems.push_back("seabed_sigma_m must be > 0");
-  if (o.ransac_subset < 3) problems.push_back("ransac_subset must be >= 3");
-  if (o.ransac_iterations < 1) problems.push_back("ransac_iterations must be >= 1");
-  if (o.ransac_score_sample < 1) problems.push_back("ransac_score_sample must be >= 1");
-  if (o.max_correspondences < o.ransac_subset) problems.push_back("max_correspondences must be >= ransac_subset");
-  if (!(o.inlier_threshold_sigma > 0.0)) problems.push_back("inlier_threshold_sigma must be > 0");
-  if (!(o.robust_loss_scale >= 0.0)) problems.push_back("robust_loss_scale must be >= 0 (0: plain least squares)");
-  if (o.min_inliers < 0) problems.push_back("min_inliers must be >= 0");
-  if (o.min_inlier_fraction < 0.0 || o.min_inlier_fraction > 1.0) problems.push_back("min_inlier_fraction in [0, 1]");
-  if (!(o.max_mean_cost > 0.0)) problems.push_back("max_mean_cost must be > 0");
-  if (o.max_solver_iterations < 1) problems.push_back("max_solver_iterations must be >= 1");
-  if (!(o.time_limit_s >= 0.0)) problems.push_back("time_limit_s must be >= 0 (0: no wall-clock cap)");
-  if (!(o.covariance_cluster_m >= 0.0))
-    problems.push_back("covariance_cluster_m must be >= 0 (0: Ceres' covariance with the assumed sigmas)");
-  if (o.min_covariance_clusters < 2) problems.push_back("min_covariance_clusters must be >= 2");
-  return problems;
-}
-
-void readRelativePoseOptions(sss::core::ConfigSection& section, RelativePoseOptions& options) {
-  using sss::core::atLeast;
-  using sss::core::greaterThan;
-  using sss::core::inRange;
-  section.optional("range_sigma_m", options.range_sigma_m, {greaterThan(0.0)});
-  section.optional("beam_width_rad", options.beam_width_rad, {inRange(1e-5, 1.0)});
-  section.optional("seabed_sigma_m", options.seabed_sigma_m, {greaterThan(0.0)});
-  section.optional("use_seabed_prior", options.use_seabed_prior);
-  section.optional("ransac_subset", options.ransac_subset, {inRange(3, 100)});
-  section.optional("ransac_iterations", options.ransac_iterations, {inRange(1, 100000)});
-  section.optional("max_correspondences", options.max_correspondences, {inRange(3, 100000)});
-  section.optional("ransac_score_sample", options.ransac_score_sample, {inRange(1, 1000000)});
-  section.optional("inlier_threshold_sigma", options.inlier_threshold_sigma, {greaterThan(0.0)});
-  section.optional("robust_loss_scale", options.robust_loss_scale, {sss::core::atLeast(0.0)});
-  section.optional("min_inliers", options.min_inliers, {atLeast(0)});
-  section.optional("min_inlier_fraction", options.min_inlier_fraction, {inRange(0.0, 1.0)});
-  section.optional("max_mean_cost", options.max_mean_cost, {greaterThan(0.0)});
-  section.optional("max_solver_iterations", options.max_solver_iterations, {inRange(1, 1000)});
-  int seed = static_cast<int>(options.seed);
-  section.optional("seed", seed, {atLeast(0)});
-  section.optional("seabed_between_lines", options.seabed_between_lines);
-  options.seed = static_cast<std::uint64_t>(seed);
-  section.optional("time_limit_s", options.time_limit_s, {sss::core::atLeast(0.0)});
-  section.optional("covariance_cluster_m", options.covariance_cluster_m, {sss::core::atLeast(0.0)});
-  section.optional("min_covariance_clusters", options.min_covariance_clusters, {inRange(2, 100000)});
-  section.optional("seabed_relief_covariance", options.seabed_relief_covariance);
-  section.optional("seabed_tilt_covariance", options.seabed_tilt_covariance);
-  if (options.max_correspondences < options.ransac_subset)
-    section.addProblem("max_correspondences", std::to_string(options.max_correspondences),
-                       "must be >= ransac_subset (" + std::to_string(options.ransac_subset) + ")");
 }
 
 }  // namespace sss::matcher

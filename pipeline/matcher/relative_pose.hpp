@@ -18,6 +18,12 @@ namespace sss::matcher {
 struct RelativePoseOptions {
   double range_sigma_m = 0.1;       // sigma_r of a slant range (about a bin), paper eq. (4)
   double beam_width_rad = 0.0087;   // alpha: plane residual sigma = r * alpha, paper eq. (4)
+  // Each match's range sigma scaled by its ZNCC peak's sharpness across range, relative to the
+  // pair's median (Correspondence::peak_curvature_col; factor sqrt(median / curvature) kept within
+  // [peak_sigma_min_factor, peak_sigma_max_factor]). false: range_sigma_m for every match.
+  bool range_sigma_from_peak = true;
+  double peak_sigma_min_factor = 0.5;
+  double peak_sigma_max_factor = 3.0;
   // Landmark depth prior: the seabed under A's ping from altimetry (sonar depth + altitude).
   // Without it a lateral offset between two lines on a flat seabed is absorbed by landmark depths.
   double seabed_sigma_m = 0.3;
