@@ -29,6 +29,9 @@ struct NavSample {
   double altitude_m = -1.0;        // body above seabed (DVL)
   bool altitude_valid = false;     // valid and not stale
   double distance_travelled_m = 0.0;
+  // The INS's own 1-sigma accuracy of position_ned_m, north and east (0: not reported).
+  double position_std_north_m = 0.0;
+  double position_std_east_m = 0.0;
 };
 
 // The DR pose of a nav sample: T_world_body from its local NED position and attitude.

@@ -1,6 +1,8 @@
 // LCM translation of pings and nav. See sensor_messages.hpp.
 #include "pipeline/messages/sensor_messages.hpp"
 
+#include <cmath>
+
 namespace sss::messages {
 
 using sss::core::NavSample;
@@ -35,6 +37,9 @@ NavSample fromNavMessage(const sss_msgs::nav_t& message) {
   nav.altitude_valid = (message.validity & sss_msgs::nav_t::VALID_ALTITUDE) &&
                        !(message.validity & sss_msgs::nav_t::STALE_ALTITUDE);
   nav.distance_travelled_m = message.distance_travelled_m;
+  auto reportedStd = [](double std_m) { return std::isfinite(std_m) && std_m > 0.0 ? std_m : 0.0; };
+  nav.position_std_north_m = reportedStd(message.position_std_ned_m[0]);
+  nav.position_std_east_m = reportedStd(message.position_std_ned_m[1]);
   return nav;
 }
 

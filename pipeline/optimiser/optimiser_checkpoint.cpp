@@ -441,6 +441,9 @@ Status OptimiserEngine::loadCheckpoint(const std::string& path) {
                        " and " + std::to_string(journal.correspondence_records));
 
   graph_ = std::move(graph);
+  // The anchor was decided with the first node (the graph's checkpoint keeps its sigma).
+  anchor_decided_ = graph_.numNodes() > 0;
+  start_accuracy_.clear();
   stored_ = std::move(stored);
   correspondences_ = std::move(correspondences);
   waiting_ = std::move(waiting);

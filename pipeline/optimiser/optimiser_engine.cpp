@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <optional>
 #include <set>
@@ -121,6 +122,7 @@ Status OptimiserEngine::addSubframe(const sss::core::Subframe& subframe) {
     return added;
   }
   if (!notice.empty()) ++counters_.odometer_resets;
+  if (graph_.numNodes() == 1) decideAnchor();
   odometer_offset_m_ = offset_m;
   last_input_distance_m_ = input_m;
   StoredSubframe& stored = stored_[subframe.id];
@@ -334,6 +336,45 @@ size_t OptimiserEngine::memoryBytes() const {
     bytes += stored.correspondences.size() * sizeof(sss::core::ClosureCorrespondence);
   }
   return bytes + graph_.numNodes() * 1024;  // graph: ~1 kB per node (estimates, covariances, factors)
+}
+
+void OptimiserEngine::addNavAccuracy(const NavAccuracy& accuracy) {
+  if (anchor_decided_) return;
+  const bool reported = std::isfinite(accuracy.north_std_m) && std::isfinite(accuracy.east_std_m) &&
+                        accuracy.north_std_m > 0.0 && accuracy.east_std_m > 0.0;
+  if (!reported) return;
+  // One per second is plenty (the INS's accuracy changes slowly); 20 min of them at most, oldest
+  // dropped: the first subframe's centre is well within that of its last ping.
+  constexpr int64_t kSpacingUs = 1'000'000;
+  constexpr size_t kMaxKept = 1200;
+  if (!start_accuracy_.empty() && accuracy.utime_us < start_accuracy_.back().utime_us + kSpacingUs &&
+      accuracy.utime_us >= start_accuracy_.back().utime_us)
+    return;
+  start_accuracy_.push_back(accuracy);
+  if (start_accuracy_.size() > kMaxKept) start_accuracy_.pop_front();
+  if (graph_.numNodes() > 0) decideAnchor();
+}
+
+void OptimiserEngine::decideAnchor() {
+  if (anchor_decided_ || graph_.numNodes() == 0) return;
+  const int64_t node_us = *graph_.firstNodeUtime();
+  const int64_t max_gap_us = static_cast<int64_t>(kAnchorAccuracyMaxGapS * 1e6);
+  const NavAccuracy* nearest = nullptr;
+  bool after_node = false;
+  for (const NavAccuracy& a : start_accuracy_) {
+    if (a.utime_us >= node_us) after_node = true;
+    if (!nearest || std::llabs(a.utime_us - node_us) < std::llabs(nearest->utime_us - node_us)) nearest = &a;
+  }
+  // A report after the node's time: none nearer can come (nav arrives in time order).
+  if (!after_node) return;
+  if (nearest && std::llabs(nearest->utime_us - node_us) <= max_gap_us) {
+    // Refused only when no report came after the first node's time for a whole window (it has
+    // been marginalised): then the anchor keeps first_node_sigma_m.
+    (void)graph_.setFirstNodeHorizontalSigma(nearest->north_std_m, nearest->east_std_m);
+  }
+  anchor_decided_ = true;
+  start_accuracy_.clear();
+  start_accuracy_.shrink_to_fit();
 }
 
 }  // namespace sss::optimiser

@@ -95,6 +95,14 @@ class OptimiserEngine {
   // An absolute position fix (GNSS, USBL) with the DR position and distance at its time, in the
   // navigation's own distance (the odometer offset is added here, as for subframes).
   Status addFix(AbsoluteFix fix);
+  // The INS's reported position accuracy (every nav sample may carry one). The report nearest the
+  // first node's time (within kAnchorAccuracyMaxGapS) widens that node's anchor to it
+  // (SlidingWindowPoseGraph::setFirstNodeHorizontalSigma): how well the INS knew where the survey
+  // started. Reports without a value are ignored; before the first node one per second is kept.
+  void addNavAccuracy(const NavAccuracy& accuracy);
+  static constexpr double kAnchorAccuracyMaxGapS = 30.0;
+  // True once the first node's anchor is decided (further reports are ignored).
+  bool anchorDecided() const { return anchor_decided_; }
 
   // Decides pending closures and solves the window (see SlidingWindowPoseGraph::optimize).
   UpdateReport update();
@@ -162,6 +170,9 @@ class OptimiserEngine {
   };
 
   Status addToGraph(const sss::core::LoopClosure& closure);
+  // Gives the graph the INS accuracy nearest its first node's time, once one is on both sides of it
+  // or the nearest is within kAnchorAccuracyMaxGapS and no nearer one can come.
+  void decideAnchor();
   // World-frame correction of a stored subframe's pings (rigid, as the matcher applies it).
   sss::core::Pose subframeCorrection(int64_t id, const StoredSubframe& stored, bool use_dr) const;
 
@@ -170,6 +181,8 @@ class OptimiserEngine {
   std::map<int64_t, StoredSubframe> stored_;
   std::map<std::pair<int64_t, int64_t>, StoredCorrespondences> correspondences_;
   std::deque<sss::core::LoopClosure> waiting_;
+  std::deque<NavAccuracy> start_accuracy_;  // INS accuracy reports until the anchor is decided
+  bool anchor_decided_ = false;
   int64_t newest_subframe_id_ = -1;
   bool new_input_ = false;
   OptimiserEngineCounters counters_;

@@ -272,6 +272,7 @@ int main(int argc, char** argv) {
     const int64_t arrival = sss::core::monotonicUtime();
     const sss::core::NavSample nav = sss::messages::fromNavMessage(message);
     const sss::optimiser::NavCorrection answer = corrector.correct(nav, *worker.snapshot());
+    if (nav.position_valid) worker.addNavAccuracy({nav.utime_us, nav.position_std_north_m, nav.position_std_east_m});
     if (answer.verdict == sss::optimiser::NavVerdict::kBadSample) {
       if (health.recordError("bad_nav", "nav sample with non-finite pose or no time", sss::core::nowUtime()))
         spdlog::warn("nav sample rejected (non-finite pose or no time); further ones are counted in SSS_STATUS");

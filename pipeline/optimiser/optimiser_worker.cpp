@@ -86,6 +86,13 @@ void OptimiserWorker::addFix(AbsoluteFix fix) {
   wake_.notify_one();
 }
 
+void OptimiserWorker::addNavAccuracy(const NavAccuracy& accuracy) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (anchor_decided_ || (last_nav_accuracy_us_ >= 0 && accuracy.utime_us < last_nav_accuracy_us_ + 1'000'000)) return;
+  last_nav_accuracy_us_ = accuracy.utime_us;
+  queued_.nav_accuracy.push_back(accuracy);  // no wake: it waits for the next subframe or closure
+}
+
 void OptimiserWorker::requestProducts() {
   std::lock_guard<std::mutex> lock(mutex_);
   queued_.products = true;
@@ -117,6 +124,7 @@ OptimiserWorkerResults OptimiserWorker::takeResults() {
 }
 
 void OptimiserWorker::take(const Batch& batch, std::vector<std::string>& messages) {
+  for (const NavAccuracy& accuracy : batch.nav_accuracy) engine_.addNavAccuracy(accuracy);
   for (const sss::core::Subframe& subframe : batch.subframes) {
     const Status status = engine_.addSubframe(subframe);
     if (!status.ok) {
@@ -189,6 +197,10 @@ void OptimiserWorker::run() {
     }
     std::vector<std::string> messages;
     take(batch, messages);
+    if (engine_.anchorDecided()) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      anchor_decided_ = true;
+    }
     const double now_s = 1e-6 * static_cast<double>(sss::core::monotonicUtime());
     bool updated = false;
     if (batch.products) {

@@ -82,6 +82,9 @@ class OptimiserWorker {
   void addSubframe(sss::core::Subframe subframe);
   void addLoopClosure(sss::core::LoopClosure closure);
   void addFix(AbsoluteFix fix);
+  // The INS's reported accuracy (OptimiserEngine::addNavAccuracy); nav comes at up to 200 Hz, so at
+  // most one per second is queued, and none once the engine has decided the first node's anchor.
+  void addNavAccuracy(const NavAccuracy& accuracy);
   void requestProducts();
   // The navigation's origin (SSS_NAV), which geo-references the products.
   void setOrigin(const sss::core::MissionOrigin& origin);
@@ -100,6 +103,7 @@ class OptimiserWorker {
     std::deque<sss::core::Subframe> subframes;
     std::deque<sss::core::LoopClosure> closures;
     std::deque<AbsoluteFix> fixes;
+    std::deque<NavAccuracy> nav_accuracy;
     bool products = false;
   };
   void run();
@@ -119,6 +123,8 @@ class OptimiserWorker {
   Batch queued_;
   bool stop_ = false;
   std::optional<sss::core::MissionOrigin> origin_;
+  int64_t last_nav_accuracy_us_ = -1;  // of the last one queued
+  bool anchor_decided_ = false;        // the engine's, as of its last batch
   std::shared_ptr<const SlidingWindowPoseGraph> snapshot_;
   OptimiserWorkerResults results_;
   std::thread thread_;

@@ -179,16 +179,30 @@ Status SlidingWindowPoseGraph::addNode(int64_t subframe_id, int64_t utime_us, co
     }
   } else {
     node.estimate = node.dr;
-    Vector6d diagonal;
-    const double sm = options_.first_node_sigma_m * options_.first_node_sigma_m;
-    const double sr = options_.first_node_sigma_rad * options_.first_node_sigma_rad;
-    diagonal << sm, sm, sm, sr, sr, sr;
-    node.covariance = diagonal.asDiagonal();
+    const Matrix6d sqrt_information = firstNodeSqrtInformation(options_, first_node_ins_sigma_ne_m_);
+    node.covariance = (sqrt_information.transpose() * sqrt_information).inverse();
     node.has_covariance = true;
   }
   index_of_[subframe_id] = static_cast<int>(nodes_.size());
   nodes_.push_back(std::move(node));
   ++counters_.nodes_added;
+  return Status::success();
+}
+
+Status SlidingWindowPoseGraph::setFirstNodeHorizontalSigma(double north_m, double east_m) {
+  if (!(std::isfinite(north_m) && std::isfinite(east_m) && north_m >= 0.0 && east_m >= 0.0))
+    return Status::error("the INS's start accuracy must be finite and >= 0 (north " + std::to_string(north_m) +
+                         " m, east " + std::to_string(east_m) + " m); the anchor keeps first_node_sigma_m");
+  // Once the first node has left the window its anchor is part of the marginalisation prior: a
+  // different sigma now would make the window and the end-of-mission smoothing disagree.
+  if (first_active_ > 0)
+    return Status::error("the first node is already marginalised; its anchor can no longer change");
+  first_node_ins_sigma_ne_m_ = Eigen::Vector2d(north_m, east_m);
+  if (nodes_.size() == 1) {
+    // A lone first node's covariance is its anchor's (every solve recomputes the covariances).
+    const Matrix6d sqrt_information = firstNodeSqrtInformation(options_, first_node_ins_sigma_ne_m_);
+    nodes_[0].covariance = (sqrt_information.transpose() * sqrt_information).inverse();
+  }
   return Status::success();
 }
 
@@ -437,7 +451,7 @@ Matrix6d SlidingWindowPoseGraph::closureSqrtInformation(const Closure& c) const 
 ceres::CostFunction* SlidingWindowPoseGraph::makeCost(const Factor& f) const {
   switch (f.kind) {
     case FactorKind::kFirstNode:
-      return PosePriorError::create(firstNodePrior(), firstNodeSqrtInformation(options_));
+      return PosePriorError::create(firstNodePrior(), firstNodeSqrtInformation(options_, first_node_ins_sigma_ne_m_));
     case FactorKind::kInsAbsolute: {
       const Eigen::Vector4d w = insAbsoluteWeights(options_);
       if (calibration_.estimated) {

@@ -61,6 +61,10 @@ struct PoseGraphOptions {
   // ---- anchor: the first node's DR pose fixes the gauge --------------------------------------------
   double first_node_sigma_m = 0.1;
   double first_node_sigma_rad = 0.001;
+  // Widen the horizontal anchor to the INS's own reported position accuracy at the first node
+  // (setFirstNodeHorizontalSigma). Off for an INS whose reported accuracy is not to be trusted:
+  // the anchor is then first_node_sigma_m alone.
+  bool first_node_sigma_from_ins = true;
 
   // ---- loop closures ------------------------------------------------------------------------------
   std::string robust_loss = "cauchy";  // "cauchy", "huber" or "none", on the whitened closure residual
@@ -184,6 +188,14 @@ struct LoopClosure {
   int association_round = 0;  // a newer round of the same pair supersedes the older closure
   int num_inliers = 0;
   double total_cost = 0.0;
+};
+
+// The INS's own 1-sigma accuracy of its horizontal position at a time (SSS_NAV's
+// position_std_ned_m; 0 or not finite: not reported).
+struct NavAccuracy {
+  int64_t utime_us = 0;
+  double north_std_m = 0.0;
+  double east_std_m = 0.0;
 };
 
 // An absolute horizontal position fix in the local NED world (GNSS at the surface, USBL).
@@ -353,6 +365,16 @@ class SlidingWindowPoseGraph {
   // mission start. Nodes must come in time order with unique ids; O(1), no solve.
   Status addNode(int64_t subframe_id, int64_t utime_us, const sss::core::Pose& T_world_body_dr,
                  double distance_travelled_m);
+  // The INS's own 1-sigma accuracy of its position, north and east, at the first node (what it
+  // reports, e.g. a GNSS-aided start before the dive). The anchor that fixes the survey's position
+  // widens to it (never below first_node_sigma_m), so absolute fixes may move the survey's start as
+  // far as the INS was unsure of it instead of bending the track. Without fixes it changes only the
+  // reported absolute covariances (the anchor is the one thing that places the survey). Refused
+  // for a negative or non-finite sigma, and once the first node is marginalised (its anchor is
+  // then part of the prior). May come before the first node.
+  Status setFirstNodeHorizontalSigma(double north_m, double east_m);
+  // What setFirstNodeHorizontalSigma set (zero: not set).
+  const Eigen::Vector2d& firstNodeInsSigma() const { return first_node_ins_sigma_ne_m_; }
   // Queues a closure for the next optimize(); refused (with the reason) when an id is unknown, the
   // input is not finite, the covariance is not positive definite or it has too few inliers. A
   // closure to a marginalised node acts through that node held constant (see pose_graph.cpp); one
@@ -378,6 +400,9 @@ class SlidingWindowPoseGraph {
   std::vector<NodeState> nodes() const;
   std::optional<NodeState> newestNode() const;  // O(1)
   size_t numNodes() const { return nodes_.size(); }
+  std::optional<int64_t> firstNodeUtime() const {  // O(1)
+    return nodes_.empty() ? std::nullopt : std::optional<int64_t>(nodes_.front().utime_us);
+  }
   std::vector<ClosureRecord> closures() const;  // in arrival order
   std::vector<FixRecord> fixes() const;         // in arrival order, with residuals at the estimate
   const FixCounters& fixCounters() const { return fix_counters_; }
@@ -541,6 +566,7 @@ class SlidingWindowPoseGraph {
   FixCounters fix_counters_;
   int64_t newest_accepted_fix_utime_us_ = -1;
   int64_t calibration_utime_us_ = -1;  // newest node of the last full smoothing that estimated the calibration
+  Eigen::Vector2d first_node_ins_sigma_ne_m_ = Eigen::Vector2d::Zero();  // setFirstNodeHorizontalSigma
   std::map<std::pair<int64_t, int64_t>, int> latest_for_pair_;  // (smaller id, larger id) -> closure
   std::map<std::pair<int, int>, bool> pcm_cache_;               // pair consistency within the horizon
   int pcm_horizon_start_ = 0;  // closures before it are decided for good

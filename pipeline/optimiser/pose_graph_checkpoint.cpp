@@ -25,7 +25,8 @@ constexpr const char* kMagic = "sss-pose-graph-checkpoint";
 // 5 adds the DR calibration; older files restore without one (not estimated).
 // 6 adds when the calibration was last estimated and whether the DVL scale was part of it; older
 // files re-estimate it at the next update and take the scale as estimated with the rest.
-constexpr int kVersion = 6;
+// 7 adds the INS's start accuracy (the first node's anchor); older files restore without it.
+constexpr int kVersion = 7;
 constexpr size_t kMaxFileBytes = size_t{1} << 31;  // 2 GiB: far above any mission
 
 using checkpoint::TextReader;
@@ -140,6 +141,10 @@ std::string SlidingWindowPoseGraph::checkpointText() const {
   for (int i = 0; i < 4; ++i) w.real(c.sigma(i));
   w.integer(calibration_utime_us_);
   w.integer(c.scale_estimated ? 1 : 0);
+  w.endLine();
+  w.word("anchor");
+  w.real(first_node_ins_sigma_ne_m_(0));
+  w.real(first_node_ins_sigma_ne_m_(1));
   w.endLine();
   const WindowStats& s = window_stats_;
   w.word("window");
@@ -336,6 +341,11 @@ Status SlidingWindowPoseGraph::restoreCheckpointText(const std::string& text) {
       return fail("bad calibration record (time, scale)");
     c.estimated = estimated == 1;
     c.scale_estimated = scale_estimated == 1;
+  }
+  if (version >= 7) {
+    Eigen::Vector2d& sigma = g.first_node_ins_sigma_ne_m_;
+    if (!r.expect("anchor") || !r.finite(sigma(0)) || !r.finite(sigma(1)) || sigma(0) < 0.0 || sigma(1) < 0.0)
+      return fail("bad anchor record");
   }
   WindowStats& s = g.window_stats_;
   if (!r.expect("window")) return fail("bad window record");

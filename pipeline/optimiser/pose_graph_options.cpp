@@ -88,6 +88,7 @@ void readPoseGraphOptions(sss::core::ConfigSection& section, PoseGraphOptions& o
   section.optional("absolute_heading_sigma_rad", options.absolute_heading_sigma_rad, {atLeast(0.0)});
   section.optional("first_node_sigma_m", options.first_node_sigma_m, {greaterThan(0.0)});
   section.optional("first_node_sigma_rad", options.first_node_sigma_rad, {greaterThan(0.0)});
+  section.optional("first_node_sigma_from_ins", options.first_node_sigma_from_ins);
   section.optional("robust_loss", options.robust_loss, {sss::core::oneOf({"cauchy", "huber", "none"})});
   section.optional("robust_loss_scale", options.robust_loss_scale, {greaterThan(0.0)});
   section.optional("min_closure_inliers", options.min_closure_inliers, {atLeast(0)});

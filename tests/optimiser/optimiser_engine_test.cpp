@@ -408,5 +408,47 @@ TEST(OptimiserEngineOdometer, RestartFromACheckpointKeepsTheOffset) {
   }
 }
 
+// ---- the first node's anchor from the INS's reported accuracy ------------------------------------
+
+// Nav reports the INS's accuracy before and after the first subframe's centre ping (as it does:
+// nav runs ahead of the subframes): the one nearest the centre sets the anchor; reports without a
+// value, and a report more than 30 s away from the centre, do not.
+TEST(OptimiserEngineAnchor, TheInsAccuracyNearestTheFirstNodeWidensItsAnchor) {
+  const Scenario s = makeScenario(-1);
+  const int64_t centre_us = s.subframes[0].pings[s.subframes[0].centre_ping_index].utime_us;
+  {
+    OptimiserEngine engine(engineOptions());
+    engine.addNavAccuracy({centre_us - 20'000'000, 1.0, 1.0});
+    engine.addNavAccuracy({centre_us - 2'000'000, 2.5, 1.5});  // nearest
+    engine.addNavAccuracy({centre_us - 1'500'000, 9.0, 9.0});  // within a second of the last: not kept
+    engine.addNavAccuracy({centre_us + 5'000'000, 3.0, 3.0});
+    engine.addNavAccuracy({centre_us + 7'000'000, 0.0, 0.0});  // not reported
+    EXPECT_FALSE(engine.anchorDecided());
+    ASSERT_TRUE(engine.addSubframe(s.subframes[0]).ok);
+    EXPECT_TRUE(engine.anchorDecided());
+    EXPECT_EQ(engine.graph().firstNodeInsSigma(), Eigen::Vector2d(2.5, 1.5));
+    engine.addNavAccuracy({centre_us + 9'000'000, 6.0, 6.0});  // decided: ignored
+    EXPECT_EQ(engine.graph().firstNodeInsSigma(), Eigen::Vector2d(2.5, 1.5));
+  }
+  {
+    // Only a report after the centre, arriving after the subframe: used when it comes.
+    OptimiserEngine engine(engineOptions());
+    ASSERT_TRUE(engine.addSubframe(s.subframes[0]).ok);
+    EXPECT_FALSE(engine.anchorDecided());
+    engine.addNavAccuracy({centre_us + 1'000'000, 0.8, 0.7});
+    EXPECT_TRUE(engine.anchorDecided());
+    EXPECT_EQ(engine.graph().firstNodeInsSigma(), Eigen::Vector2d(0.8, 0.7));
+  }
+  {
+    // Too far from the centre (an INS that stopped reporting long before): first_node_sigma_m stays.
+    OptimiserEngine engine(engineOptions());
+    engine.addNavAccuracy({centre_us - 60'000'000, 5.0, 5.0});
+    engine.addNavAccuracy({centre_us + 45'000'000, 5.0, 5.0});
+    ASSERT_TRUE(engine.addSubframe(s.subframes[0]).ok);
+    EXPECT_TRUE(engine.anchorDecided());
+    EXPECT_EQ(engine.graph().firstNodeInsSigma(), Eigen::Vector2d::Zero());
+  }
+}
+
 }  // namespace
 }  // namespace sss::optimiser

@@ -178,6 +178,28 @@ TEST(OptimiserWorker, UpdatesAtMostOncePerPeriodAndFinishTakesWhatIsQueued) {
   EXPECT_DOUBLE_EQ(recorder.products_origin->latitude_deg, 58.25);
 }
 
+// Nav's accuracy reports (200 Hz on the vehicle) reach the engine with the next batch, at most
+// one per second, and the first node's anchor takes the one nearest its centre.
+TEST(OptimiserWorker, PassesTheInsAccuracyOnForTheFirstNodesAnchor) {
+  const Scenario s = makeScenario();
+  OptimiserEngine engine(engineOptions());
+  Recorder recorder;
+  OptimiserWorker worker(engine, {0.0, ""}, recorder.hooks());
+  worker.start();
+  const int64_t centre_us = s.subframes[0].pings[s.subframes[0].centre_ping_index].utime_us;
+  for (int64_t t_us = centre_us - 10'000'000; t_us <= centre_us + 10'000'000; t_us += 5'000) {
+    // 200 Hz; the accuracy worsens by 1 cm a second, 1.23 m at the centre.
+    const double std_m = 1.23 + 0.01 * 1e-6 * static_cast<double>(t_us - centre_us);
+    worker.addNavAccuracy({t_us, std_m, 0.5 * std_m});
+  }
+  worker.addSubframe(s.subframes[0]);
+  waitForNodes(worker, recorder, 1);
+  worker.finish();
+  EXPECT_TRUE(engine.anchorDecided());
+  EXPECT_NEAR(engine.graph().firstNodeInsSigma().x(), 1.23, 1e-9);
+  EXPECT_NEAR(engine.graph().firstNodeInsSigma().y(), 0.615, 1e-9);
+}
+
 TEST(OptimiserWorker, WritesACheckpointAfterEveryUpdateAndTheProductsOnRequest) {
   const Scenario s = makeScenario();
   const std::string checkpoint = temporaryPath("checkpoint");

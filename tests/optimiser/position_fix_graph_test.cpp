@@ -183,10 +183,10 @@ TEST(PositionFixGraph, CheckpointCarriesTheFixes) {
       ASSERT_TRUE(plain.optimize().ok);
     }
     std::string version_3 = plain.checkpointText();
-    const std::string header = "sss-pose-graph-checkpoint 6";
+    const std::string header = "sss-pose-graph-checkpoint 7";
     ASSERT_EQ(version_3.rfind(header, 0), 0u);
     version_3.replace(0, header.size(), "sss-pose-graph-checkpoint 3");
-    for (const char* newer : {"\nfixes ", "\ncalibration "}) {
+    for (const char* newer : {"\nfixes ", "\ncalibration ", "\nanchor "}) {
       const size_t record = version_3.find(newer);
       ASSERT_NE(record, std::string::npos) << newer;
       version_3.erase(record, version_3.find('\n', record + 1) - record);
@@ -206,6 +206,70 @@ TEST(PositionFixGraph, CheckpointCarriesTheFixes) {
   }
   const auto a = estimates(graph), b = estimates(restored);
   for (size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].translation, b[i].translation) << i;
+}
+
+// The INS knew where the survey started only to a few metres (its reported accuracy), and DR's
+// start is 5 m off the truth. With the anchor at first_node_sigma_m (0.1 m) the fixes cannot move
+// the start: the first one is gated out and the survey stays shifted. With the anchor at the INS's
+// reported 4 m the fixes bring the whole survey back. Without fixes the anchor changes nothing but
+// the reported covariance.
+TEST(PositionFixGraph, FirstNodeAnchorFollowsTheInsAccuracy) {
+  synthetic::Mission mission = synthetic::makeLawnmowerMission(missionOptions(3));
+  const Eigen::Vector3d start_error_m(4.0, -3.0, 0.0);
+  for (synthetic::Node& n : mission.nodes) n.dr.translation += start_error_m;
+  const size_t last = mission.nodes.size() - 1;
+  std::mt19937_64 random(99);
+  const std::vector<std::pair<size_t, AbsoluteFix>> fixes = {{0, fixAt(mission.nodes[0], 1.0, random)},
+                                                             {last, fixAt(mission.nodes[last], 1.0, random)}};
+  SlidingWindowPoseGraph tight(graphOptions());
+  feedWithFixes(tight, mission, true, fixes);
+  SlidingWindowPoseGraph widened(graphOptions());
+  ASSERT_TRUE(widened.setFirstNodeHorizontalSigma(4.0, 4.0).ok);  // before the first node
+  feedWithFixes(widened, mission, true, fixes);
+  const double ate_tight = synthetic::translationRmse(estimates(tight), mission.nodes);
+  const double ate_widened = synthetic::translationRmse(estimates(widened), mission.nodes);
+  std::printf("DR start 5 m off: first node error %.2f m (anchor 0.1 m) vs %.2f m (INS 4 m); ATE %.2f vs %.2f m; "
+              "fixes accepted %llu vs %llu\n",
+              error(tight, mission, 0), error(widened, mission, 0), ate_tight, ate_widened,
+              static_cast<unsigned long long>(tight.fixCounters().accepted),
+              static_cast<unsigned long long>(widened.fixCounters().accepted));
+  EXPECT_GT(error(tight, mission, 0), 4.5);
+  EXPECT_LT(error(widened, mission, 0), 2.0);
+  EXPECT_EQ(widened.fixCounters().accepted, 2u);
+  EXPECT_LT(ate_widened, 0.5 * ate_tight);
+  EXPECT_EQ(widened.firstNodeInsSigma(), Eigen::Vector2d(4.0, 4.0));
+
+  // first_node_sigma_from_ins off: the INS's report is kept but the anchor stays first_node_sigma_m.
+  PoseGraphOptions distrusting = graphOptions();
+  distrusting.first_node_sigma_from_ins = false;
+  SlidingWindowPoseGraph ignored(distrusting);
+  ASSERT_TRUE(ignored.setFirstNodeHorizontalSigma(4.0, 4.0).ok);
+  feedWithFixes(ignored, mission, true, fixes);
+  EXPECT_NEAR(error(ignored, mission, 0), error(tight, mission, 0), 1e-3);
+
+  // Without fixes the anchor only places the survey: the same estimate, a wider first-node sigma.
+  SlidingWindowPoseGraph plain(graphOptions()), plain_widened(graphOptions());
+  ASSERT_TRUE(plain_widened.setFirstNodeHorizontalSigma(4.0, 3.0).ok);
+  feedWithFixes(plain, mission, true, {});
+  feedWithFixes(plain_widened, mission, true, {});
+  const auto a = estimates(plain), b = estimates(plain_widened);
+  for (size_t i = 0; i < a.size(); ++i) EXPECT_LT((a[i].translation - b[i].translation).norm(), 1e-3) << i;
+  const int64_t first_id = mission.nodes[0].subframe_id;
+  EXPECT_NEAR(std::sqrt((*plain.covariance(first_id))(0, 0)), 0.1, 0.01);
+  EXPECT_NEAR(std::sqrt((*plain_widened.covariance(first_id))(0, 0)), 4.0, 0.1);
+  EXPECT_NEAR(std::sqrt((*plain_widened.covariance(first_id))(1, 1)), 3.0, 0.1);
+
+  // Kept by the checkpoint; refused once the first node has left the window, or when not a sigma.
+  SlidingWindowPoseGraph restored(graphOptions());
+  ASSERT_TRUE(restored.restoreCheckpointText(plain_widened.checkpointText()).ok);
+  EXPECT_EQ(restored.firstNodeInsSigma(), Eigen::Vector2d(4.0, 3.0));
+  const Status late = plain.setFirstNodeHorizontalSigma(2.0, 2.0);
+  EXPECT_FALSE(late.ok);
+  EXPECT_NE(late.message.find("marginalised"), std::string::npos) << late.message;
+  SlidingWindowPoseGraph fresh(graphOptions());
+  EXPECT_FALSE(fresh.setFirstNodeHorizontalSigma(-1.0, 2.0).ok);
+  EXPECT_FALSE(fresh.setFirstNodeHorizontalSigma(std::nan(""), 2.0).ok);
+  EXPECT_EQ(fresh.firstNodeInsSigma(), Eigen::Vector2d::Zero());
 }
 
 TEST(PositionFixGraph, BadFixesAreRefusedWithTheReason) {

@@ -175,13 +175,13 @@ TEST(SeparationBias, SurvivesACheckpointAndOlderCheckpointsRestoreWithout) {
   // The same state as version 2 wrote it: no separation_bias record (nor version 4's fixes record
   // and version 5's calibration record).
   std::string version_2 = text;
-  const std::string header = "sss-pose-graph-checkpoint 6";
+  const std::string header = "sss-pose-graph-checkpoint 7";
   ASSERT_EQ(version_2.rfind(header, 0), 0u) << version_2.substr(0, 40);
   version_2.replace(0, header.size(), "sss-pose-graph-checkpoint 2");
   const size_t record = version_2.find("\nseparation_bias ");
   ASSERT_NE(record, std::string::npos);
   version_2.erase(record, version_2.find('\n', record + 1) - record);
-  for (const char* newer : {"\nfixes ", "\ncalibration "}) {
+  for (const char* newer : {"\nfixes ", "\ncalibration ", "\nanchor "}) {
     const size_t newer_record = version_2.find(newer);
     ASSERT_NE(newer_record, std::string::npos) << newer;
     version_2.erase(newer_record, version_2.find('\n', newer_record + 1) - newer_record);

@@ -94,6 +94,12 @@ struct OfflineSummary {
   FixSummary fixes;
   // The DR calibration the final smoothing estimated (estimated: false when nothing observed it).
   sss::optimiser::DrCalibration calibration;
+  // The INS's reported 1-sigma of its position at the first node, north and east (0: not reported):
+  // the survey's anchor (SlidingWindowPoseGraph::setFirstNodeHorizontalSigma).
+  Eigen::Vector2d anchor_ins_sigma_ne_m = Eigen::Vector2d::Zero();
+  // The anchor's 1-sigma north and east as the graph held it (first_node_sigma_m, or the INS's
+  // accuracy where wider and first_node_sigma_from_ins is on).
+  Eigen::Vector2d anchor_sigma_ne_m = Eigen::Vector2d::Zero();
   // Seabed seen by the subframes under the SLAM poses (coverage.yaml), and by two lines or more.
   double coverage_covered_m2 = 0.0;
   double coverage_seen_twice_m2 = 0.0;

@@ -292,6 +292,13 @@ bool writeSummaryJson(const std::string& path, const OfflineRequest& request, co
   calibration_json["heading_cos_sigma_rad"] = jsonValue(s.calibration.sigma(2), 6);
   calibration_json["heading_sin_rad"] = jsonValue(s.calibration.heading_sin_rad, 6);
   calibration_json["heading_sin_sigma_rad"] = jsonValue(s.calibration.sigma(3), 6);
+  // The survey's anchor: the first node's DR position, held to first_node_sigma_m or to the INS's own
+  // reported accuracy there, whichever is wider (0: the INS reported none).
+  Json& anchor_json = (json["anchor"] = Json::object());
+  anchor_json["ins_position_sigma_north_m"] = jsonValue(s.anchor_ins_sigma_ne_m(0), 4);
+  anchor_json["ins_position_sigma_east_m"] = jsonValue(s.anchor_ins_sigma_ne_m(1), 4);
+  anchor_json["sigma_north_m"] = jsonValue(s.anchor_sigma_ne_m(0), 4);
+  anchor_json["sigma_east_m"] = jsonValue(s.anchor_sigma_ne_m(1), 4);
   Json& lines_json = (json["lines"] = Json::object());
   lines_json["survey_lines"] = jsonValue(s.survey_lines);
   lines_json["turn_pings"] = jsonValue(s.buffer.builder.turn_pings);
