@@ -20,7 +20,7 @@ PACKAGES=(
   # tests, benchmarks, fuzzing (clang's libFuzzer runtime)
   libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
   # tools: python for the report and plotting scripts
-  python3 python3-numpy
+  python3 python3-numpy python3-matplotlib
 )
 
 # LCM needs socket receive buffers that hold a multi-megabyte subframe (systemd/60-sss-slam.conf

@@ -2,6 +2,7 @@
 // errors (SLAM 0.1 m north of the truth, heightmaps 0.05 m and 0.3 m too deep, 3 + 1 closures) ->
 // exit code, files, metrics.json numbers, the verdict; missing required and optional inputs.
 #include "tools/eval/heightmap_metrics.hpp"
+#include "tools/eval/run_report.hpp"
 #include "tools/eval/trajectory_io.hpp"
 #include "tools/sim/mission.hpp"
 
@@ -338,6 +339,30 @@ TEST_F(RunReport, MissingOptionalInputsLeaveTheirSectionsOutWithNotes) {
     EXPECT_FALSE(fs::exists(out_dir() / absent)) << absent;
   }
   EXPECT_EQ(json["outcome"].as<std::string>(), "better");
+}
+
+// No /usr/bin/python3 (or no matplotlib): the whole report without its figures, one note naming the
+// cause and tools/setup-deps.sh, status ok (sss-report exits 0, as for any missing figure).
+TEST_F(RunReport, WithoutPythonTheReportIsWrittenWithoutFiguresAndOneNote) {
+  RunReportRequest request;
+  request.mission_dir = mission_dir_.string();
+  request.run_dir = run_dir().string();
+  request.out_dir = out_dir().string();
+  request.figures.python = (dir_ / "no-python3").string();
+  const sss::eval::RunReport report = writeRunReport(request);
+  ASSERT_EQ(report.status, RunReportStatus::ok) << report.error;
+  ASSERT_EQ(report.notes.size(), 1u);
+  EXPECT_NE(report.notes[0].find(request.figures.python + " not found"), std::string::npos) << report.notes[0];
+  EXPECT_NE(report.notes[0].find("tools/setup-deps.sh"), std::string::npos) << report.notes[0];
+  const std::string html = slurp(out_dir() / "index.html");
+  EXPECT_NE(html.find("tools/setup-deps.sh"), std::string::npos);  // the notes are on the page
+  EXPECT_NE(html.find("ATE horizontal RMSE"), std::string::npos);  // the tables are all there
+  for (const std::string& figure : kFigures) {
+    EXPECT_EQ(html.find("<img src=\"" + figure + "\""), std::string::npos) << figure;
+    EXPECT_FALSE(fs::exists(out_dir() / figure)) << figure;
+  }
+  EXPECT_TRUE(fs::exists(out_dir() / "metrics.json"));
+  EXPECT_TRUE(fs::exists(out_dir() / "report.md"));
 }
 
 TEST_F(RunReport, SaysPlainlyWhenSlamIsWorseThanDeadReckoning) {

@@ -19,8 +19,10 @@ const char* kExplanation =
     "--label names the estimates in order (default: file name); the first estimate is the baseline\n"
     "  of the 'vs first' column (horizontal ATE RMSE improvement, %).\n"
     "--plot OUT.png writes OUT.png (trajectories, north/east), OUT_error.png (error over time) and\n"
-    "  OUT_heightmap_<label>.png per heightmap; --error-map PREFIX writes PREFIX_<label>.yaml +\n"
-    "  PREFIX_<label>_depth.f32 (estimate - true depth, the seabed raster format).\n"
+    "  OUT_heightmap_<label>.png per heightmap, drawn by report_figures.py (python3-matplotlib) from\n"
+    "  OUT_figure_data/; without it the JSON is still written and the exit code is 1.\n"
+    "--error-map PREFIX writes PREFIX_<label>.yaml + PREFIX_<label>_depth.f32 (estimate - true\n"
+    "  depth, the seabed raster format).\n"
     "Truth is interpolated at estimate times (gaps up to --max-gap-s, default 1 s); otherwise the\n"
     "  nearest truth pose within --time-tolerance-s (default 0.02 s) is used.\n"
     "--closures: each loop closure's relative pose (sss-process loop_closures.csv: dx_m dy_m dz_m =\n"
@@ -173,10 +175,9 @@ int main(int argc, char** argv) {
       report.has_matches = true;
     }
     std::cout << sss::eval::formatTable(report);
-    if (!sss::eval::writeFigures(request, report, error)) {
-      std::cerr << "sss-eval: " << error << "\n";
-      return 1;
-    }
+    // Without figures (e.g. no python3-matplotlib) the JSON is still written; the exit code says 1.
+    std::string figures_error;
+    if (!sss::eval::writeFigures(request, report, error)) figures_error = error;
     if (!request.json_path.empty()) {
       report.json_path = request.json_path;
       std::ofstream out(request.json_path, std::ios::binary);
@@ -189,6 +190,10 @@ int main(int argc, char** argv) {
     }
     for (const std::string& plot : report.plots) std::cout << "wrote " << plot << "\n";
     if (!request.json_path.empty()) std::cout << "wrote " << request.json_path << "\n";
+    if (!figures_error.empty()) {
+      std::cerr << "sss-eval: " << figures_error << "\n";
+      return 1;
+    }
   } catch (const std::bad_alloc&) {
     std::cerr << "sss-eval: out of memory; are the inputs the right files?\n";
     return 2;

@@ -1,6 +1,7 @@
 // sss-eval runs: inputs -> metrics -> table, JSON, figures. See report.hpp.
 #include "tools/eval/report.hpp"
 
+#include "tools/eval/figure_script.hpp"
 #include "tools/eval/json_values.hpp"
 
 #include <algorithm>
@@ -267,34 +268,45 @@ bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalR
 }
 
 bool writeFigures(const EvalRequest& request, EvalReport& report, std::string& error) {
+  // The PNGs are drawn by report_figures.py from X_figure_data/ beside X.png (figure_script.hpp).
+  const std::filesystem::path plot(request.plot_path);
+  const std::string out_dir = plot.parent_path().empty() ? "." : plot.parent_path().string();
+  FigureBatch figures;
+  if (!request.plot_path.empty()) {  // X.png -> X_figure_data (checked to end in .png)
+    figures.data_dir = request.plot_path.substr(0, request.plot_path.size() - 4) + "_figure_data";
+  }
+  std::vector<std::string> paths;  // each figure's path as --plot names it
+  const auto add = [&](const std::string& kind, const std::string& suffix, const std::string& title) -> Json& {
+    paths.push_back(withSuffix(request.plot_path, suffix));
+    return addFigure(figures, kind, std::filesystem::path(paths.back()).filename().string(), title);
+  };
   if (!request.plot_path.empty() && !report.estimates.empty()) {
-    PlotTrajectory truth{"truth", {}};
-    for (const StampedPose& p : report.truth) truth.north_east_m.push_back(p.T_world_body.translation.head<2>());
-    std::vector<PlotTrajectory> estimates;
-    for (const EstimateReport& e : report.estimates) {
-      PlotTrajectory t{e.input.label, {}};
-      for (const AssociatedPose& p : e.evaluation.association.pairs) t.north_east_m.push_back(p.estimate.translation.head<2>());
-      estimates.push_back(std::move(t));
-    }
     const std::string title = "Trajectories (north/east), truth: " + std::filesystem::path(report.truth_path).filename().string();
-    if (!writeTrajectoryPlot(request.plot_path, truth, estimates, title, error)) return false;
-    report.plots.push_back(request.plot_path);
+    Json& map = add("map", "", title);
+    map["lines"] = Json::array();
+    for (size_t i = 0; i < report.estimates.size(); ++i) {
+      const EstimateReport& e = report.estimates[i];
+      std::vector<Eigen::Vector2d> points;
+      for (const AssociatedPose& p : e.evaluation.association.pairs) points.push_back(p.estimate.translation.head<2>());
+      map["lines"].push_back(mapLine(e.input.label, points, paletteColour(static_cast<int>(i))));
+    }
+    // Truth last so it stays visible on top of estimates that follow it closely.
+    std::vector<Eigen::Vector2d> truth;
+    for (const StampedPose& p : report.truth) truth.push_back(p.T_world_body.translation.head<2>());
+    map["lines"].push_back(mapLine("truth", truth, "black", 1.2, true, true));
 
     // Error over time since the truth's first pose, in minutes; survey lines shaded.
     const int64_t t0 = report.truth.front().utime_us;
-    std::vector<PlotCurve> curves;
+    Json& curves = add("curves", "_error", "Horizontal position error over the mission");
+    curves["x_label"] = "time since start (min)";
+    curves["y_label"] = "horizontal error (m)";
+    curves["curves"] = Json::array();
     for (size_t i = 0; i < report.estimates.size(); ++i) {
       const EstimateReport& e = report.estimates[i];
-      for (PlotCurve& curve : horizontalErrorCurves(e.input.label, e.evaluation.series, static_cast<int>(i), t0))
-        curves.push_back(std::move(curve));
+      for (Json& curve : horizontalErrorCurves(e.input.label, e.evaluation.series, paletteColour(static_cast<int>(i)), t0))
+        curves["curves"].push_back(std::move(curve));
     }
-    const std::vector<PlotBand> bands = surveyLineBands(report.lines, t0);
-    const std::string error_path = withSuffix(request.plot_path, "_error");
-    if (!writeCurvePlot(error_path, curves, bands, "Horizontal position error over the mission", "time since start (min)",
-                        "horizontal error (m)", error)) {
-      return false;
-    }
-    report.plots.push_back(error_path);
+    curves["bands"] = surveyLineBands(report.lines, t0);
   }
   for (HeightmapReport& h : report.heightmaps) {
     const std::string safe = fileSafeLabel(h.input.label);
@@ -304,14 +316,29 @@ bool writeFigures(const EvalRequest& request, EvalReport& report, std::string& e
       h.error_map_yaml = prefix + ".yaml";
     }
     if (!request.plot_path.empty()) {
-      const std::string png = withSuffix(request.plot_path, "_heightmap_" + safe);
       char title[256];
       std::snprintf(title, sizeof title, "Heightmap error %s: MAE %.3f m over %.1f %% coverage", h.input.label.c_str(),
                     h.result.abs_error_m.mean, 100.0 * h.result.coverage_fraction);
-      if (!writeErrorMapPng(png, h.result.error_map, title, error, report.options.error_map_png)) return false;
-      h.error_map_png = png;
-      report.plots.push_back(png);
+      Json& figure = add("error_map", "_heightmap_" + safe, title);
+      figure["raster"] = heightmapRaster(figures, h.result.error_map, "heightmap_error_" + safe);
+      figure["limit_m"] = report.options.error_map_png.limit_m;  // <= 0: the script picks the p99
+      h.error_map_png = paths.back();
     }
+  }
+  const FigureRun run = drawFigures(figures, out_dir, request.figures);
+  const auto drawn = [&](const std::string& path) {
+    const std::string file = std::filesystem::path(path).filename().string();
+    return std::find(run.missing.begin(), run.missing.end(), file) == run.missing.end();
+  };
+  for (const std::string& path : paths) {
+    if (drawn(path)) report.plots.push_back(path);
+  }
+  for (HeightmapReport& h : report.heightmaps) {
+    if (!h.error_map_png.empty() && !drawn(h.error_map_png)) h.error_map_png.clear();
+  }
+  if (!run.problem.empty()) {
+    error = run.problem;
+    return false;
   }
   return true;
 }

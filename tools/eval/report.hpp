@@ -60,6 +60,7 @@
 #pragma once
 
 #include "tools/eval/closure_metrics.hpp"
+#include "tools/eval/figure_script.hpp"
 #include "tools/eval/heightmap_metrics.hpp"
 #include "tools/eval/landmark_consistency.hpp"
 #include "tools/eval/json_values.hpp"
@@ -93,6 +94,7 @@ struct EvalRequest {
   bool lce_optional = false;           // lce by default, not asked for: no survey lines skips it, not an error
   std::string matches_path;            // matches.csv of sss-process --write-matches; needs mission_dir
   std::string mission_dir;             // the sss-sim folder (mission.yaml) the matches are evaluated against
+  FigureScriptOptions figures;         // the interpreter and the script that draw the PNGs
 };
 
 struct EvalOptions {
@@ -164,8 +166,10 @@ struct EvalReport {
 // truth's time span, a heightmap that does not overlap the seabed, --lce without survey lines.
 bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalReport& report, std::string& error);
 
-// Figures and error-map rasters of the request (plot_path, error_map_prefix). False with a
-// message when a file cannot be written.
+// Figures and error-map rasters of the request (plot_path, error_map_prefix); the figures drawn
+// by report_figures.py (figure_script.hpp). False with a one-line message when a file cannot be
+// written or figures were not drawn (no python3-matplotlib: the message says to run
+// tools/setup-deps.sh); report.plots then lists only the PNGs drawn.
 bool writeFigures(const EvalRequest& request, EvalReport& report, std::string& error);
 
 // The aligned terminal table: one row per estimate (ATE RMSE raw and aligned, horizontal ATE RMSE

@@ -344,12 +344,16 @@ RunReport writeRunReport(const RunReportRequest& request, const RunReportOptions
                   "cannot create " + request.out_dir + (ec ? ": " + ec.message() : std::string()));
     }
     std::vector<Section> sections;
-    FigureContext context{request, report, sections};
-    trajectoryFigures(context, truth, background);
-    closureFigure(context, background);
+    FigureBatch figures{joinPath(request.out_dir, "figure_data"), Json::array(), ""};
+    FigureContext context{request, report, sections, figures};
+    const Json background_raster = background ? mosaicRaster(figures, *background, "mosaic_truth") : Json();
+    trajectoryFigures(context, truth, background_raster);
+    closureFigure(context, background_raster);
     mosaicFigure(context);
     heightmapFigures(context);
     productsSection(context);
+    // Every figure in one run of the script (one interpreter start-up), then the pages.
+    dropUndrawnFigures(context, drawFigures(figures, request.out_dir, request.figures));
 
     const Table key = keyTable(report, options);
     const std::vector<Table> tables = metricTables(report, options);

@@ -6,6 +6,8 @@
 // dead_reckoning.tum (else MISSION_DIR's, with a note), loop_closures.csv, heightmap.yaml (SLAM) and
 // heightmap_dr.yaml, mosaic_dr.yaml / mosaic_slam.yaml (+ .png), summary.json. A missing or
 // unreadable optional input drops its section and adds a note; it never fails the report.
+// Figures: drawn by report_figures.py (matplotlib) from OUT_DIR/figure_data/ (figures.json + .npy);
+// without python3-matplotlib the report is written without them, with one note saying why.
 //
 // metrics.json (schema "sss-report/1"; numbers that do not exist are null; stats = {"count",
 // "rmse", "mean", "median", "max"}; improvement = (DR - SLAM) / DR * 100, positive = SLAM better):
@@ -38,6 +40,7 @@
 #pragma once
 
 #include "tools/eval/closure_metrics.hpp"
+#include "tools/eval/figure_script.hpp"
 #include "tools/eval/heightmap_metrics.hpp"
 #include "tools/eval/landmark_consistency.hpp"
 #include "tools/eval/trajectory_io.hpp"
@@ -59,6 +62,7 @@ struct RunReportRequest {
   std::string run_dir;      // sss-process output folder
   std::string out_dir;      // created if missing
   std::string title;        // empty: "sss-slam run <run folder name>"
+  FigureScriptOptions figures;  // the interpreter and the script that draw the PNGs
 };
 
 struct RunReportOptions {

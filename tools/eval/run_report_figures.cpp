@@ -4,45 +4,42 @@
 namespace sss::eval::report_internal {
 
 
-void trajectoryFigures(FigureContext& context, const Trajectory& truth, const GreyMosaic* mosaic) {
+void trajectoryFigures(FigureContext& context, const Trajectory& truth, const Json& background) {
   RunReport& report = context.report;
   Section section{"1. Trajectories over the mosaic", "", {}, {}};
-  MapFigure map;
-  map.title = mosaic ? "Trajectories over the true-pose mosaic: truth, dead reckoning (DR), SLAM"
-                     : "Trajectories: truth, dead reckoning (DR), SLAM (no mosaic in the mission folder)";
-  map.background = mosaic;
-  MapPolyline truth_line{"truth", northEast(truth), {255, 255, 255}, 3, 1, {0, 0, 0}, true};
-  MapPolyline dr_line{"dead reckoning (DR)", estimateNorthEast(report.dr), paletteRgb(kDrColour), 2, 0, {}, false};
-  MapPolyline slam_line{"SLAM", estimateNorthEast(report.slam), paletteRgb(kSlamColour), 2, 0, {}, false};
-  map.polylines = {truth_line, dr_line, slam_line};
-  map.note = "horizontal error RMSE: DR " + metres(report.dr.ate.horizontal_m.rmse) + " (max " +
-             metres(report.dr.ate.horizontal_m.max) + "), SLAM " + metres(report.slam.ate.horizontal_m.rmse) + " (max " +
-             metres(report.slam.ate.horizontal_m.max) + "); lines closer than a pixel overlap";
-  if (drawFigure(context, "trajectories.png", [&](const std::string& path, std::string& error) {
-        return writeMapPng(path, map, error);
-      })) {
-    section.figures.push_back({"", "trajectories.png", "trajectories over the mosaic",
-                               "Truth (white, black outline), DR (orange) and SLAM (cyan) over the mosaic rendered from "
-                               "the true poses. The error over time below resolves what is finer than a pixel here."});
-  }
+  Json& map = addFigure(context.figures, "map", "trajectories.png",
+                        background.is_null()
+                            ? "Trajectories: truth, dead reckoning (DR), SLAM (no mosaic in the mission folder)"
+                            : "Trajectories over the true-pose mosaic: truth, dead reckoning (DR), SLAM");
+  map["background"] = background;
+  map["lines"] = {mapLine("truth", northEast(truth), "black", 3.0, true, true),
+                  mapLine("dead reckoning (DR)", estimateNorthEast(report.dr), paletteColour(kDrColour), 2.0),
+                  mapLine("SLAM", estimateNorthEast(report.slam), paletteColour(kSlamColour), 2.0)};
+  map["note"] = "horizontal error RMSE: DR " + metres(report.dr.ate.horizontal_m.rmse) + " (max " +
+                metres(report.dr.ate.horizontal_m.max) + "), SLAM " + metres(report.slam.ate.horizontal_m.rmse) +
+                " (max " + metres(report.slam.ate.horizontal_m.max) + "); lines closer than a pixel overlap";
+  section.figures.push_back({"", "trajectories.png", "trajectories over the mosaic",
+                             "Truth (white, black outline), DR (orange) and SLAM (cyan) over the mosaic rendered from "
+                             "the true poses. The error over time below resolves what is finer than a pixel here."});
   context.sections.push_back(section);
 
   Section errors{"2. Horizontal error over time", "", {}, {}};
   const int64_t t0 = truth.front().utime_us;
-  std::vector<PlotCurve> curves;
+  Json& plot = addFigure(context.figures, "curves", "error_over_time.png",
+                         "Horizontal position error against the truth: DR vs SLAM");
+  plot["x_label"] = "time since start (min)";
+  plot["y_label"] = "horizontal error (m)";
+  plot["curves"] = Json::array();
   for (const auto& [label, evaluation, colour] :
        {std::tuple{std::string("DR"), &report.dr, kDrColour}, std::tuple{std::string("SLAM"), &report.slam, kSlamColour}}) {
-    for (PlotCurve& curve : horizontalErrorCurves(label, evaluation->series, colour, t0)) curves.push_back(std::move(curve));
+    for (Json& curve : horizontalErrorCurves(label, evaluation->series, paletteColour(colour), t0)) {
+      plot["curves"].push_back(std::move(curve));
+    }
   }
-  const std::vector<PlotBand> bands = surveyLineBands(report.lines, t0);
-  if (drawFigure(context, "error_over_time.png", [&](const std::string& path, std::string& error) {
-        return writeCurvePlot(path, curves, bands, "Horizontal position error against the truth: DR vs SLAM",
-                              "time since start (min)", "horizontal error (m)", error);
-      })) {
-    errors.figures.push_back({"", "error_over_time.png", "horizontal error over time",
-                              "Solid: raw error; dashed: after the best rigid (SE(3)) alignment of the whole trajectory, "
-                              "i.e. the shape error without the global offset. Shaded: survey lines."});
-  }
+  plot["bands"] = surveyLineBands(report.lines, t0);
+  errors.figures.push_back({"", "error_over_time.png", "horizontal error over time",
+                            "Solid: raw error; dashed: after the best rigid (SE(3)) alignment of the whole trajectory, "
+                            "i.e. the shape error without the global offset. Shaded: survey lines."});
   context.sections.push_back(errors);
 }
 
@@ -84,7 +81,7 @@ Table tieTable(const std::vector<LoopClosureRecord>& closures) {
   return table;
 }
 
-void closureFigure(FigureContext& context, const GreyMosaic* mosaic) {
+void closureFigure(FigureContext& context, const Json& background) {
   RunReport& report = context.report;
   Section section{"3. Loop closures", "", {}, {}};
   if (!report.has_closures) {
@@ -93,38 +90,40 @@ void closureFigure(FigureContext& context, const GreyMosaic* mosaic) {
     return;
   }
   const LoopClosureCounts& c = report.closure_counts;
-  MapFigure map;
-  map.title = "Loop closures between subframes over the SLAM trajectory";
-  map.background = mosaic;
-  map.background_base = 150.0;  // faded, so the graph reads first
-  map.background_gain = 0.4;
-  map.polylines.push_back({"SLAM trajectory", estimateNorthEast(report.slam), {70, 70, 70}, 1, 0, {}, true});
-  MapSegments accepted{"accepted (" + std::to_string(c.accepted) + ")", {}, paletteRgb(2), 2};
-  MapSegments rejected{"rejected (" + std::to_string(c.rejected) + ")", {}, paletteRgb(3), 2};
-  MapSegments other{"superseded / pending (" + std::to_string(c.superseded + c.pending) + ")", {}, paletteRgb(7), 2};
-  for (const LoopClosureRecord& r : report.closures) {
-    MapSegments& set = r.status == "accepted" ? accepted : r.status == "rejected" ? rejected : other;
-    set.north_east_m.emplace_back(r.centre_a_north_east_m, r.centre_b_north_east_m);
-  }
-  map.segments = {other, rejected, accepted};  // accepted on top
-  if (c.superseded + c.pending == 0) map.segments.erase(map.segments.begin());
-  map.note = "each segment joins the centres of the two subframes of a closure (final SLAM estimate)";
-  if (drawFigure(context, "loop_closures.png", [&](const std::string& path, std::string& error) {
-        return writeMapPng(path, map, error);
-      })) {
-    std::string caption = "Green: accepted closures; red: rejected";
-    if (!c.rejection_reasons.empty()) {
-      caption += " (";
-      bool first = true;
-      for (const auto& [reason, n] : c.rejection_reasons) {
-        caption += (first ? "" : ", ") + reason + " " + std::to_string(n);
-        first = false;
-      }
-      caption += ")";
+  Json& map = addFigure(context.figures, "map", "loop_closures.png", "Loop closures between subframes over the SLAM trajectory");
+  map["background"] = background;
+  if (!background.is_null()) map["background"]["alpha"] = 0.45;  // faded, so the graph reads first
+  map["lines"] = {mapLine("SLAM trajectory", estimateNorthEast(report.slam), "#464646", 1.0, true)};
+  const auto segments = [&](const std::string& status, const std::string& label, const std::string& colour) {
+    Json pairs = Json::array();
+    for (const LoopClosureRecord& r : report.closures) {
+      const bool other = r.status != "accepted" && r.status != "rejected";
+      if (r.status != status && !(status == "other" && other)) continue;
+      pairs.push_back({{r.centre_a_north_east_m.x(), r.centre_a_north_east_m.y()},
+                       {r.centre_b_north_east_m.x(), r.centre_b_north_east_m.y()}});
     }
-    caption += "; grey: superseded or still pending.";
-    section.figures.push_back({"", "loop_closures.png", "loop-closure graph", caption});
+    return Json{{"label", label}, {"colour", colour}, {"north_east_m", std::move(pairs)}};
+  };
+  map["segments"] = Json::array();  // drawn in order: accepted last, on top
+  if (c.superseded + c.pending > 0) {
+    map["segments"].push_back(
+        segments("other", "superseded / pending (" + std::to_string(c.superseded + c.pending) + ")", paletteColour(7)));
   }
+  map["segments"].push_back(segments("rejected", "rejected (" + std::to_string(c.rejected) + ")", paletteColour(3)));
+  map["segments"].push_back(segments("accepted", "accepted (" + std::to_string(c.accepted) + ")", paletteColour(2)));
+  map["note"] = "each segment joins the centres of the two subframes of a closure (final SLAM estimate)";
+  std::string caption = "Green: accepted closures; red: rejected";
+  if (!c.rejection_reasons.empty()) {
+    caption += " (";
+    bool first = true;
+    for (const auto& [reason, n] : c.rejection_reasons) {
+      caption += (first ? "" : ", ") + reason + " " + std::to_string(n);
+      first = false;
+    }
+    caption += ")";
+  }
+  caption += "; grey: superseded or still pending.";
+  section.figures.push_back({"", "loop_closures.png", "loop-closure graph", caption});
   section.tables.push_back(tieTable(report.closures));
   if (section.tables.back().rows.empty()) section.tables.pop_back();
   context.sections.push_back(section);
@@ -185,23 +184,25 @@ void productsSection(FigureContext& context) {
 
 void mosaicFigure(FigureContext& context) {
   Section section{"4. Mosaics: DR vs SLAM", "", {}, {}};
-  GreyMosaic dr, slam;
-  std::string error;
-  bool ok = true;
-  for (auto [name, mosaic] : {std::pair{"mosaic_dr.yaml", &dr}, std::pair{"mosaic_slam.yaml", &slam}}) {
-    const std::string path = joinPath(context.request.run_dir, name);
+  Json panels = Json::array();
+  for (auto [name, label] : {std::pair{"mosaic_dr", "dead reckoning (DR)"}, std::pair{"mosaic_slam", "SLAM"}}) {
+    const std::string path = joinPath(context.request.run_dir, std::string(name) + ".yaml");
+    GreyMosaic mosaic;
+    std::string error;
     if (!fileExists(path)) {
-      context.report.notes.push_back("no " + std::string(name) + " in the run folder (" + path + "): no mosaic comparison");
-      ok = false;
-    } else if (!readMosaic(path, *mosaic, error)) {
+      context.report.notes.push_back("no " + std::string(name) + ".yaml in the run folder (" + path +
+                                     "): no mosaic comparison");
+    } else if (!readMosaic(path, mosaic, error)) {
       context.report.notes.push_back("mosaic unusable, no mosaic comparison: " + error);
-      ok = false;
+    } else {
+      Json panel = mosaicRaster(context.figures, mosaic, name);
+      panel["label"] = label;
+      panels.push_back(std::move(panel));
     }
   }
-  if (ok && drawFigure(context, "mosaics_dr_slam.png", [&](const std::string& path, std::string& e) {
-        return writeMosaicPanelsPng(path, {{"dead reckoning (DR)", &dr}, {"SLAM", &slam}},
-                                    "Mosaics rendered with the DR and the SLAM navigation", e);
-      })) {
+  if (panels.size() == 2) {
+    addFigure(context.figures, "mosaics", "mosaics_dr_slam.png", "Mosaics rendered with the DR and the SLAM navigation")
+        ["panels"] = std::move(panels);
     section.figures.push_back({"", "mosaics_dr_slam.png", "DR vs SLAM mosaics",
                                "Where lines overlap, features should be single and sharp; doubled or smeared features "
                                "show navigation error."});
@@ -221,37 +222,46 @@ void heightmapFigures(FigureContext& context) {
     char title[256];
     std::snprintf(title, sizeof title, "SLAM heightmap: %.2g m cells, grid %zu x %zu", slam.resolution_m,
                   static_cast<size_t>(slam.cols), static_cast<size_t>(slam.rows));
-    if (drawFigure(context, "heightmap_slam.png", [&](const std::string& path, std::string& e) {
-          return writeDepthMapPng(path, cropToData(slam), title, e);
-        })) {
-      section.figures.push_back({"depth", "heightmap_slam.png", "SLAM heightmap", "Gridded bathymetry from the SLAM poses."});
-    }
+    addFigure(context.figures, "depth", "heightmap_slam.png", title)["raster"] =
+        heightmapRaster(context.figures, cropToData(slam), "heightmap_slam");
+    section.figures.push_back({"depth", "heightmap_slam.png", "SLAM heightmap", "Gridded bathymetry from the SLAM poses."});
   }
   std::vector<const HeightmapRaster*> maps;
   for (const RunHeightmap* h : {&report.heightmap_dr, &report.heightmap_slam}) {
     if (h->present) maps.push_back(&h->error.error_map);
   }
-  if (!maps.empty()) {
-    ErrorMapPngOptions png_options;
-    png_options.limit_m = sharedErrorLimit(maps);
-    png_options.max_size_px = 700;
-    for (const auto& [label, name, entry] :
-         {std::tuple{std::string("DR"), std::string("heightmap_error_dr.png"), &report.heightmap_dr},
-          std::tuple{std::string("SLAM"), std::string("heightmap_error_slam.png"), &report.heightmap_slam}}) {
-      if (!entry->present) continue;
-      char title[256];
-      std::snprintf(title, sizeof title, "Heightmap error, %s: MAE %.3f m, bias %+.3f m", label.c_str(),
-                    entry->error.abs_error_m.mean, entry->error.mean_signed_error_m);
-      if (drawFigure(context, name, [&](const std::string& path, std::string& e) {
-            return writeErrorMapPng(path, cropToData(entry->error.error_map), title, e, png_options);
-          })) {
-        section.figures.push_back({"errors", name, label + " heightmap error",
-                                   label + " heightmap minus the true seabed (same colour scale for DR and SLAM)."});
-      }
-    }
+  const double limit_m = maps.empty() ? 0.0 : sharedErrorLimit(maps);
+  for (const auto& [label, name, entry] :
+       {std::tuple{std::string("DR"), std::string("heightmap_error_dr"), &report.heightmap_dr},
+        std::tuple{std::string("SLAM"), std::string("heightmap_error_slam"), &report.heightmap_slam}}) {
+    if (!entry->present) continue;
+    char title[256];
+    std::snprintf(title, sizeof title, "Heightmap error, %s: MAE %.3f m, bias %+.3f m", label.c_str(),
+                  entry->error.abs_error_m.mean, entry->error.mean_signed_error_m);
+    Json& figure = addFigure(context.figures, "error_map", name + ".png", title);
+    figure["raster"] = heightmapRaster(context.figures, cropToData(entry->error.error_map), name);
+    figure["limit_m"] = limit_m;
+    section.figures.push_back({"errors", name + ".png", label + " heightmap error",
+                               label + " heightmap minus the true seabed (same colour scale for DR and SLAM)."});
   }
   if (section.figures.empty()) section.text = "Not available (see the notes).";
   context.sections.push_back(section);
+}
+
+void dropUndrawnFigures(FigureContext& context, const FigureRun& run) {
+  for (const std::string& path : run.written) context.report.files.push_back(path);
+  if (!run.problem.empty()) context.report.notes.push_back(run.problem);
+  for (Section& section : context.sections) {
+    const size_t before = section.figures.size();
+    const auto undrawn = [&](const Figure& figure) {
+      return std::find(run.missing.begin(), run.missing.end(), figure.file) != run.missing.end();
+    };
+    section.figures.erase(std::remove_if(section.figures.begin(), section.figures.end(), undrawn),
+                          section.figures.end());
+    if (section.figures.size() < before && section.figures.empty() && section.text.empty()) {
+      section.text = "Figures not drawn (see the notes).";
+    }
+  }
 }
 
 // ---- tables --------------------------------------------------------------------------------

@@ -5,6 +5,7 @@
 #include "tools/eval/run_report.hpp"
 #include "tools/eval/csv_fields.hpp"
 #include "tools/eval/json_values.hpp"
+#include "tools/eval/figure_script.hpp"
 #include "tools/eval/plots.hpp"
 #include "tools/eval/report.hpp"
 
@@ -276,24 +277,18 @@ struct FigureContext {
   const RunReportRequest& request;
   RunReport& report;
   std::vector<Section>& sections;
+  FigureBatch& figures;  // drawn by report_figures.py once every section is described
 };
 
-// Writes one PNG through draw(path, error); records the file, or a note when it fails.
-template <typename Draw>
-bool drawFigure(FigureContext& context, const std::string& name, const Draw& draw) {
-  const std::string path = joinPath(context.request.out_dir, name);
-  std::string error;
-  if (!draw(path, error)) {
-    context.report.notes.push_back("figure " + name + " not drawn: " + error);
-    return false;
-  }
-  context.report.files.push_back(path);
-  return true;
-}
+// After the script: removes the figures it did not draw from the sections (a section left empty
+// says so), lists the drawn PNGs in report.files and adds the one note saying why.
+void dropUndrawnFigures(FigureContext& context, const FigureRun& run);
 
-// Figures (run_report_figures.cpp): each writes its PNGs into the output folder and adds its section.
-void trajectoryFigures(FigureContext& context, const Trajectory& truth, const GreyMosaic* mosaic);
-void closureFigure(FigureContext& context, const GreyMosaic* mosaic);
+// Figures and sections (run_report_figures.cpp).
+// Each describes its PNGs to context.figures (see report_figures.py for what each kind reads) and
+// lists them in its section. background: the true-pose mosaic's raster entry, null without one.
+void trajectoryFigures(FigureContext& context, const Trajectory& truth, const Json& background);
+void closureFigure(FigureContext& context, const Json& background);
 void productsSection(FigureContext& context);
 void mosaicFigure(FigureContext& context);
 void heightmapFigures(FigureContext& context);

@@ -1,0 +1,238 @@
+// Figure data for report_figures.py and the run of the script. See figure_script.hpp.
+#include "tools/eval/figure_script.hpp"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+extern char** environ;
+
+namespace sss::eval {
+namespace {
+
+namespace fs = std::filesystem;
+
+// NumPy's .npy format 1.0 (what np.load reads without extra packages): magic, header length,
+// a Python dict literal padded to a multiple of 64 bytes, then the little-endian data (x86/ARM).
+bool writeNpy(const std::string& path, const char* descr, const void* data, size_t bytes, int rows, int cols,
+              std::string& error) {
+  std::string header = "{'descr': '" + std::string(descr) + "', 'fortran_order': False, 'shape': (" +
+                       std::to_string(rows) + ", " + std::to_string(cols) + "), }";
+  const size_t preamble = 10;  // magic (6) + version (2) + header length (2)
+  header.append(63 - (preamble + header.size()) % 64, ' ');
+  header += '\n';
+  std::ofstream out(path, std::ios::binary);
+  const char magic[8] = {'\x93', 'N', 'U', 'M', 'P', 'Y', 1, 0};
+  const uint16_t length = static_cast<uint16_t>(header.size());
+  const char length_le[2] = {static_cast<char>(length & 0xff), static_cast<char>(length >> 8)};
+  out.write(magic, sizeof magic);
+  out.write(length_le, sizeof length_le);
+  out << header;
+  out.write(static_cast<const char*>(data), static_cast<std::streamsize>(bytes));
+  out.close();
+  if (!out) {
+    error = "cannot write " + path + "; check the folder is writable and the disk not full";
+    return false;
+  }
+  return true;
+}
+
+std::string lastLine(const std::string& path) {
+  std::ifstream in(path);
+  std::string line, last;
+  while (std::getline(in, line)) {
+    if (!line.empty()) last = line;
+  }
+  return last;
+}
+
+// Runs python script data_dir out_dir with stdout and stderr into log_path; the exit status, or
+// -1 with a message when it could not be started or did not exit normally.
+int runScript(const FigureScriptOptions& options, const std::string& data_dir, const std::string& out_dir,
+              const std::string& log_path, std::string& error) {
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  std::vector<std::string> args = {options.python, options.script, data_dir, out_dir};
+  std::vector<char*> argv;
+  for (std::string& arg : args) argv.push_back(arg.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  const int spawned = posix_spawn(&pid, options.python.c_str(), &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawned != 0) {
+    error = "cannot start " + options.python + ": " + std::strerror(spawned);
+    return -1;
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0) {
+    if (errno != EINTR) {
+      error = "waiting for " + options.script + ": " + std::strerror(errno);
+      return -1;
+    }
+  }
+  if (!WIFEXITED(status)) {
+    error = options.script + " was killed by signal " + std::to_string(WTERMSIG(status));
+    return -1;
+  }
+  return WEXITSTATUS(status);
+}
+
+}  // namespace
+
+std::string defaultFigureScript() {
+  std::error_code ec;
+  if (fs::is_regular_file(SSS_FIGURE_SCRIPT_SOURCE, ec)) return SSS_FIGURE_SCRIPT_SOURCE;
+  return SSS_FIGURE_SCRIPT_INSTALLED;
+}
+
+std::string paletteColour(int index) { return "C" + std::to_string(((index % 10) + 10) % 10); }
+
+Json& addFigure(FigureBatch& batch, const std::string& kind, const std::string& file, const std::string& title) {
+  Json figure = Json::object();
+  figure["kind"] = kind;
+  figure["file"] = file;
+  figure["title"] = title;
+  batch.figures.push_back(std::move(figure));
+  return batch.figures.back();
+}
+
+Json mosaicRaster(FigureBatch& batch, const GreyMosaic& mosaic, const std::string& name) {
+  std::error_code ec;
+  fs::create_directories(batch.data_dir, ec);
+  const std::string file = name + ".npy";
+  std::string error;
+  if (!writeNpy((fs::path(batch.data_dir) / file).string(), "|u1", mosaic.pixels.data(), mosaic.pixels.size(),
+                mosaic.rows, mosaic.cols, error) &&
+      batch.error.empty()) {
+    batch.error = error;
+  }
+  Json raster = Json::object();
+  raster["npy"] = file;
+  raster["resolution_m"] = mosaic.resolution_m;
+  raster["north_max_m"] = mosaic.north_max_m;
+  raster["east_min_m"] = mosaic.east_min_m;
+  return raster;
+}
+
+Json heightmapRaster(FigureBatch& batch, const HeightmapRaster& map, const std::string& name) {
+  std::error_code ec;
+  fs::create_directories(batch.data_dir, ec);
+  const std::string file = name + ".npy";
+  std::string error;
+  if (!writeNpy((fs::path(batch.data_dir) / file).string(), "<f4", map.depth_m.data(),
+                map.depth_m.size() * sizeof(float), map.rows, map.cols, error) &&
+      batch.error.empty()) {
+    batch.error = error;
+  }
+  Json raster = Json::object();
+  raster["npy"] = file;
+  raster["resolution_m"] = map.resolution_m;
+  raster["north_min_m"] = map.north_min_m;
+  raster["east_min_m"] = map.east_min_m;
+  return raster;
+}
+
+Json mapLine(const std::string& label, const std::vector<Eigen::Vector2d>& north_east_m, const std::string& colour,
+             double width_pt, bool mark_start, bool truth) {
+  Json points = Json::array();
+  for (const Eigen::Vector2d& p : north_east_m) {
+    if (p.allFinite()) points.push_back({p.x(), p.y()});
+  }
+  Json line = Json::object();
+  line["label"] = label;
+  line["north_east_m"] = std::move(points);
+  line["colour"] = colour;
+  line["width"] = width_pt;
+  line["mark_start"] = mark_start;
+  line["truth"] = truth;
+  return line;
+}
+
+std::vector<Json> horizontalErrorCurves(const std::string& label, const std::vector<ErrorSample>& series,
+                                        const std::string& colour, int64_t t0_us) {
+  Json raw = {{"label", label + " horizontal"}, {"colour", colour}, {"dashed", false}};
+  Json aligned = {{"label", label + " horizontal, SE(3)-aligned"}, {"colour", colour}, {"dashed", true}};
+  Json minutes = Json::array(), raw_m = Json::array(), aligned_m = Json::array();
+  for (const ErrorSample& s : series) {
+    minutes.push_back(static_cast<double>(s.utime_us - t0_us) / 60e6);
+    raw_m.push_back(jsonValue(s.horizontal_m));  // NaN as null: a gap in the curve
+    aligned_m.push_back(jsonValue(s.aligned_horizontal_m));
+  }
+  raw["x"] = minutes;
+  raw["y"] = std::move(raw_m);
+  aligned["x"] = std::move(minutes);
+  aligned["y"] = std::move(aligned_m);
+  return {std::move(raw), std::move(aligned)};
+}
+
+Json surveyLineBands(const std::vector<SurveyLine>& lines, int64_t t0_us) {
+  Json bands = Json::array();
+  for (const SurveyLine& line : lines) {
+    bands.push_back({{"x_min", static_cast<double>(line.start_utime_us - t0_us) / 60e6},
+                     {"x_max", static_cast<double>(line.end_utime_us - t0_us) / 60e6},
+                     {"label", "line " + std::to_string(line.index)}});
+  }
+  return bands;
+}
+
+FigureRun drawFigures(const FigureBatch& batch, const std::string& out_dir, const FigureScriptOptions& options) {
+  FigureRun run;
+  if (batch.figures.empty()) return run;
+  std::vector<std::string> files;
+  for (const Json& figure : batch.figures) files.push_back(figure["file"].get<std::string>());
+  // Old PNGs of the same names go first, so that what exists afterwards is what this run drew.
+  std::error_code ec;
+  for (const std::string& file : files) fs::remove(fs::path(out_dir) / file, ec);
+  const std::string spec_path = (fs::path(batch.data_dir) / "figures.json").string();
+  const std::string log_path = (fs::path(batch.data_dir) / "report_figures.log").string();
+
+  std::string problem = batch.error;
+  if (problem.empty()) {
+    fs::create_directories(batch.data_dir, ec);
+    std::ofstream out(spec_path, std::ios::binary);
+    out << Json{{"schema", "sss-figures/1"}, {"figures", batch.figures}}.dump(1) << "\n";
+    out.close();
+    if (!out) problem = "cannot write " + spec_path + "; check the folder is writable";
+  }
+  if (problem.empty() && access(options.python.c_str(), X_OK) != 0) {
+    problem = options.python + " not found; install python3 and python3-matplotlib with tools/setup-deps.sh";
+  } else if (problem.empty() && !fs::is_regular_file(options.script, ec)) {
+    problem = "the figure script " + options.script + " is missing; run from the build tree or reinstall (cmake --install)";
+  } else if (problem.empty()) {
+    std::string error;
+    const int code = runScript(options, batch.data_dir, out_dir, log_path, error);
+    if (code == 3) {
+      problem = "matplotlib is not installed for " + options.python + "; run tools/setup-deps.sh (python3-matplotlib)";
+    } else if (code < 0) {
+      problem = error;
+    } else if (code != 0) {
+      problem = options.script + " failed (exit " + std::to_string(code) + "): " + lastLine(log_path) +
+                "; whole log in " + log_path;
+    }
+  }
+  for (const std::string& file : files) {
+    const fs::path path = fs::path(out_dir) / file;
+    if (fs::is_regular_file(path, ec)) {
+      run.written.push_back(path.string());
+    } else {
+      run.missing.push_back(file);
+    }
+  }
+  if (problem.empty() && !run.missing.empty()) problem = options.script + " exited 0 without writing them; see " + log_path;
+  if (!problem.empty()) {
+    std::string names;
+    for (const std::string& file : run.missing) names += (names.empty() ? "" : ", ") + file;
+    run.problem = "figures not drawn (" + names + "): " + problem;
+  }
+  return run;
+}
+
+}  // namespace sss::eval
