@@ -447,7 +447,7 @@ TEST(RelativePose, SharpPeaksWeighMoreThanFlatOnes) {
     RelativePoseOptions with = testOptions();
     with.range_sigma_m = 0.22;  // the median match's range error per slant range (0.31 m on the difference)
     with.seed = seed;
-    ASSERT_TRUE(with.range_sigma_from_peak);  // the default
+    with.range_sigma_from_peak = true;  // off by default (see RelativePoseOptions)
     RelativePoseOptions without = with;
     without.range_sigma_from_peak = false;
     const RelativePoseResult a = estimateRelativePose(pair.input, with);
