@@ -46,6 +46,11 @@ bool Runner::writeFixOutputs(const std::string& dir, std::string& error) {
   }
 
   sss::optimiser::SlidingWindowPoseGraph fixed(options_.optimiser.graph);
+  // The same anchor as the SLAM graph (the INS's accuracy at the first node), so the baseline
+  // differs from SLAM by the closures alone.
+  const Eigen::Vector2d& anchor_ins_sigma_ne_m = graph.firstNodeInsSigma();
+  if (anchor_ins_sigma_ne_m.x() > 0.0 || anchor_ins_sigma_ne_m.y() > 0.0)
+    fixed.setFirstNodeHorizontalSigma(anchor_ins_sigma_ne_m.x(), anchor_ins_sigma_ne_m.y());
   for (const sss::optimiser::NodeState& n : graph.nodes()) {
     fixed.addNode(n.subframe_id, n.utime_us, n.T_world_body_dr, n.distance_travelled_m);
   }
