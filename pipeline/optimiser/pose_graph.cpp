@@ -441,6 +441,13 @@ Matrix6d SlidingWindowPoseGraph::closureCovarianceInWindow(const Closure& c) con
     sigma += ad * nodes_[c.a].conditional_covariance * ad.transpose();
   }
   if (!isActive(c.b)) sigma += nodes_[c.b].conditional_covariance;
+  if (separationWidened()) {
+    // The residual's translation is in B's frame (T = T_hat Exp(d)); the direction is A's lateral.
+    const Eigen::Vector3d direction = c.record.closure.T_a_b.rotation.inverse() * separationDirection(c);
+    const double disputed_m2 = separation_bias_.tested_m * separation_bias_.tested_m +
+                               separation_bias_.sigma_m * separation_bias_.sigma_m;
+    sigma.topLeftCorner<3, 3>() += disputed_m2 * direction * direction.transpose();
+  }
   return sigma;
 }
 
@@ -468,7 +475,7 @@ ceres::CostFunction* SlidingWindowPoseGraph::makeCost(const Factor& f) const {
     case FactorKind::kClosure: {
       const Closure& c = closures_[f.index];
       Matrix6d sqrt_information = closureSqrtInformation(c);
-      if (!isActive(c.a) || !isActive(c.b)) {
+      if (!isActive(c.a) || !isActive(c.b) || (separationWidened() && separationDirection(c).squaredNorm() > 0.0)) {
         // Inflated covariance stays positive definite: a sum of a PD and a PSD matrix.
         Matrix6d inflated;
         if (sqrtInformation(closureCovarianceInWindow(c), inflated)) sqrt_information = inflated;

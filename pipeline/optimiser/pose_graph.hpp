@@ -123,6 +123,11 @@ struct PoseGraphOptions {
   // high-drift 1.72 -> 3.31 m). Absolute fixes or cross lines would tell the two apart.
   double separation_bias_sigma_m = 2.0;
   bool separation_bias_apply = false;
+  // When the bias is significant, not applied and a shortening (what feature faces do), the closures
+  // and DR disagree on the lines' separation and nothing tells which is wrong: widen the lateral
+  // variance of the opposite-side closures by the disputed amount (estimate^2 + sigma^2), so they
+  // keep what they say along track and in heading and stop pulling the lines together.
+  bool separation_bias_widen = false;
   double separation_bias_min_lateral_m = 10.0;
   double separation_bias_significance = 3.0;
 
@@ -541,6 +546,8 @@ class SlidingWindowPoseGraph {
   // Unit direction (in A's body frame) along which the separation bias moves the closure's
   // measured B, or zero when the closure is not between opposite-side lines.
   Eigen::Vector3d separationDirection(const Closure& closure) const;
+  // separation_bias_widen in effect: the last estimate significant and not applied.
+  bool separationWidened() const;
   // Variance components of closures and odometry at the current estimate, solving again with the
   // new factors until they settle (full smoothing, every node active).
   void reweighFromResiduals(const std::vector<Factor>& factors, UpdateReport& report, bool estimate_calibration);

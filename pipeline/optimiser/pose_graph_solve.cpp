@@ -81,6 +81,13 @@ Eigen::Vector3d SlidingWindowPoseGraph::separationDirection(const Closure& c) co
   return Eigen::Vector3d(0.0, lateral_m > 0.0 ? 1.0 : -1.0, 0.0);
 }
 
+bool SlidingWindowPoseGraph::separationWidened() const {
+  // Only a shortening (tested_m > 0) is what feature faces seen from opposite sides do to closures;
+  // closures that put the lines farther apart than DR point at DR (e.g. its scale on the turns).
+  return options_.separation_bias_widen && separation_bias_.significant && !separation_bias_.applied &&
+         separation_bias_.tested_m > 0.0 && std::isfinite(separation_bias_.sigma_m);
+}
+
 Matrix6d SlidingWindowPoseGraph::odometrySqrtInformation(int k, bool calibrated) const {
   const Node& node = nodes_[k];
   if (!calibrated || k == 0) return node.odometry_sqrt_information / std::sqrt(variance_factors_.odometry);

@@ -134,6 +134,43 @@ TEST(SeparationBias, TruthfulClosuresGiveNoBias) {
   }
 }
 
+// separation_bias_widen: the bias is found but not applied (it may be DR's), and the opposite-side
+// closures' lateral variance grows by the disputed amount. They then stop pulling the lines 1.5 m
+// together: the trajectory is better than the plain graph's. Truthful closures are never
+// significant, and closures that lengthen the separation are not what feature faces do: in both
+// nothing is widened and the trajectory is the plain one.
+TEST(SeparationBias, WideningTheDisputedSeparationStopsBiasedClosuresPullingTheLines) {
+  PoseGraphOptions plain_options = withBias(graphOptions());
+  plain_options.separation_bias_apply = false;
+  PoseGraphOptions widen_options = plain_options;
+  widen_options.separation_bias_widen = true;
+  for (uint64_t seed = 1; seed <= 4; ++seed) {
+    const synthetic::Mission truthful = synthetic::makeLawnmowerMission(goodInsMission(seed));
+    const synthetic::Mission biased = shortened(truthful, 1.5);
+    const Solved plain = smooth(biased, plain_options);
+    const Solved widened = smooth(biased, widen_options);
+    const Solved truthful_plain = smooth(truthful, plain_options);
+    const Solved truthful_widened = smooth(truthful, widen_options);
+    const double ate_dr = synthetic::translationRmse(synthetic::drPoses(truthful), truthful.nodes);
+    std::printf("seed %llu: closures 1.5 m short: ATE DR %.3f, plain %.3f, widened %.3f m (bias %.2f +- %.2f); "
+                "truthful closures %.3f / %.3f m\n",
+                static_cast<unsigned long long>(seed), ate_dr, plain.ate_m, widened.ate_m, widened.bias.tested_m,
+                widened.bias.sigma_m, truthful_plain.ate_m, truthful_widened.ate_m);
+    EXPECT_TRUE(widened.bias.significant) << "seed " << seed;
+    EXPECT_FALSE(widened.bias.applied) << "seed " << seed;
+    EXPECT_LT(widened.ate_m, 0.75 * plain.ate_m) << "seed " << seed;
+    EXPECT_FALSE(truthful_widened.bias.significant) << "seed " << seed;
+    EXPECT_EQ(truthful_widened.ate_m, truthful_plain.ate_m) << "seed " << seed;
+    // Closures that put the lines farther apart than DR: not what feature faces do; nothing widened.
+    const synthetic::Mission lengthened = shortened(truthful, -1.5);
+    const Solved lengthened_plain = smooth(lengthened, plain_options);
+    const Solved lengthened_widened = smooth(lengthened, widen_options);
+    EXPECT_TRUE(lengthened_widened.bias.significant) << "seed " << seed;
+    EXPECT_LT(lengthened_widened.bias.tested_m, 0.0) << "seed " << seed;
+    EXPECT_EQ(lengthened_widened.ate_m, lengthened_plain.ate_m) << "seed " << seed;
+  }
+}
+
 // Closures along one line (B ahead of A on the same track) or across it are not opposite-side pairs:
 // they take no bias. Cross lines (B's heading 90 deg off) neither.
 TEST(SeparationBias, OnlyParallelPairsOffToTheSideTakeIt) {
