@@ -179,7 +179,7 @@ Status SlidingWindowPoseGraph::addNode(int64_t subframe_id, int64_t utime_us, co
     }
   } else {
     node.estimate = node.dr;
-    const Matrix6d sqrt_information = firstNodeSqrtInformation(options_, first_node_ins_sigma_ne_m_);
+    const Matrix6d sqrt_information = firstNodeSqrtInformation(options_, firstNodeHorizontalSigma());
     node.covariance = (sqrt_information.transpose() * sqrt_information).inverse();
     node.has_covariance = true;
   }
@@ -187,6 +187,12 @@ Status SlidingWindowPoseGraph::addNode(int64_t subframe_id, int64_t utime_us, co
   nodes_.push_back(std::move(node));
   ++counters_.nodes_added;
   return Status::success();
+}
+
+Eigen::Vector2d SlidingWindowPoseGraph::firstNodeHorizontalSigma() const {
+  Eigen::Vector2d sigma_ne_m = Eigen::Vector2d::Constant(options_.first_node_sigma_m);
+  if (options_.first_node_sigma_from_ins) sigma_ne_m = sigma_ne_m.cwiseMax(first_node_ins_sigma_ne_m_);
+  return sigma_ne_m;
 }
 
 Status SlidingWindowPoseGraph::setFirstNodeHorizontalSigma(double north_m, double east_m) {
@@ -200,7 +206,7 @@ Status SlidingWindowPoseGraph::setFirstNodeHorizontalSigma(double north_m, doubl
   first_node_ins_sigma_ne_m_ = Eigen::Vector2d(north_m, east_m);
   if (nodes_.size() == 1) {
     // A lone first node's covariance is its anchor's (every solve recomputes the covariances).
-    const Matrix6d sqrt_information = firstNodeSqrtInformation(options_, first_node_ins_sigma_ne_m_);
+    const Matrix6d sqrt_information = firstNodeSqrtInformation(options_, firstNodeHorizontalSigma());
     nodes_[0].covariance = (sqrt_information.transpose() * sqrt_information).inverse();
   }
   return Status::success();
@@ -458,7 +464,7 @@ Matrix6d SlidingWindowPoseGraph::closureSqrtInformation(const Closure& c) const 
 ceres::CostFunction* SlidingWindowPoseGraph::makeCost(const Factor& f) const {
   switch (f.kind) {
     case FactorKind::kFirstNode:
-      return PosePriorError::create(firstNodePrior(), firstNodeSqrtInformation(options_, first_node_ins_sigma_ne_m_));
+      return PosePriorError::create(firstNodePrior(), firstNodeSqrtInformation(options_, firstNodeHorizontalSigma()));
     case FactorKind::kInsAbsolute: {
       const Eigen::Vector4d w = insAbsoluteWeights(options_);
       if (calibration_.estimated) {

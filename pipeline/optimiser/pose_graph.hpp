@@ -380,6 +380,9 @@ class SlidingWindowPoseGraph {
   Status setFirstNodeHorizontalSigma(double north_m, double east_m);
   // What setFirstNodeHorizontalSigma set (zero: not set).
   const Eigen::Vector2d& firstNodeInsSigma() const { return first_node_ins_sigma_ne_m_; }
+  // The anchor's 1-sigma north and east as held: first_node_sigma_m, or the INS's sigma where wider
+  // and first_node_sigma_from_ins is on.
+  Eigen::Vector2d firstNodeHorizontalSigma() const;
   // Queues a closure for the next optimize(); refused (with the reason) when an id is unknown, the
   // input is not finite, the covariance is not positive definite or it has too few inliers. A
   // closure to a marginalised node acts through that node held constant (see pose_graph.cpp); one

@@ -2,7 +2,6 @@
 // pose_graph_closures.cpp); not part of the public interface.
 #pragma once
 
-#include <algorithm>
 #include <cmath>
 
 #include "pipeline/optimiser/pose_graph.hpp"
@@ -16,14 +15,12 @@ using sss::core::Vector6d;
 
 namespace internal {
 
-// Whitening of the first node's anchor: first_node_sigma_m, or wider north and east where the INS
-// said it was less sure of its start (SlidingWindowPoseGraph::setFirstNodeHorizontalSigma).
-inline Matrix6d firstNodeSqrtInformation(const PoseGraphOptions& o, const Eigen::Vector2d& ins_sigma_ne_m) {
+// Whitening of the first node's anchor: its horizontal sigma north and east as the graph holds it
+// (SlidingWindowPoseGraph::firstNodeHorizontalSigma), first_node_sigma_m in depth.
+inline Matrix6d firstNodeSqrtInformation(const PoseGraphOptions& o, const Eigen::Vector2d& horizontal_sigma_ne_m) {
   Vector6d inverse_sigma;
   const double m = 1.0 / o.first_node_sigma_m, r = 1.0 / o.first_node_sigma_rad;
-  inverse_sigma << m, m, m, r, r, r;
-  if (o.first_node_sigma_from_ins)
-    for (int i = 0; i < 2; ++i) inverse_sigma(i) = 1.0 / std::max(o.first_node_sigma_m, ins_sigma_ne_m(i));
+  inverse_sigma << 1.0 / horizontal_sigma_ne_m(0), 1.0 / horizontal_sigma_ne_m(1), m, r, r, r;
   return inverse_sigma.asDiagonal();
 }
 

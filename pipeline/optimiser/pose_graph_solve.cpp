@@ -173,7 +173,7 @@ bool SlidingWindowPoseGraph::solve(const std::vector<Factor>& factors, int max_i
               ? CalibratedOdometryError::createEstimated(calibratedOdometry(f.index, true))
           : f.kind == FactorKind::kInsAbsolute
               ? CalibratedInsAbsoluteError::createEstimated(node.dr, insAbsoluteWeights(options_), dr_heading_rad)
-              : CalibratedPosePriorError::create(node.dr, firstNodeSqrtInformation(options_, first_node_ins_sigma_ne_m_), dr_heading_rad);
+              : CalibratedPosePriorError::create(node.dr, firstNodeSqrtInformation(options_, firstNodeHorizontalSigma()), dr_heading_rad);
       problem.AddResidualBlock(cost, nullptr, blocks);
       continue;
     }

@@ -85,6 +85,24 @@ int runScript(const FigureScriptOptions& options, const std::string& data_dir, c
   return WEXITSTATUS(status);
 }
 
+// Writes data_dir/NAME.npy (batch.error keeps the first failure) and returns the raster's entry
+// with its file and resolution; the caller adds where its corner lies.
+Json writeRaster(FigureBatch& batch, const std::string& name, const char* dtype, const void* data, size_t bytes,
+                 int rows, int cols, double resolution_m) {
+  std::error_code ec;
+  fs::create_directories(batch.data_dir, ec);
+  const std::string file = name + ".npy";
+  std::string error;
+  if (!writeNpy((fs::path(batch.data_dir) / file).string(), dtype, data, bytes, rows, cols, error) &&
+      batch.error.empty()) {
+    batch.error = error;
+  }
+  Json raster = Json::object();
+  raster["npy"] = file;
+  raster["resolution_m"] = resolution_m;
+  return raster;
+}
+
 }  // namespace
 
 std::string defaultFigureScript() {
@@ -105,36 +123,16 @@ Json& addFigure(FigureBatch& batch, const std::string& kind, const std::string& 
 }
 
 Json mosaicRaster(FigureBatch& batch, const GreyMosaic& mosaic, const std::string& name) {
-  std::error_code ec;
-  fs::create_directories(batch.data_dir, ec);
-  const std::string file = name + ".npy";
-  std::string error;
-  if (!writeNpy((fs::path(batch.data_dir) / file).string(), "|u1", mosaic.pixels.data(), mosaic.pixels.size(),
-                mosaic.rows, mosaic.cols, error) &&
-      batch.error.empty()) {
-    batch.error = error;
-  }
-  Json raster = Json::object();
-  raster["npy"] = file;
-  raster["resolution_m"] = mosaic.resolution_m;
+  Json raster = writeRaster(batch, name, "|u1", mosaic.pixels.data(), mosaic.pixels.size(), mosaic.rows, mosaic.cols,
+                            mosaic.resolution_m);
   raster["north_max_m"] = mosaic.north_max_m;
   raster["east_min_m"] = mosaic.east_min_m;
   return raster;
 }
 
 Json heightmapRaster(FigureBatch& batch, const HeightmapRaster& map, const std::string& name) {
-  std::error_code ec;
-  fs::create_directories(batch.data_dir, ec);
-  const std::string file = name + ".npy";
-  std::string error;
-  if (!writeNpy((fs::path(batch.data_dir) / file).string(), "<f4", map.depth_m.data(),
-                map.depth_m.size() * sizeof(float), map.rows, map.cols, error) &&
-      batch.error.empty()) {
-    batch.error = error;
-  }
-  Json raster = Json::object();
-  raster["npy"] = file;
-  raster["resolution_m"] = map.resolution_m;
+  Json raster = writeRaster(batch, name, "<f4", map.depth_m.data(), map.depth_m.size() * sizeof(float), map.rows,
+                            map.cols, map.resolution_m);
   raster["north_min_m"] = map.north_min_m;
   raster["east_min_m"] = map.east_min_m;
   return raster;

@@ -229,11 +229,7 @@ bool Runner::writeOutputs(std::string& error) {
   summary_.separation_bias = optimiser_.graph().separationBias();
   summary_.calibration = optimiser_.graph().calibration();
   summary_.anchor_ins_sigma_ne_m = optimiser_.graph().firstNodeInsSigma();
-  const sss::optimiser::PoseGraphOptions& graph_options = optimiser_.graph().options();
-  for (int i = 0; i < 2; ++i)
-    summary_.anchor_sigma_ne_m(i) = graph_options.first_node_sigma_from_ins
-                                        ? std::max(graph_options.first_node_sigma_m, summary_.anchor_ins_sigma_ne_m(i))
-                                        : graph_options.first_node_sigma_m;
+  summary_.anchor_sigma_ne_m = optimiser_.graph().firstNodeHorizontalSigma();
 
   // Bathymetry: SLAM poses (the product) and DR poses (the baseline the map error is compared to).
   const auto& bathymetry = options_.optimiser.bathymetry;
