@@ -33,14 +33,6 @@ struct NodeOptions {
   std::string state_directory;
 };
 
-// The service's log lines, written and cleared.
-void writeLog(sss::subframe::ServiceLog& log) {
-  for (const std::string& line : log.info) spdlog::info("{}", line);
-  for (const std::string& line : log.warnings) spdlog::warn("{}", line);
-  for (const std::string& line : log.errors) spdlog::error("{}", line);
-  log = {};
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -88,10 +80,10 @@ int main(int argc, char** argv) {
   service_options.numbering_path = state_directory.empty() ? "" : state_directory + "/numbering";
   sss::subframe::ServiceLog log;
   sss::subframe::SubframeBufferService service(service_options, log);
-  writeLog(log);
+  sss::transport::writeServiceLog(log);
 
   const auto publish = [&](const std::vector<sss::subframe::Subframe>& subframes) {
-    writeLog(log);
+    sss::transport::writeServiceLog(log);
     for (const sss::subframe::Subframe& subframe : subframes) {
       const sss_msgs::subframe_t message = sss::messages::toSubframeMessage(
           subframe, options.buffer.subframes.intensity_bits, options.buffer.subframes.max_intensity,
@@ -111,7 +103,7 @@ int main(int argc, char** argv) {
   loop.addTimer(1.0, [&] {
     service.reportHealth(loop.health(), sss::core::nowUtime(), log);
     loop.health().setQueueDepth(options.ping_channel, false, 0);
-    writeLog(log);
+    sss::transport::writeServiceLog(log);
   });
   const int code = loop.run();
   publish(service.finish(log));

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "pipeline/core/health.hpp"
+#include "pipeline/core/service_log.hpp"
 #include "pipeline/subframe/subframe_buffer.hpp"
 
 namespace sss::subframe {
@@ -27,12 +28,7 @@ struct SubframeBufferServiceOptions {
   std::string numbering_path;
 };
 
-struct ServiceLog {
-  std::vector<std::string> info;
-  std::vector<std::string> warnings;
-  std::vector<std::string> errors;
-  bool empty() const { return info.empty() && warnings.empty() && errors.empty(); }
-};
+using ServiceLog = sss::core::ServiceLog;
 
 class SubframeBufferService {
  public:

@@ -15,4 +15,11 @@ void initLogging(const std::string& process_name, const std::string& level) {
   spdlog::set_default_logger(logger);
 }
 
+void writeServiceLog(sss::core::ServiceLog& log) {
+  for (const std::string& line : log.info) spdlog::info("{}", line);
+  for (const std::string& line : log.warnings) spdlog::warn("{}", line);
+  for (const std::string& line : log.errors) spdlog::error("{}", line);
+  log = {};
+}
+
 }  // namespace sss::transport
