@@ -8,13 +8,11 @@
 // (loop_closures.csv), tracks and footprints (GeoJSON), coverage, mosaics, bathymetry (PLY) and heightmap,
 // the rasters also as GeoTIFF in the origin's UTM zone.
 //   sss-optimiser [--config FILE [--check-config]] [--lcm-url URL]
-#include <sys/eventfd.h>
-#include <unistd.h>
-
 #include <atomic>
 #include <csignal>
 #include <cstdint>
 #include <cstdlib>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -139,18 +137,13 @@ int main(int argc, char** argv) {
   sss::transport::initLogging(options.process.process_name, options.process.log_level);
   sss::transport::ProcessLoop loop(options.process);
   sss::core::HealthMonitor& health = loop.health();
-  // The worker wakes the loop through an eventfd when it has results.
-  const int results_fd = eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
-  if (results_fd < 0) {
+  // The worker wakes the loop when it has results: the trajectory for the matcher, the status.
+  std::function<void()> on_results;  // set once the service exists
+  const std::function<void()> results_ready = loop.addWakeup([&] { on_results(); });
+  if (!results_ready) {
     spdlog::error("cannot create an eventfd for the optimiser thread");
     return 1;
   }
-  const auto results_ready = [results_fd] {
-    const uint64_t one = 1;
-    if (write(results_fd, &one, sizeof one) < 0) {
-      // Saturated counter: the loop is already due to read.
-    }
-  };
   sss::core::ServiceLog log;
   sss::optimiser::OptimiserService service(options.service, results_ready, log);
   sss::transport::writeServiceLog(log);
@@ -205,13 +198,11 @@ int main(int argc, char** argv) {
     service.addFix(message, health, log);
     sss::transport::writeServiceLog(log);
   });
-  loop.addFileDescriptor(results_fd, [&] {
-    uint64_t count = 0;
-    if (read(results_fd, &count, sizeof count) < 0) return;
+  on_results = [&] {
     const std::optional<sss_msgs::trajectory_t> trajectory = service.takeResults(health, sss::core::nowUtime(), log);
     sss::transport::writeServiceLog(log);
     if (trajectory) loop.bus().publish(options.trajectory_channel, *trajectory);
-  });
+  };
 
   if (dds_writer) {
     loop.addTimer(0.25 / options.dds_rate_hz, [&] {
@@ -230,6 +221,5 @@ int main(int argc, char** argv) {
   // End of mission: whatever arrived last, full smoothing, products and a final checkpoint.
   service.finish(log);
   sss::transport::writeServiceLog(log);
-  close(results_fd);
   return exit_code;
 }

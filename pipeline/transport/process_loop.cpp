@@ -61,6 +61,7 @@ ProcessLoop::ProcessLoop(ProcessOptions options)
 ProcessLoop::~ProcessLoop() {
   g_wake_fd.store(-1);
   if (wake_fd_ >= 0) ::close(wake_fd_);
+  for (const int fd : wakeup_fds_) ::close(fd);
 }
 
 void ProcessLoop::addTimer(double period_s, std::function<void()> callback) {
@@ -70,6 +71,23 @@ void ProcessLoop::addTimer(double period_s, std::function<void()> callback) {
 
 void ProcessLoop::addFileDescriptor(int fd, std::function<void()> on_readable) {
   watched_fds_.push_back({fd, std::move(on_readable)});
+}
+
+std::function<void()> ProcessLoop::addWakeup(std::function<void()> on_wake) {
+  const int fd = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
+  if (fd < 0) return {};
+  wakeup_fds_.push_back(fd);
+  addFileDescriptor(fd, [fd, on_wake = std::move(on_wake)] {
+    uint64_t count = 0;
+    if (::read(fd, &count, sizeof count) < 0) return;  // EAGAIN: another wake-up took it
+    on_wake();
+  });
+  return [fd] {
+    const uint64_t one = 1;
+    if (::write(fd, &one, sizeof one) < 0) {
+      // Saturated counter: the loop is already due to wake.
+    }
+  };
 }
 
 void ProcessLoop::removeFileDescriptor(int fd) {

@@ -34,6 +34,10 @@ class ProcessLoop {
   // Calls on_readable when fd has data (or is closed/in error: POLLIN|POLLHUP|POLLERR).
   void addFileDescriptor(int fd, std::function<void()> on_readable);
   void removeFileDescriptor(int fd);
+  // For a worker thread that hands results to the loop: returns a thread-safe notify(); after one
+  // or more notify() calls the loop calls on_wake once, on its own thread. Empty when the kernel
+  // refuses an eventfd (the caller says so and exits).
+  std::function<void()> addWakeup(std::function<void()> on_wake);
 
   // Runs until stop() or a termination signal. Sends READY=1 first. Returns the exit code:
   // 0 after a graceful stop, 1 when the LCM URL could not be opened.
@@ -73,6 +77,7 @@ class ProcessLoop {
   std::vector<Timer> timers_;
   std::vector<WatchedFd> watched_fds_;
   int wake_fd_ = -1;  // eventfd written by stop() and the signal handler
+  std::vector<int> wakeup_fds_;  // addWakeup()'s eventfds, closed with the loop
 };
 
 }  // namespace sss::transport

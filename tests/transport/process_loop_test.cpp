@@ -5,6 +5,8 @@
 #include <unistd.h>
 
 #include <csignal>
+#include <functional>
+#include <thread>
 
 #include "pipeline/core/time.hpp"
 #include "sss_msgs/nav_t.hpp"
@@ -100,6 +102,30 @@ TEST(ProcessLoop, ReadableFileDescriptorCallsItsHandler) {
   EXPECT_EQ(received, "ping");
   ::close(fds[0]);
   ::close(fds[1]);
+}
+
+// A worker thread's notify() wakes the loop, which then runs on_wake on its own thread; notifies
+// that come before the loop gets to them are taken by one call.
+TEST(ProcessLoop, WakeupFromAnotherThreadRunsOnTheLoopsThread) {
+  ProcessLoop loop(testOptions(10.0));
+  const std::thread::id loop_thread = std::this_thread::get_id();
+  int wakes = 0;
+  bool on_loop_thread = true;
+  const std::function<void()> notify = loop.addWakeup([&] {
+    ++wakes;
+    on_loop_thread = on_loop_thread && std::this_thread::get_id() == loop_thread;
+    loop.stop();
+  });
+  ASSERT_TRUE(notify);
+  std::thread worker([&] {
+    notify();
+    notify();
+    notify();
+  });
+  worker.join();  // three notifies before the loop runs
+  EXPECT_EQ(loop.run(), 0);
+  EXPECT_EQ(wakes, 1);
+  EXPECT_TRUE(on_loop_thread);
 }
 
 TEST(ProcessLoop, UnopenableLcmUrlExitsWithAnError) {
