@@ -2,8 +2,9 @@
 // SSS_POSE for every nav sample and the correction on DDS for the navigation computer.
 // Wiring only: OptimiserService (optimiser_service.hpp) decodes the inputs, answers each nav sample
 // from the newest solved graph and has the graph solved by OptimiserWorker on its own thread, so a
-// solve never delays a pose; the DDS correction is paced by LatestSamplePacer. The engine (graph, ping poses, correspondences) is checkpointed after every update
-// into the state directory and restored at start. On SIGTERM (end of mission) or SIGUSR1 (on request) it runs full smoothing and
+// solve never delays a pose; the DDS correction is paced by LatestSamplePacer. The engine (graph,
+// ping poses, correspondences) is checkpointed after every update into the state directory and
+// restored at start. On SIGTERM (end of mission) or SIGUSR1 (on request) it runs full smoothing and
 // writes the products: optimised trajectory (TUM), corrected navigation (navigation.csv, .nmea), tie report
 // (loop_closures.csv), tracks and footprints (GeoJSON), coverage, mosaics, bathymetry (PLY) and heightmap,
 // the rasters also as GeoTIFF in the origin's UTM zone.

@@ -16,6 +16,7 @@ void initLogging(const std::string& process_name, const std::string& level) {
 }
 
 void writeServiceLog(sss::core::ServiceLog& log) {
+  if (log.empty()) return;  // the usual case, after every nav sample (200 Hz)
   for (const std::string& line : log.info) spdlog::info("{}", line);
   for (const std::string& line : log.warnings) spdlog::warn("{}", line);
   for (const std::string& line : log.errors) spdlog::error("{}", line);
