@@ -10,16 +10,14 @@
 
 #include <cstdint>
 #include <string>
-#include <vector>
 
 #include "drivers/ins/ins_bridge.hpp"
+#include "pipeline/core/service_log.hpp"
 
 namespace sss::ins {
 
-struct BridgeStateLog {
-  std::vector<std::string> info;
-  std::vector<std::string> errors;
-};
+// What the store has to say, for the process to write (info and errors).
+using BridgeStateLog = sss::core::ServiceLog;
 
 class BridgeStateStore {
  public:

@@ -1,27 +1,19 @@
 // sss-ins-bridge: iXblue NMEA from UDP, TCP, a serial port or a file -> SSS_NAV on LCM, with
 // staleness in the message flags and in SSS_STATUS; and, when fix_udp_port is set, absolute position
 // fixes (GNSS at the surface, USBL relayed by the modem: NMEA GGA + GST + ZDA on their own UDP port)
-// -> SSS_FIX, placed in the mission frame with the DR state at their time. Translation only; the
-// logic is in InsInputSource, InsBridge, PositionFixReader and FixAligner.
+// -> SSS_FIX, placed in the mission frame with the DR state at their time. Wiring only: the bytes come
+// from InsInputSource, the logic is InsBridgeService (ins_bridge_service.hpp).
 //   sss-ins-bridge [--config FILE] [--file ins.nmea [--speed X]] [--lcm-url URL]
 #include <cstdlib>
-#include <deque>
 #include <string>
-#include <string_view>
 
-#include "drivers/ins/bridge_state.hpp"
-#include "drivers/ins/fix_aligner.hpp"
-#include "drivers/ins/fix_message.hpp"
-#include "drivers/ins/ins_bridge.hpp"
+#include "drivers/ins/ins_bridge_service.hpp"
 #include "drivers/ins/ins_input_source.hpp"
-#include "drivers/ins/position_fix.hpp"
-#include "drivers/ins/nav_message.hpp"
 #include "pipeline/core/mission_origin.hpp"
 #include "pipeline/core/state_file.hpp"
 #include "pipeline/core/time.hpp"
 #include "pipeline/transport/logging.hpp"
 #include "pipeline/transport/process_loop.hpp"
-#include "pipeline/transport/replay_pacer.hpp"
 
 namespace {
 
@@ -79,38 +71,18 @@ std::string readNodeOptions(const std::string& config_path, NodeOptions& options
   return config.problemReport();
 }
 
-// SSS_STATUS: the staleness (recovers by itself when data returns) and the counters; the fixes'
-// counters only when fixes are read (fix_aligner set).
-void setStatusCounters(const sss::ins::InsBridge& bridge, const sss::ins::BridgeStateStore& state,
-                       const sss::ins::FixAligner* fix_aligner, const sss::ins::PositionFixReader& fix_reader,
-                       uint64_t fixes_published, sss::core::HealthMonitor& health) {
-  const std::string stale = bridge.describeStale(monotonicUtime());
-  health.setState(stale.empty() ? sss::core::HealthState::kOk : sss::core::HealthState::kWarning,
-                  stale.empty() ? "navigation ok" : stale);
-  const auto& stream = bridge.streamCounters();
-  health.setCounter("nmea_sentences", static_cast<double>(stream.sentences));
-  health.setCounter("nmea_bad_checksum", static_cast<double>(stream.bad_checksum));
-  health.setCounter("nmea_missing_checksum", static_cast<double>(stream.missing_checksum));
-  health.setCounter("nmea_overlong", static_cast<double>(stream.overlong));
-  health.setCounter("nmea_truncated", static_cast<double>(stream.truncated));
-  health.setCounter("nmea_garbage_bytes", static_cast<double>(stream.garbage_bytes));
-  health.setCounter("ins_epochs", static_cast<double>(bridge.assemblerCounters().epochs));
-  health.setCounter("ins_epochs_out_of_order", static_cast<double>(bridge.epochsOutOfOrder()));
-  health.setCounter("odometer_m", bridge.odometer().distance_travelled_m);
-  health.setCounter("odometer_write_failures", static_cast<double>(state.odometerWriteFailures()));
-  if (fix_aligner) {
-    const auto& aligned = fix_aligner->counters();
-    health.setCounter("fixes_in", static_cast<double>(aligned.fixes_in));
-    health.setCounter("fixes_published", static_cast<double>(fixes_published));
-    health.setCounter("fixes_below_surface", static_cast<double>(aligned.below_surface));
-    health.setCounter("fixes_outside_navigation", static_cast<double>(aligned.outside_navigation));
-    const auto& read = fix_reader.counters();
-    health.setCounter("fix_sentences_skipped", static_cast<double>(read.rejected_sentences + read.malformed));
-  }
-  if (bridge.origin()) {  // the mission frame, for the operator (NaN-free: only once it is known)
-    health.setCounter("origin_latitude_deg", bridge.origin()->latitude_deg);
-    health.setCounter("origin_longitude_deg", bridge.origin()->longitude_deg);
-  }
+// The service's options: the node's, with the state directory resolved.
+sss::ins::InsBridgeServiceOptions serviceOptions(const NodeOptions& options) {
+  sss::ins::InsBridgeServiceOptions service;
+  service.bridge = options.bridge;
+  service.replay = options.input.source == "file";
+  service.replay_speed = options.replay_speed;
+  service.read_fixes = options.fix_udp_port > 0;
+  service.fix_reader = options.fix_reader;
+  service.fix_aligner = options.fix_aligner;
+  service.state_directory =
+      sss::core::resolveSystemdDirectory(options.state_directory, std::getenv("STATE_DIRECTORY"));
+  return service;
 }
 
 // The fixes' own UDP port, on the INS input's address.
@@ -189,64 +161,29 @@ int main(int argc, char** argv) {
 
   sss::transport::initLogging(options.process.process_name, options.process.log_level);
   sss::transport::ProcessLoop loop(options.process);
-  sss::core::HealthMonitor& health = loop.health();
-  sss::ins::InsBridge bridge(options.bridge);
-  std::vector<sss::ins::NavSample> samples;
+  sss::core::ServiceLog log;
+  sss::ins::InsBridgeService service(serviceOptions(options), log);
+  sss::transport::writeServiceLog(log);
 
-  // The odometer and the mission origin across restarts (bridge_state.hpp). A file replay is
-  // offline: nothing kept.
-  sss::ins::BridgeStateStore state(options.input.source == "file" ? std::string()
-      : sss::core::resolveSystemdDirectory(options.state_directory, std::getenv("STATE_DIRECTORY")));
-  // Runs one step of the store and writes what it says.
-  auto logged = [](const auto& step) {
-    sss::ins::BridgeStateLog lines;
-    step(lines);
-    for (const std::string& line : lines.info) spdlog::info("{}", line);
-    for (const std::string& line : lines.errors) spdlog::error("{}", line);
+  auto publish = [&](const sss::ins::BridgeMessages& messages) {
+    sss::transport::writeServiceLog(log);
+    for (const auto& nav : messages.nav) loop.bus().publish(options.nav_channel, nav, messages.since_monotonic_us);
+    for (const auto& fix : messages.fixes) loop.bus().publish(options.fix_channel, fix, messages.since_monotonic_us);
   };
-  logged([&](sss::ins::BridgeStateLog& lines) { state.restore(bridge, lines); });
   auto saveOdometerIfMoved = [&] {
-    logged([&](sss::ins::BridgeStateLog& lines) { state.saveOdometerIfMoved(bridge, lines); });
+    service.saveOdometerIfMoved(log);
+    sss::transport::writeServiceLog(log);
   };
   loop.addTimer(1.0, saveOdometerIfMoved);
-
-  // Fixes: read from their port, tied to the navigation as it passes their time.
-  sss::ins::PositionFixReader fix_reader(options.fix_reader);
-  sss::ins::FixAligner fix_aligner(options.fix_aligner);
-  uint64_t fixes_published = 0;
-  bool fix_problem_reported = false;
-  auto publishFixes = [&](int64_t since_us) {
-    if (!bridge.origin()) return;
-    for (const sss::ins::AlignedFix& fix : fix_aligner.take()) {
-      loop.bus().publish(options.fix_channel, sss::ins::toFixMessage(fix, *bridge.origin()), since_us);
-      ++fixes_published;
-    }
-  };
-  auto publishAll = [&](int64_t since_us) {
-    logged([&](sss::ins::BridgeStateLog& lines) { state.noteOrigin(bridge, lines); });
-    for (const auto& sample : samples) {
-      loop.bus().publish(options.nav_channel, sss::ins::toNavMessage(sample), since_us);
-      if ((sample.ins.validity & sss::ins::kValidPosition) && sample.origin)
-        fix_aligner.addNav(sample.ins.utime_us, sample.position_ned_m, sample.distance_travelled_m, sample.origin);
-    }
-    samples.clear();
-    if (options.fix_udp_port > 0) publishFixes(since_us);
-  };
-  // Health: staleness (recovers by itself when data returns), counters, faults logged once.
   loop.addTimer(0.5, [&] {
-    setStatusCounters(bridge, state, options.fix_udp_port > 0 ? &fix_aligner : nullptr, fix_reader, fixes_published, health);
-    if (options.fix_udp_port > 0 && !fix_problem_reported && !fix_reader.firstProblem().empty()) {
-      loop.reportFaults("fix_input", {"fixes: " + fix_reader.firstProblem()});  // once: later ones are counted
-      fix_problem_reported = true;
-    }
-    loop.reportFaults("ins_input", bridge.takeNewFaultMessages());
+    service.reportHealth(loop.health(), monotonicUtime());
+    loop.reportFaults("fix_input", service.takeFixFaults());
+    loop.reportFaults("ins_input", service.takeInsFaults());
   });
 
+  // Fixes: read from their own port, placed as the navigation passes their time.
   sss::ins::InsInputHooks fix_hooks;
-  fix_hooks.chunk = [&](const sss::ins::InsInputChunk& chunk) {
-    fix_reader.feed(std::string_view(reinterpret_cast<const char*>(chunk.data), chunk.size));
-    for (const sss::ins::PositionFix& fix : fix_reader.take()) fix_aligner.addFix(fix);
-  };
+  fix_hooks.chunk = [&](const sss::ins::InsInputChunk& chunk) { publish(service.onFixChunk(chunk)); };
   sss::ins::InsInputSource fix_input(fixInputOptions(options), fix_hooks);
   if (options.fix_udp_port > 0) {
     if (const std::string error = fix_input.open(); !error.empty()) {
@@ -255,27 +192,16 @@ int main(int argc, char** argv) {
     }
     spdlog::info("absolute fixes (NMEA GGA + GST + ZDA) on UDP {}:{} -> {}", options.input.bind_address,
                  options.fix_udp_port, options.fix_channel);
-    loop.addFileDescriptor(fix_input.fd(), [&] { fix_input.read(0.0); publishFixes(monotonicUtime()); });
+    loop.addFileDescriptor(fix_input.fd(), [&] { fix_input.read(0.0); });
   }
 
-  // The INS bytes: samples go out as they come, or, replaying a file, wait in a queue for the
-  // recorded pace.
-  const bool replay = options.input.source == "file";
-  std::deque<sss::ins::NavSample> replay_queue;
-  sss::transport::ReplayPacer pacer(options.replay_speed);
+  // The INS bytes: live, samples go out as they come; replaying a file, at the recorded pace.
   sss::ins::InsInputHooks hooks;
-  hooks.chunk = [&](const sss::ins::InsInputChunk& chunk) {
-    bridge.onBytes(chunk.data, chunk.size, chunk.arrival_us, samples);
-    if (chunk.end_of_file) bridge.finish(chunk.arrival_us, samples);
-    else if (chunk.stream_break) bridge.onChunkEnd(chunk.arrival_us, samples);
-    if (!replay) return publishAll(chunk.arrival_us);
-    replay_queue.insert(replay_queue.end(), samples.begin(), samples.end());
-    samples.clear();
-  };
+  hooks.chunk = [&](const sss::ins::InsInputChunk& chunk) { publish(service.onInsChunk(chunk, log)); };
   hooks.info = [](const std::string& line) { spdlog::info("{}", line); };
   hooks.warning = [](const std::string& line) { spdlog::warn("{}", line); };
   hooks.open_failed = [&](const std::string& error) {
-    if (health.recordError("serial_open", error, sss::core::nowUtime())) spdlog::warn("{}; retrying", error);
+    if (loop.health().recordError("serial_open", error, sss::core::nowUtime())) spdlog::warn("{}; retrying", error);
   };
   sss::ins::InsInputSource input(options.input, hooks);
   if (const std::string error = input.open(); !error.empty()) {
@@ -283,17 +209,13 @@ int main(int argc, char** argv) {
     return 1;
   }
   InputOnLoop input_on_loop(input, loop);
-  if (replay) {
+  if (options.input.source == "file") {
     loop.addTimer(0.002, [&] {
-      while (!input.atEnd() && replay_queue.size() < 256) input.read(0.0);
-      const int64_t now = monotonicUtime();
-      for (int budget = 500; budget > 0 && !replay_queue.empty() && pacer.due(replay_queue.front().ins.utime_us, now); --budget) {
-        samples.push_back(replay_queue.front());
-        replay_queue.pop_front();
-        publishAll(now);
-      }
-      if (input.atEnd() && replay_queue.empty()) {
-        spdlog::info("replay of '{}' finished: {} epochs", options.input.file, bridge.assemblerCounters().epochs);
+      while (!input.atEnd() && service.wantsReplayInput()) input.read(0.0);
+      publish(service.takeDue(monotonicUtime(), log));
+      if (input.atEnd() && service.replayQueueEmpty()) {
+        spdlog::info("replay of '{}' finished: {} epochs", options.input.file,
+                     service.bridge().assemblerCounters().epochs);
         loop.stop();
       }
     });

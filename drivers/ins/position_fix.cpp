@@ -119,7 +119,20 @@ void PositionFixReader::feed(std::string_view bytes) {
   std::vector<std::string> sentences;
   impl_->framing.feed(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size(), sentences);
   for (const std::string& s : sentences) addSentence(s);
+  countRejectedSentences();
+}
+
+// Sentences the framing refused, counted, and the first refusal's cause kept as the first problem
+// (a live stream is never finished: it must say so as it goes).
+void PositionFixReader::countRejectedSentences() {
   counters_.rejected_sentences = static_cast<uint64_t>(impl_->framing.rejectedSentences());
+  if (counters_.rejected_sentences == 0 || !first_problem_.empty()) return;
+  const NmeaStreamFirstErrors& e = impl_->framing.firstErrors();
+  for (const std::string* text : {&e.bad_checksum, &e.missing_checksum, &e.overlong, &e.bad_character, &e.truncated})
+    if (!text->empty()) {
+      problem(*text);
+      break;
+    }
 }
 
 void PositionFixReader::addSentence(const std::string& body) {
@@ -224,15 +237,7 @@ std::vector<PositionFix> PositionFixReader::finish() {
   std::vector<std::string> sentences;
   impl_->framing.flush(sentences);
   for (const std::string& s : sentences) addSentence(s);
-  counters_.rejected_sentences = static_cast<uint64_t>(impl_->framing.rejectedSentences());
-  if (counters_.rejected_sentences > 0) {
-    const NmeaStreamFirstErrors& e = impl_->framing.firstErrors();
-    for (const std::string* text : {&e.bad_checksum, &e.missing_checksum, &e.overlong, &e.bad_character, &e.truncated})
-      if (!text->empty()) {
-        problem(*text);
-        break;
-      }
-  }
+  countRejectedSentences();
   release();
   return take();
 }

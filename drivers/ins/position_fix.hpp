@@ -85,6 +85,7 @@ class PositionFixReader {
   void addSentence(const std::string& body);
   void release();  // the pending fix is complete
   void problem(const std::string& text);
+  void countRejectedSentences();
 
   FixReaderOptions options_;
   std::optional<FixSource> forced_source_;
