@@ -111,6 +111,18 @@ bool opposedLooks(const GeoImage& a, int ra, int ca, const GeoImage& b, int rb, 
   return side_a * side_b * col_a.dot(col_b) < -0.70710678f * norms;
 }
 
+// Of a patch's contrast about its mean (sum of squared deviations over its valid pixels), the share
+// on raised features' pixels.
+// Whether a patch holds a raised feature's pixel (grid_relief 255).
+bool patchHasRelief(const cv::Mat1b& grid_relief, int r, int c, int half) {
+  for (int y = r - half; y <= r + half; ++y) {
+    const std::uint8_t* row = grid_relief.ptr<std::uint8_t>(y);
+    for (int x = c - half; x <= c + half; ++x)
+      if (row[x]) return true;
+  }
+  return false;
+}
+
 // Valid geo-referenced pixels of B as a nanoflann point cloud (positions relative to an origin,
 // so float keeps millimetres far from the mission origin).
 struct PointCloud {
@@ -393,6 +405,36 @@ float parabolaPeak(float minus, float centre, float plus) {
 
 }  // namespace
 
+cv::Mat1b findReliefFeatures(const GeoImage& image, double outlier_sigmas) {
+  std::vector<float> logs;
+  logs.reserve(image.intensity.total());
+  float largest = 0.0f;
+  for (int r = 0; r < image.intensity.rows; ++r)
+    for (int c = 0; c < image.intensity.cols; ++c)
+      if (image.valid(r, c)) largest = std::max(largest, image.intensity(r, c));
+  // A shadow holds no echo: its intensity may be 0. Floored far below any echo, so it stays an outlier.
+  const float floor = std::max(1e-30f, 1e-6f * largest);
+  auto logOf = [floor](float v) { return std::log(std::max(v, floor)); };
+  for (int r = 0; r < image.intensity.rows; ++r)
+    for (int c = 0; c < image.intensity.cols; ++c)
+      if (image.valid(r, c)) logs.push_back(logOf(image.intensity(r, c)));
+  if (logs.size() < 100) return {};
+  const auto middle = logs.begin() + static_cast<std::ptrdiff_t>(logs.size() / 2);
+  std::nth_element(logs.begin(), middle, logs.end());
+  const float median = *middle;
+  for (float& v : logs) v = std::abs(v - median);
+  std::nth_element(logs.begin(), middle, logs.end());
+  const float sigma = 1.4826f * *middle;
+  cv::Mat1b relief = cv::Mat1b::zeros(image.intensity.rows, image.intensity.cols);
+  if (!(sigma > 0.0f)) return relief;
+  const float limit = static_cast<float>(outlier_sigmas) * sigma;
+  for (int r = 0; r < image.intensity.rows; ++r)
+    for (int c = 0; c < image.intensity.cols; ++c)
+      if (image.valid(r, c) && std::abs(logOf(image.intensity(r, c)) - median) > limit) relief(r, c) = 255;
+  cv::dilate(relief, relief, cv::Mat1b::ones(3, 3));
+  return relief;
+}
+
 std::vector<std::string> validateDenseMatcherOptions(const DenseMatcherOptions& o) {
   std::vector<std::string> problems;
   if (o.patch_size < 3 || o.patch_size > 31 || o.patch_size % 2 == 0)
@@ -438,6 +480,7 @@ void readDenseMatcherOptions(sss::core::ConfigSection& section, DenseMatcherOpti
   section.optional("max_fb_error_px", options.max_fb_error_px, {atLeast(0.0)});
   section.optional("subpixel", options.subpixel);
   section.optional("reject_mirrored_relief", options.reject_mirrored_relief);
+  section.optional("reject_shadowed_relief", options.reject_shadowed_relief);
   section.optional("min_coherent_neighbours", options.min_coherent_neighbours, {inRange(0, 8)});
   section.optional("min_structure_ratio", options.min_structure_ratio, {inRange(0.0, 1.0)});
   section.optional("random_search_ratio", options.random_search_ratio,
@@ -513,6 +556,15 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
   }
   grid_b.value = cv::Mat1f::zeros(grid_rows, grid_cols);
   grid_b.weight = cv::Mat1f::zeros(grid_rows, grid_cols);
+  // Raised features' pixels on the grid (reject_shadowed_relief), B's where any of the four pixels
+  // of its bilinear sample is one.
+  const bool test_relief = o.reject_shadowed_relief && !a.relief.empty() && !b.relief.empty();
+  cv::Mat1b relief_a, relief_b;
+  if (test_relief) {
+    relief_a = cv::Mat1b::zeros(grid_rows, grid_cols);
+    a.relief.copyTo(relief_a(cv::Rect(pad_c, pad_r, a.intensity.cols, a.intensity.rows)));
+    relief_b = cv::Mat1b::zeros(grid_rows, grid_cols);
+  }
   cv::Mat2f map_to_b(grid_rows, grid_cols, cv::Vec2f(-1.0f, -1.0f));  // continuous (row, col) in B
   cv::Mat1b has_map = cv::Mat1b::zeros(grid_rows, grid_cols);
   const float max_distance_sq = static_cast<float>(o.max_init_distance_m * o.max_init_distance_m);
@@ -555,6 +607,8 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
         grid_b.value(gr, gc) = (1 - fr) * ((1 - fc) * b.intensity(r0, c0) + fc * b.intensity(r0, c0 + 1)) +
                                fr * ((1 - fc) * b.intensity(r0 + 1, c0) + fc * b.intensity(r0 + 1, c0 + 1));
         grid_b.weight(gr, gc) = 1.0f;
+        if (test_relief && (b.relief(r0, c0) || b.relief(r0 + 1, c0) || b.relief(r0, c0 + 1) || b.relief(r0 + 1, c0 + 1)))
+          relief_b(gr, gc) = 255;
       }
     }
   });
@@ -696,10 +750,18 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
       if (nearest_r < 0 || nearest_c < 0 || nearest_r >= b.valid.rows || nearest_c >= b.valid.cols ||
           !b.valid(nearest_r, nearest_c))
         continue;
-      if (o.reject_mirrored_relief &&
-          opposedLooks(a, sr - pad_r, sc - pad_c, b, nearest_r, nearest_c) &&
+      const bool opposed = (o.reject_mirrored_relief || test_relief) &&
+                           opposedLooks(a, sr - pad_r, sc - pad_c, b, nearest_r, nearest_c);
+      if (opposed && o.reject_mirrored_relief &&
           bestMirroredScore(score_mirrored, sr, sc, tr, tc, half, grid_cols) > forward.score[k]) {
         mirrored_nodes.push_back({i, j});
+        continue;
+      }
+      // A feature's face or shadow in either patch: its contrast outweighs the seabed's and moves
+      // the peak towards the side it is seen from.
+      if (opposed && test_relief &&
+          (patchHasRelief(relief_a, sr, sc, half) || patchHasRelief(relief_b, tr, tc, half))) {
+        ++t.shadowed_relief_rejected;
         continue;
       }
       Correspondence match;

@@ -106,6 +106,7 @@ void addTimings(MatchTimings& total, const MatchTimings& pass) {
   total.total_s += pass.total_s;
   total.overlapping_pixels = std::max(total.overlapping_pixels, pass.overlapping_pixels);
   total.mirrored_relief_rejected += pass.mirrored_relief_rejected;
+  total.shadowed_relief_rejected += pass.shadowed_relief_rejected;
 }
 
 }  // namespace
@@ -199,8 +200,12 @@ PairMatch matchPair(const sss::core::Subframe& a, const std::vector<sss::core::P
     return result;
   }
   result.decimation = columnDecimation(a.geometry, options);
-  const GeoImage image_a = toGeoImage(a, poses_a, result.decimation, options.smoothing_sigma_px);
-  const GeoImage image_b = toGeoImage(b, poses_b, result.decimation, options.smoothing_sigma_px);
+  GeoImage image_a = toGeoImage(a, poses_a, result.decimation, options.smoothing_sigma_px);
+  GeoImage image_b = toGeoImage(b, poses_b, result.decimation, options.smoothing_sigma_px);
+  if (dense.options().reject_shadowed_relief) {  // on the smoothed intensity, for both passes
+    image_a.relief = findReliefFeatures(image_a);
+    image_b.relief = findReliefFeatures(image_b);
+  }
   result.georeference_s = secondsSince(start);
   result.matches = dense.match(image_a, image_b, &result.dense_timings);
   if (options.rectify_sigma_px > 0.0) {
