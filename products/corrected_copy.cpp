@@ -15,6 +15,8 @@
 #include "drivers/xtf/xtf_writer.hpp"
 
 namespace sss::products {
+
+using sss::core::Status;
 namespace {
 
 constexpr double kRadToDeg = 180.0 / M_PI;
@@ -25,19 +27,15 @@ struct FileCloser {
 using File = std::unique_ptr<std::FILE, FileCloser>;
 
 // The copy to patch: in_path copied to out_path and opened for update.
-File copyForUpdate(const std::string& in_path, const std::string& out_path, std::string& error) {
+sss::core::Result<File> copyForUpdate(const std::string& in_path, const std::string& out_path) {
   std::error_code ec;
   if (std::filesystem::equivalent(in_path, out_path, ec)) {
-    error = "the corrected copy " + out_path + " would overwrite its input; write it to another folder";
-    return nullptr;
+    return Status::error("the corrected copy " + out_path + " would overwrite its input; write it to another folder");
   }
   std::filesystem::copy_file(in_path, out_path, std::filesystem::copy_options::overwrite_existing, ec);
-  if (ec) {
-    error = "cannot copy " + in_path + " to " + out_path + ": " + ec.message();
-    return nullptr;
-  }
+  if (ec) return Status::error("cannot copy " + in_path + " to " + out_path + ": " + ec.message());
   File file(std::fopen(out_path.c_str(), "r+b"));
-  if (!file) error = "cannot open " + out_path + " for update";
+  if (!file) return Status::error("cannot open " + out_path + " for update");
   return file;
 }
 
@@ -49,12 +47,12 @@ bool read(std::FILE* file, uint64_t offset, uint8_t* bytes, size_t size) {
   return std::fseek(file, static_cast<long>(offset), SEEK_SET) == 0 && std::fread(bytes, 1, size, file) == size;
 }
 
-bool fail(File& file, const std::string& out_path, const std::string& message, std::string& error) {
+// Closes and removes the half-written copy.
+Status fail(File& file, const std::string& out_path, const std::string& message) {
   file.reset();
   std::error_code ec;
   std::filesystem::remove(out_path, ec);
-  error = message;
-  return false;
+  return Status::error(message);
 }
 
 double wrapDegrees(double degrees) {
@@ -64,27 +62,27 @@ double wrapDegrees(double degrees) {
 
 }  // namespace
 
-bool writeCorrectedJsf(const std::string& in_path, const std::string& out_path, const NavigationAt& navigation,
-                       CorrectedCopyCounters& counters, std::string& error) {
+Status writeCorrectedJsf(const std::string& in_path, const std::string& out_path, const NavigationAt& navigation,
+                         CorrectedCopyCounters& counters) {
   sss::edgetech::JsfFileReader reader(in_path);
   if (!reader.isOpen()) {
-    error = reader.error();
-    return false;
+    return Status::error(reader.error());
   }
-  File out = copyForUpdate(in_path, out_path, error);
-  if (!out) return false;
+  sss::core::Result<File> copy = copyForUpdate(in_path, out_path);
+  if (!copy) return copy.status();
+  File out = std::move(*copy);
   sss::edgetech::JsfMessage message;
   while (reader.next(message)) {
     if (message.header.message_type != sss::edgetech::kJsfSonarData) continue;
-    const sss::edgetech::SonarDecodeResult decoded =
+    const sss::core::Result<sss::edgetech::SonarChannelRecord> decoded =
         sss::edgetech::decodeSonarData(message.header, message.body.data(), message.body.size());
     const std::optional<PingNavigation> nav =
-        decoded.record ? navigation(decoded.record->ping_time_us) : std::nullopt;
+        decoded.ok() ? navigation(decoded->ping_time_us) : std::nullopt;
     if (!nav) {
       ++counters.records_without_pose;
       continue;
     }
-    sss::edgetech::SonarChannelRecord record = *decoded.record;
+    sss::edgetech::SonarChannelRecord record = *decoded;
     record.projected_position = nav->projected;
     record.latitude_deg = nav->latitude_deg;
     record.longitude_deg = nav->longitude_deg;
@@ -102,25 +100,25 @@ bool writeCorrectedJsf(const std::string& in_path, const std::string& out_path, 
     std::vector<uint8_t> header(message.body.begin(), message.body.begin() + sss::edgetech::kSonarDataHeaderSize);
     sss::edgetech::encodeSonarNavigation(record, header.data());
     if (!patch(out.get(), message.stream_offset + sss::edgetech::kJsfHeaderSize, header.data(), header.size())) {
-      return fail(out, out_path, "cannot write " + out_path, error);
+      return fail(out, out_path, "cannot write " + out_path);
     }
     ++counters.records_corrected;
   }
-  if (std::fclose(out.release()) != 0) return fail(out, out_path, "cannot write " + out_path, error);
-  return true;
+  if (std::fclose(out.release()) != 0) return fail(out, out_path, "cannot write " + out_path);
+  return Status::success();
 }
 
-bool writeCorrectedXtf(const std::string& in_path, const std::string& out_path, const NavigationAt& navigation,
-                       CorrectedCopyCounters& counters, std::string& error, int xtf_pair_index) {
+Status writeCorrectedXtf(const std::string& in_path, const std::string& out_path, const NavigationAt& navigation,
+                         CorrectedCopyCounters& counters, int xtf_pair_index) {
   sss::xtf::XtfReaderOptions options;
   options.pair_index = xtf_pair_index;
   sss::xtf::XtfReader reader(in_path, options);
   if (!reader.isOpen()) {
-    error = reader.error();
-    return false;
+    return Status::error(reader.error());
   }
-  File out = copyForUpdate(in_path, out_path, error);
-  if (!out) return false;
+  sss::core::Result<File> copy = copyForUpdate(in_path, out_path);
+  if (!copy) return copy.status();
+  File out = std::move(*copy);
   sss::edgetech::DriverPing ping;
   std::vector<uint8_t> header(sss::xtf::kPingHeaderBytes);
   while (reader.next(ping)) {
@@ -131,7 +129,7 @@ bool writeCorrectedXtf(const std::string& in_path, const std::string& out_path, 
     }
     const uint64_t offset = reader.lastPingOffset();
     if (!read(out.get(), offset, header.data(), header.size())) {
-      return fail(out, out_path, "cannot read back " + out_path, error);
+      return fail(out, out_path, "cannot read back " + out_path);
     }
     sss::xtf::XtfPingInput fields;
     fields.sensor_y = nav->projected ? nav->northing_m : nav->latitude_deg;
@@ -142,12 +140,12 @@ bool writeCorrectedXtf(const std::string& in_path, const std::string& out_path, 
     fields.heading_deg = static_cast<float>(wrapDegrees(nav->heading_rad * kRadToDeg));
     sss::xtf::encodePingNavigation(fields, header.data());
     if (!patch(out.get(), offset, header.data(), header.size())) {
-      return fail(out, out_path, "cannot write " + out_path, error);
+      return fail(out, out_path, "cannot write " + out_path);
     }
     ++counters.records_corrected;
   }
-  if (std::fclose(out.release()) != 0) return fail(out, out_path, "cannot write " + out_path, error);
-  return true;
+  if (std::fclose(out.release()) != 0) return fail(out, out_path, "cannot write " + out_path);
+  return Status::success();
 }
 
 }  // namespace sss::products

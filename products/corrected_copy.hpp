@@ -8,6 +8,8 @@
 #include <optional>
 #include <string>
 
+#include "pipeline/core/status.hpp"
+
 namespace sss::products {
 
 // The navigation to write into a ping, in the file's units: latitude/longitude degrees, or the
@@ -29,11 +31,12 @@ struct CorrectedCopyCounters {
 };
 
 // Copies in_path to out_path, then rewrites the navigation of every ping the project's reader
-// finds (JSF type 80 messages; XTF sonar packets of the side-scan pair read). False with a message
+// finds (JSF type 80 messages; XTF sonar packets of the side-scan pair read). Fails with a message
 // when a file cannot be read or written; out_path is removed then.
-bool writeCorrectedJsf(const std::string& in_path, const std::string& out_path, const NavigationAt& navigation,
-                       CorrectedCopyCounters& counters, std::string& error);
-bool writeCorrectedXtf(const std::string& in_path, const std::string& out_path, const NavigationAt& navigation,
-                       CorrectedCopyCounters& counters, std::string& error, int xtf_pair_index = 0);
+sss::core::Status writeCorrectedJsf(const std::string& in_path, const std::string& out_path,
+                                    const NavigationAt& navigation, CorrectedCopyCounters& counters);
+sss::core::Status writeCorrectedXtf(const std::string& in_path, const std::string& out_path,
+                                    const NavigationAt& navigation, CorrectedCopyCounters& counters,
+                                    int xtf_pair_index = 0);
 
 }  // namespace sss::products

@@ -13,6 +13,8 @@
 
 namespace sss::products {
 
+using sss::core::Status;
+
 namespace {
 
 // Inside a convex quadrilateral given in order (either winding).
@@ -87,11 +89,10 @@ CoverageGrid computeCoverage(const std::vector<FootprintStrip>& strips, double r
   return grid;
 }
 
-bool writeCoverageFiles(const std::string& yaml_path, const CoverageGrid& grid, std::string& error,
-                        const std::optional<sss::core::MissionOrigin>& origin) {
+Status writeCoverageFiles(const std::string& yaml_path, const CoverageGrid& grid,
+                          const std::optional<sss::core::MissionOrigin>& origin) {
   if (grid.rows < 1 || grid.cols < 1) {
-    error = "coverage " + yaml_path + " has no cells (no subframe)";
-    return false;
+    return Status::error("coverage " + yaml_path + " has no cells (no subframe)");
   }
   std::string prefix = yaml_path;
   if (prefix.size() > 5 && prefix.compare(prefix.size() - 5, 5, ".yaml") == 0) prefix.resize(prefix.size() - 5);
@@ -99,8 +100,7 @@ bool writeCoverageFiles(const std::string& yaml_path, const CoverageGrid& grid, 
   std::ofstream raw(raw_path, std::ios::binary);
   raw.write(reinterpret_cast<const char*>(grid.lines.data()), static_cast<std::streamsize>(grid.lines.size()));
   if (!raw) {
-    error = "cannot write " + raw_path;
-    return false;
+    return Status::error("cannot write " + raw_path);
   }
   std::ostringstream yaml;
   yaml.precision(12);
@@ -116,8 +116,7 @@ bool writeCoverageFiles(const std::string& yaml_path, const CoverageGrid& grid, 
   std::ofstream out(prefix + ".yaml");
   out << yaml.str();
   if (!out) {
-    error = "cannot write " + prefix + ".yaml";
-    return false;
+    return Status::error("cannot write " + prefix + ".yaml");
   }
   // North up: image row 0 is the northernmost grid row.
   cv::Mat image(grid.rows, grid.cols, CV_8UC3);
@@ -129,10 +128,9 @@ bool writeCoverageFiles(const std::string& yaml_path, const CoverageGrid& grid, 
       image.at<cv::Vec3b>(grid.rows - 1 - r, c) = colour;
     }
   if (!cv::imwrite(prefix + ".png", image)) {
-    error = "cannot write " + prefix + ".png";
-    return false;
+    return Status::error("cannot write " + prefix + ".png");
   }
-  return true;
+  return Status::success();
 }
 
 FrameRaster coverageRaster(const CoverageGrid& grid) {

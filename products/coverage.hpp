@@ -36,8 +36,8 @@ CoverageGrid computeCoverage(const std::vector<FootprintStrip>& strips, double r
 
 // coverage.yaml (geo-reference: the heightmap's keys), coverage_lines.u8 (raw uint8, row-major) and
 // coverage.png (none black, one line grey, two green, three or more blue), north up.
-bool writeCoverageFiles(const std::string& yaml_path, const CoverageGrid& grid, std::string& error,
-                        const std::optional<sss::core::MissionOrigin>& origin);
+sss::core::Status writeCoverageFiles(const std::string& yaml_path, const CoverageGrid& grid,
+                                     const std::optional<sss::core::MissionOrigin>& origin);
 
 // The grid as an 8-bit GeoTIFF raster, north up; cells no line saw are no data.
 FrameRaster coverageRaster(const CoverageGrid& grid);

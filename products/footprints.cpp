@@ -11,6 +11,8 @@
 
 namespace sss::products {
 
+using sss::core::Status;
+
 SubframeFootprint footprintOf(const sss::subframe::Subframe& s) {
   SubframeFootprint f{s.id, s.line_id, s.geometry.bins_per_side * s.geometry.bin_size_m + s.geometry.first_bin_range_m,
                       {}};
@@ -38,11 +40,11 @@ std::vector<FootprintStrip> slamStrips(const std::vector<SubframeFootprint>& foo
   return strips;
 }
 
-bool writeGeoJsonFiles(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& slam,
-                       const std::vector<sss::optimiser::StampedPose>& dr,
-                       const std::vector<SubframeFootprint>& footprints, const sss::optimiser::OptimiserEngine& engine,
-                       const std::optional<sss::core::MissionOrigin>& origin, std::string& error) {
-  if (!origin) return true;
+Status writeGeoJsonFiles(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& slam,
+                         const std::vector<sss::optimiser::StampedPose>& dr,
+                         const std::vector<SubframeFootprint>& footprints, const sss::optimiser::OptimiserEngine& engine,
+                         const std::optional<sss::core::MissionOrigin>& origin) {
+  if (!origin) return Status::success();
   const sss::core::LocalTangentPlane plane(origin->latitude_deg, origin->longitude_deg);
   auto lonLat = [&](const Eigen::Vector3d& ned) {
     const sss::core::GeodeticPosition g = plane.toGeodetic(ned);
@@ -52,8 +54,7 @@ bool writeGeoJsonFiles(const std::string& dir, const std::vector<sss::optimiser:
   auto write = [&](const std::string& path, const nlohmann::json& json) {
     std::ofstream out(path);
     out << json.dump() << "\n";
-    if (!out) error = "cannot write " + path;
-    return static_cast<bool>(out);
+    return out ? Status::success() : Status::error("cannot write " + path);
   };
   nlohmann::json tracks = {{"type", "FeatureCollection"}, {"features", nlohmann::json::array()}};
   for (const auto& [name, poses] : {std::pair<const char*, const std::vector<sss::optimiser::StampedPose>*>{"SLAM", &slam},
@@ -68,7 +69,7 @@ bool writeGeoJsonFiles(const std::string& dir, const std::vector<sss::optimiser:
                                                   {"end_utc", sss::core::formatUtimeIso8601(poses->back().utime_us)}}},
                                   {"geometry", {{"type", "LineString"}, {"coordinates", line}}}});
   }
-  if (!write(dir + "/track.geojson", tracks)) return false;
+  if (const Status written = write(dir + "/track.geojson", tracks); !written) return written;
 
   nlohmann::json polygons = {{"type", "FeatureCollection"}, {"features", nlohmann::json::array()}};
   const std::vector<FootprintStrip> strips = slamStrips(footprints, engine);

@@ -18,6 +18,9 @@
 #include <mutex>
 
 namespace sss::products {
+
+using sss::core::Status;
+
 namespace {
 
 void registerGdalOnce() {
@@ -74,18 +77,16 @@ Srs tangentPlaneSrs(const sss::core::MissionOrigin& origin) {
 }
 
 // An in-memory single-band dataset holding the raster, geo-referenced in its own grid.
-Dataset memoryDataset(const FrameRaster& raster, double easting_offset_m, double northing_offset_m,
-                      OGRSpatialReferenceH srs, std::string& error) {
+sss::core::Result<Dataset> memoryDataset(const FrameRaster& raster, double easting_offset_m,
+                                         double northing_offset_m, OGRSpatialReferenceH srs) {
   GDALDriverH mem = GDALGetDriverByName("MEM");
   if (!mem) {
-    error = "GDAL has no MEM driver";
-    return nullptr;
+    return Status::error("GDAL has no MEM driver");
   }
   const bool is_byte = raster.type == RasterType::kByte;
   Dataset dataset(GDALCreate(mem, "", raster.cols, raster.rows, 1, is_byte ? GDT_Byte : GDT_Float32, nullptr));
   if (!dataset) {
-    error = QuietGdalErrors::last();
-    return nullptr;
+    return Status::error(QuietGdalErrors::last());
   }
   GDALDatasetH handle = static_cast<GDALDatasetH>(dataset.get());
   double transform[6] = {easting_offset_m + raster.east_left_edge_m, raster.resolution_m, 0.0,
@@ -113,8 +114,7 @@ Dataset memoryDataset(const FrameRaster& raster, double easting_offset_m, double
                            GDT_Float32, 0, 0);
   }
   if (written != CE_None) {
-    error = QuietGdalErrors::last();
-    return nullptr;
+    return Status::error(QuietGdalErrors::last());
   }
   return dataset;
 }
@@ -149,20 +149,19 @@ void addCreationOptions(Argv& argv, const FrameRaster& raster) {
   argv.add("-co").add(raster.type == RasterType::kByte ? "PREDICTOR=1" : "PREDICTOR=3");
 }
 
-bool addOverviews(GDALDatasetH dataset, const FrameRaster& raster, int& count, std::string& error) {
+Status addOverviews(GDALDatasetH dataset, const FrameRaster& raster, int& count) {
   count = 0;
   const int largest = std::max(GDALGetRasterXSize(dataset), GDALGetRasterYSize(dataset));
-  if (largest <= kOverviewMinSizePx) return true;
+  if (largest <= kOverviewMinSizePx) return Status::success();
   std::vector<int> levels;
   for (int level = 2; largest / level >= 256; level *= 2) levels.push_back(level);
-  if (levels.empty()) return true;
+  if (levels.empty()) return Status::success();
   if (GDALBuildOverviews(dataset, raster.categorical ? "NEAREST" : "AVERAGE", static_cast<int>(levels.size()),
                          levels.data(), 0, nullptr, nullptr, nullptr) != CE_None) {
-    error = "cannot build overviews: " + QuietGdalErrors::last();
-    return false;
+    return Status::error("cannot build overviews: " + QuietGdalErrors::last());
   }
   count = static_cast<int>(levels.size());
-  return true;
+  return Status::success();
 }
 
 }  // namespace
@@ -179,13 +178,14 @@ FrameRaster rasterOverCentredGrid(int rows, int cols, double resolution_m, doubl
   return raster;
 }
 
-bool isKnownCrs(const std::string& crs, std::string& error) {
+Status isKnownCrs(const std::string& crs) {
   registerGdalOnce();
   QuietGdalErrors quiet;
   Srs srs(OSRNewSpatialReference(nullptr));
-  if (OSRSetFromUserInput(static_cast<OGRSpatialReferenceH>(srs.get()), crs.c_str()) == OGRERR_NONE) return true;
-  error = "'" + crs + "' is not a CRS GDAL knows (" + QuietGdalErrors::last() + "); use e.g. EPSG:32633";
-  return false;
+  if (OSRSetFromUserInput(static_cast<OGRSpatialReferenceH>(srs.get()), crs.c_str()) == OGRERR_NONE) {
+    return Status::success();
+  }
+  return Status::error("'" + crs + "' is not a CRS GDAL knows (" + QuietGdalErrors::last() + "); use e.g. EPSG:32633");
 }
 
 int utmEpsgCode(double latitude_deg, double longitude_deg) {
@@ -195,18 +195,15 @@ int utmEpsgCode(double latitude_deg, double longitude_deg) {
   return (north ? 32600 : 32700) + zone;
 }
 
-bool writeGeoTiff(const std::string& path, const FrameRaster& raster, const RasterFrame& frame, std::string& error,
-                  GeoTiffInfo* info) {
+Status writeGeoTiff(const std::string& path, const FrameRaster& raster, const RasterFrame& frame, GeoTiffInfo* info) {
   if (raster.rows <= 0 || raster.cols <= 0 ||
       raster.values.size() != static_cast<size_t>(raster.rows) * static_cast<size_t>(raster.cols) ||
       !(raster.resolution_m > 0.0)) {
-    error = path + ": empty or inconsistent raster (" + std::to_string(raster.rows) + " x " +
-            std::to_string(raster.cols) + ")";
-    return false;
+    return Status::error(path + ": empty or inconsistent raster (" + std::to_string(raster.rows) + " x " +
+                         std::to_string(raster.cols) + ")");
   }
   if (!frame.projected && !frame.origin) {
-    error = path + ": the mission frame has no origin on Earth, so the raster cannot be placed";
-    return false;
+    return Status::error(path + ": the mission frame has no origin on Earth, so the raster cannot be placed");
   }
   registerGdalOnce();
   QuietGdalErrors quiet;
@@ -219,21 +216,18 @@ bool writeGeoTiff(const std::string& path, const FrameRaster& raster, const Rast
       srs.reset(OSRNewSpatialReference(nullptr));
       if (OSRSetFromUserInput(static_cast<OGRSpatialReferenceH>(srs.get()), frame.projected_crs.c_str()) !=
           OGRERR_NONE) {
-        error = path + ": products.projected_crs '" + frame.projected_crs +
-                "' is not a CRS GDAL knows (use e.g. EPSG:32633)";
-        return false;
+        return Status::error(path + ": products.projected_crs '" + frame.projected_crs +
+                             "' is not a CRS GDAL knows (use e.g. EPSG:32633)");
       }
     }
-    Dataset memory = memoryDataset(raster, frame.grid_easting_offset_m, frame.grid_northing_offset_m,
-                                   static_cast<OGRSpatialReferenceH>(srs.get()), error);
-    if (!memory) {
-      error = path + ": " + error;
-      return false;
-    }
+    sss::core::Result<Dataset> memory = memoryDataset(raster, frame.grid_easting_offset_m,
+                                                      frame.grid_northing_offset_m,
+                                                      static_cast<OGRSpatialReferenceH>(srs.get()));
+    if (!memory) return Status::error(path + ": " + memory.message());
     Argv argv;
     addCreationOptions(argv, raster);
     GDALTranslateOptions* options = GDALTranslateOptionsNew(argv.get(), nullptr);
-    output.reset(GDALTranslate(path.c_str(), static_cast<GDALDatasetH>(memory.get()), options, nullptr));
+    output.reset(GDALTranslate(path.c_str(), static_cast<GDALDatasetH>(memory->get()), options, nullptr));
     GDALTranslateOptionsFree(options);
     if (srs) {
       OGRSpatialReferenceH handle = static_cast<OGRSpatialReferenceH>(srs.get());
@@ -246,14 +240,11 @@ bool writeGeoTiff(const std::string& path, const FrameRaster& raster, const Rast
     // The tangent plane warped into the origin's UTM zone, on a grid aligned to the resolution.
     Srs plane = tangentPlaneSrs(*frame.origin);
     if (!plane) {
-      error = path + ": cannot describe the tangent plane at the origin: " + QuietGdalErrors::last();
-      return false;
+      return Status::error(path + ": cannot describe the tangent plane at the origin: " + QuietGdalErrors::last());
     }
-    Dataset memory = memoryDataset(raster, 0.0, 0.0, static_cast<OGRSpatialReferenceH>(plane.get()), error);
-    if (!memory) {
-      error = path + ": " + error;
-      return false;
-    }
+    sss::core::Result<Dataset> memory =
+        memoryDataset(raster, 0.0, 0.0, static_cast<OGRSpatialReferenceH>(plane.get()));
+    if (!memory) return Status::error(path + ": " + memory.message());
     const int epsg = utmEpsgCode(frame.origin->latitude_deg, frame.origin->longitude_deg);
     const std::string nodata = raster.type == RasterType::kByte ? "0" : number(raster.nodata_value);
     Argv argv;
@@ -263,14 +254,13 @@ bool writeGeoTiff(const std::string& path, const FrameRaster& raster, const Rast
     argv.add("-overwrite");
     addCreationOptions(argv, raster);
     GDALWarpAppOptions* options = GDALWarpAppOptionsNew(argv.get(), nullptr);
-    GDALDatasetH source = static_cast<GDALDatasetH>(memory.get());
+    GDALDatasetH source = static_cast<GDALDatasetH>(memory->get());
     output.reset(GDALWarp(path.c_str(), nullptr, 1, &source, options, nullptr));
     GDALWarpAppOptionsFree(options);
     written.epsg = epsg;
   }
   if (!output) {
-    error = "cannot write " + path + ": " + QuietGdalErrors::last();
-    return false;
+    return Status::error("cannot write " + path + ": " + QuietGdalErrors::last());
   }
   GDALDatasetH handle = static_cast<GDALDatasetH>(output.get());
   if (!raster.description.empty()) GDALSetMetadataItem(handle, "TIFFTAG_IMAGEDESCRIPTION", raster.description.c_str(), nullptr);
@@ -278,9 +268,8 @@ bool writeGeoTiff(const std::string& path, const FrameRaster& raster, const Rast
     GDALSetMetadataItem(handle, "SSS_ORIGIN_LATITUDE_DEG", number(frame.origin->latitude_deg).c_str(), nullptr);
     GDALSetMetadataItem(handle, "SSS_ORIGIN_LONGITUDE_DEG", number(frame.origin->longitude_deg).c_str(), nullptr);
   }
-  if (!addOverviews(handle, raster, written.overview_count, error)) {
-    error = path + ": " + error;
-    return false;
+  if (const Status overviews = addOverviews(handle, raster, written.overview_count); !overviews) {
+    return Status::error(path + ": " + overviews.message);
   }
   if (written.crs_name.empty() && written.epsg != 0) {
     const char* wkt = GDALGetProjectionRef(handle);
@@ -291,11 +280,10 @@ bool writeGeoTiff(const std::string& path, const FrameRaster& raster, const Rast
   written.cols = GDALGetRasterXSize(handle);
   output.reset();  // flushes and closes
   if (CPLGetLastErrorType() == CE_Failure) {
-    error = "cannot write " + path + ": " + QuietGdalErrors::last();
-    return false;
+    return Status::error("cannot write " + path + ": " + QuietGdalErrors::last());
   }
   if (info) *info = written;
-  return true;
+  return Status::success();
 }
 
 }  // namespace sss::products

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "pipeline/core/mission_origin.hpp"
+#include "pipeline/core/status.hpp"
 
 namespace sss::products {
 
@@ -66,16 +67,16 @@ struct GeoTiffInfo {
 // (Norway's and Svalbard's zone exceptions included).
 int utmEpsgCode(double latitude_deg, double longitude_deg);
 
-// True when GDAL knows the CRS text (what products.projected_crs takes: "EPSG:32633", a WKT, a PROJ
-// string); false with the reason otherwise, so that a configuration is refused before a run.
-bool isKnownCrs(const std::string& crs, std::string& error);
+// Succeeds when GDAL knows the CRS text (what products.projected_crs takes: "EPSG:32633", a WKT, a
+// PROJ string); fails with the reason otherwise, so that a configuration is refused before a run.
+sss::core::Status isKnownCrs(const std::string& crs);
 
 // Rasters larger than this in either dimension get internal overviews (2x, 4x, ... down to ~256 px).
 constexpr int kOverviewMinSizePx = 1024;
 
-// Writes path as a tiled, DEFLATE-compressed GeoTIFF. False with a message naming the cause
-// (no frame, GDAL's error) when it cannot.
-bool writeGeoTiff(const std::string& path, const FrameRaster& raster, const RasterFrame& frame, std::string& error,
-                  GeoTiffInfo* info = nullptr);
+// Writes path as a tiled, DEFLATE-compressed GeoTIFF. Fails with a message naming the cause (no
+// frame, GDAL's error) when it cannot.
+sss::core::Status writeGeoTiff(const std::string& path, const FrameRaster& raster, const RasterFrame& frame,
+                               GeoTiffInfo* info = nullptr);
 
 }  // namespace sss::products

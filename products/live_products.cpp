@@ -18,59 +18,58 @@ bool writeLiveProducts(const sss::optimiser::OptimiserEngine& engine, const Mosa
                        const std::optional<sss::core::MissionOrigin>& origin, std::vector<std::string>& messages) {
   std::error_code ec;
   fs::create_directories(directory, ec);
-  std::string error;
   const auto trajectory = engine.pingTrajectory(true);
-  if (!sss::optimiser::writeTum(directory + "/slam.tum", trajectory,
-                                "sss-optimiser: optimised pose of every ping of the subframes", error, origin)) {
-    messages.push_back(error);
+  if (const sss::core::Status written =
+          sss::optimiser::writeTum(directory + "/slam.tum", trajectory,
+                                   "sss-optimiser: optimised pose of every ping of the subframes", origin);
+      !written) {
+    messages.push_back(written.message);
     return false;
   }
   const auto points = engine.seabedPoints(false);
   const sss::optimiser::HeightmapGrid heightmap = sss::optimiser::gridSeabedPoints(points, engine.options().bathymetry);
-  bool ok = sss::optimiser::writeSeabedPly(directory + "/bathymetry.ply", points, error, origin);
-  if (ok && !points.empty()) {
-    ok = sss::optimiser::writeHeightmapFiles(directory + "/heightmap.yaml", heightmap,
-                                             "sss-optimiser: seabed re-triangulated with the optimised poses", error,
-                                             origin);
+  sss::core::Status written = sss::optimiser::writeSeabedPly(directory + "/bathymetry.ply", points, origin);
+  if (written && !points.empty()) {
+    written = sss::optimiser::writeHeightmapFiles(directory + "/heightmap.yaml", heightmap,
+                                                  "sss-optimiser: seabed re-triangulated with the optimised poses",
+                                                  origin);
   }
   // The survey products sss-process writes: the corrected navigation, the tie report, the mosaics
   // (DR and SLAM) and the heightmap, with GeoTIFFs in the origin's UTM zone.
-  if (ok) ok = writeNavigationFiles(directory, trajectory, engine, origin, {}, error);
-  if (ok) ok = writeTieReportCsv(directory + "/loop_closures.csv", engine, error);
+  if (written) written = writeNavigationFiles(directory, trajectory, engine, origin, {});
+  if (written) written = writeTieReportCsv(directory + "/loop_closures.csv", engine);
   std::optional<RasterFrame> frame;
   if (origin) frame = RasterFrame{origin, false, 0.0, 0.0, ""};
   std::vector<std::string> geotiffs;
   GeoTiffInfo info;
-  if (ok) {
-    ok = writeMosaicProducts(directory, mosaics.subframes(), engine, sss::subframe::PictureOptions{}, origin,
-                                            frame, "sss-optimiser", geotiffs, info, error);
+  if (written) {
+    written = writeMosaicProducts(directory, mosaics.subframes(), engine, sss::subframe::PictureOptions{}, origin,
+                                  frame, "sss-optimiser", geotiffs, info);
   }
-  if (ok && mosaics.dropped() > 0) {
+  if (written && mosaics.dropped() > 0) {
     messages.push_back("products: the mosaics show the newest " + std::to_string(mosaics.subframes().size()) +
                        " subframes; " + std::to_string(mosaics.dropped()) +
                        " older ones went to stay within products_mosaic_max_mib");
   }
   // Tracks and subframe footprints for GIS, and how many lines saw each 5 m cell.
-  if (ok) ok = writeGeoJsonFiles(directory, trajectory, engine.pingTrajectory(false), footprints, engine,
-                                                origin, error);
-  if (ok && !footprints.empty()) {
-    const CoverageGrid coverage =
-        computeCoverage(slamStrips(footprints, engine), 5.0);
-    ok = writeCoverageFiles(directory + "/coverage.yaml", coverage, error, origin);
-    if (ok && frame) {
-      ok = writeGeoTiff(directory + "/coverage.tif", coverageRaster(coverage), *frame, error);
-    }
+  if (written) {
+    written = writeGeoJsonFiles(directory, trajectory, engine.pingTrajectory(false), footprints, engine, origin);
   }
-  if (ok && !points.empty() && frame) {
-    ok = writeGeoTiff(
+  if (written && !footprints.empty()) {
+    const CoverageGrid coverage = computeCoverage(slamStrips(footprints, engine), 5.0);
+    written = writeCoverageFiles(directory + "/coverage.yaml", coverage, origin);
+    if (written && frame) written = writeGeoTiff(directory + "/coverage.tif", coverageRaster(coverage), *frame);
+  }
+  if (written && !points.empty() && frame) {
+    written = writeGeoTiff(
         directory + "/heightmap.tif",
         heightmapRaster(heightmap, "sss-optimiser: seabed re-triangulated with the optimised poses (depth m, down)"),
-        *frame, error);
+        *frame);
   }
-  messages.push_back(ok ? "products written to " + directory + ": " + std::to_string(trajectory.size()) +
-                              " poses, " + std::to_string(points.size()) + " seabed points"
-                        : "products: " + error);
-  return ok;
+  messages.push_back(written ? "products written to " + directory + ": " + std::to_string(trajectory.size()) +
+                                   " poses, " + std::to_string(points.size()) + " seabed points"
+                             : "products: " + written.message);
+  return written.ok;
 }
 
 }  // namespace sss::products

@@ -7,6 +7,8 @@
 
 namespace sss::products {
 
+using sss::core::Status;
+
 MosaicStore::MosaicStore(sss::subframe::PictureOptions pictures, size_t max_bytes)
     : pictures_(pictures), max_bytes_(max_bytes) {}
 
@@ -32,12 +34,12 @@ void MosaicStore::add(const sss::subframe::Subframe& subframe) {
   dropped_ += drop;
 }
 
-bool writeMosaicProducts(const std::string& dir, const std::vector<sss::subframe::Subframe>& subframes,
-                         const sss::optimiser::OptimiserEngine& engine, const sss::subframe::PictureOptions& pictures,
-                         const std::optional<sss::core::MissionOrigin>& origin,
-                         const std::optional<RasterFrame>& frame, const std::string& tool,
-                         std::vector<std::string>& geotiffs, GeoTiffInfo& geotiff_info, std::string& error) {
-  if (subframes.empty()) return true;
+Status writeMosaicProducts(const std::string& dir, const std::vector<sss::subframe::Subframe>& subframes,
+                           const sss::optimiser::OptimiserEngine& engine, const sss::subframe::PictureOptions& pictures,
+                           const std::optional<sss::core::MissionOrigin>& origin,
+                           const std::optional<RasterFrame>& frame, const std::string& tool,
+                           std::vector<std::string>& geotiffs, GeoTiffInfo& geotiff_info) {
+  if (subframes.empty()) return Status::success();
   // The SLAM pose of every ping: the optimiser's correction at its time applied to its DR pose.
   std::map<int64_t, std::vector<sss::core::Pose>> slam_poses;
   for (const auto& s : subframes) {
@@ -55,21 +57,19 @@ bool writeMosaicProducts(const std::string& dir, const std::vector<sss::subframe
                  {slam_poses, "mosaic_slam", "side-scan mosaic geo-referenced with the SLAM poses"}};
   for (const auto& mosaic : mosaics) {
     const std::string png = dir + "/" + mosaic.name + ".png";
-    const auto raster = sss::subframe::renderMosaic(subframes, mosaic.poses, pictures, error);
+    const auto raster = sss::subframe::renderMosaic(subframes, mosaic.poses, pictures);
     if (!raster) {
-      error += " " + png;
-      return false;
+      return Status::error(raster.message() + " " + png);
     }
-    if (!sss::subframe::writeMosaic(*raster, png, error, origin)) return false;
+    if (const Status written = sss::subframe::writeMosaic(*raster, png, origin); !written) return written;
     if (!frame) continue;
     const std::string tif = std::string(mosaic.name) + ".tif";
-    if (!writeGeoTiff(dir + "/" + tif, mosaicRaster(*raster, tool + ": " + mosaic.description), *frame, error,
-                      &geotiff_info)) {
-      return false;
-    }
+    const Status written =
+        writeGeoTiff(dir + "/" + tif, mosaicRaster(*raster, tool + ": " + mosaic.description), *frame, &geotiff_info);
+    if (!written) return written;
     geotiffs.push_back(tif);
   }
-  return true;
+  return Status::success();
 }
 
 }  // namespace sss::products

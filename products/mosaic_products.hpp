@@ -37,10 +37,11 @@ class MosaicStore {
 // Writes dir/mosaic_dr.{png,yaml} and dir/mosaic_slam.{png,yaml}, and their GeoTIFFs when frame
 // is given; `tool` names the writer in the descriptions. The names of the GeoTIFFs written are
 // appended to geotiffs (with the last one's info in geotiff_info).
-bool writeMosaicProducts(const std::string& dir, const std::vector<sss::subframe::Subframe>& subframes,
-                         const sss::optimiser::OptimiserEngine& engine, const sss::subframe::PictureOptions& pictures,
-                         const std::optional<sss::core::MissionOrigin>& origin,
-                         const std::optional<RasterFrame>& frame, const std::string& tool,
-                         std::vector<std::string>& geotiffs, GeoTiffInfo& geotiff_info, std::string& error);
+sss::core::Status writeMosaicProducts(const std::string& dir, const std::vector<sss::subframe::Subframe>& subframes,
+                                      const sss::optimiser::OptimiserEngine& engine,
+                                      const sss::subframe::PictureOptions& pictures,
+                                      const std::optional<sss::core::MissionOrigin>& origin,
+                                      const std::optional<RasterFrame>& frame, const std::string& tool,
+                                      std::vector<std::string>& geotiffs, GeoTiffInfo& geotiff_info);
 
 }  // namespace sss::products

@@ -12,6 +12,8 @@
 #include "pipeline/core/time.hpp"
 
 namespace sss::products {
+
+using sss::core::Status;
 namespace {
 
 const char* statusName(sss::optimiser::ClosureStatus status) {
@@ -36,13 +38,12 @@ const char* rejectionName(sss::optimiser::ClosureRejection rejection) {
 
 }  // namespace
 
-bool writeTieReportCsv(const std::string& path, const sss::optimiser::OptimiserEngine& engine, std::string& error) {
+Status writeTieReportCsv(const std::string& path, const sss::optimiser::OptimiserEngine& engine) {
   std::map<int64_t, int64_t> utime_of;
   for (const auto& node : engine.graph().nodes()) utime_of[node.subframe_id] = node.utime_us;
   std::FILE* f = std::fopen(path.c_str(), "w");
   if (!f) {
-    error = "cannot write " + path;
-    return false;
+    return Status::error("cannot write " + path);
   }
   std::fprintf(f, "# loop closures from the matcher and the optimiser's decision; T_a_b maps B's centre body frame into A's;\n"
                   "# north/east: the two subframe centres under the final SLAM estimate (local NED, m);\n"
@@ -84,15 +85,14 @@ bool writeTieReportCsv(const std::string& path, const sss::optimiser::OptimiserE
                  std::sqrt(std::max(heading_variance, 0.0)), before(0), before(1), before(2), before(3), after(0),
                  after(1), after(2), after(3));
   }
-  const bool ok = std::fclose(f) == 0;
-  if (!ok) error = "cannot write " + path;
-  return ok;
+  if (std::fclose(f) != 0) return Status::error("cannot write " + path);
+  return Status::success();
 }
 
-bool writeNavigationFiles(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& poses,
-                          const sss::optimiser::OptimiserEngine& engine,
-                          const std::optional<sss::core::MissionOrigin>& origin, const std::vector<double>& altitude_m,
-                          std::string& error) {
+Status writeNavigationFiles(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& poses,
+                            const sss::optimiser::OptimiserEngine& engine,
+                            const std::optional<sss::core::MissionOrigin>& origin,
+                            const std::vector<double>& altitude_m) {
   std::optional<sss::core::LocalTangentPlane> plane;
   if (origin) plane.emplace(origin->latitude_deg, origin->longitude_deg);
   const std::string csv_path = dir + "/navigation.csv";
@@ -101,8 +101,7 @@ bool writeNavigationFiles(const std::string& dir, const std::vector<sss::optimis
   if (!csv || (plane && !nmea)) {
     if (csv) std::fclose(csv);
     if (nmea) std::fclose(nmea);
-    error = "cannot write " + (csv ? dir + "/navigation.nmea" : csv_path);
-    return false;
+    return Status::error("cannot write " + (csv ? dir + "/navigation.nmea" : csv_path));
   }
   std::fprintf(csv, "# sss-process: corrected navigation at every ping%s; horizontal_sigma_m: 1-sigma of the position "
                     "(the larger axis); source: SLAM (corrected by closures or fixes) or DR\n"
@@ -142,10 +141,9 @@ bool writeNavigationFiles(const std::string& dir, const std::vector<sss::optimis
   const bool csv_ok = std::fclose(csv) == 0;
   const bool nmea_ok = !nmea || std::fclose(nmea) == 0;
   if (!csv_ok || !nmea_ok) {
-    error = "cannot write " + (csv_ok ? dir + "/navigation.nmea" : csv_path);
-    return false;
+    return Status::error("cannot write " + (csv_ok ? dir + "/navigation.nmea" : csv_path));
   }
-  return true;
+  return Status::success();
 }
 
 }  // namespace sss::products

@@ -170,11 +170,11 @@ std::vector<uint8_t> encodeSonarData(const SonarChannelRecord& record, const std
   return bytes;
 }
 
-SonarDecodeResult decodeSonarData(const JsfMessageHeader& header, const uint8_t* body, size_t body_size) {
-  SonarDecodeResult result;
+sss::core::Result<SonarChannelRecord> decodeSonarData(const JsfMessageHeader& header, const uint8_t* body,
+                                                      size_t body_size) {
   if (body_size < kSonarDataHeaderSize) {
-    result.error = "sonar data body of " + std::to_string(body_size) + " bytes is shorter than its 240-byte header";
-    return result;
+    return sss::core::Status::error("sonar data body of " + std::to_string(body_size) +
+                                    " bytes is shorter than its 240-byte header");
   }
   SonarChannelRecord r;
   r.subsystem = header.subsystem;
@@ -228,19 +228,18 @@ SonarDecodeResult decodeSonarData(const JsfMessageHeader& header, const uint8_t*
   } else if (r.data_format == 1) {
     bytes_per_sample = 4;
   } else {
-    result.error = "sonar data format " + std::to_string(r.data_format) + " is not supported (0 envelope, 1 I/Q)";
-    return result;
+    return sss::core::Status::error("sonar data format " + std::to_string(r.data_format) +
+                                    " is not supported (0 envelope, 1 I/Q)");
   }
   const size_t needed = kSonarDataHeaderSize + num_samples * bytes_per_sample;
   if (needed > body_size) {
-    result.error = "sonar data of " + std::to_string(num_samples) + " samples needs " + std::to_string(needed) +
-                   " bytes, the message has " + std::to_string(body_size);
-    return result;
+    return sss::core::Status::error("sonar data of " + std::to_string(num_samples) + " samples needs " +
+                                    std::to_string(needed) + " bytes, the message has " + std::to_string(body_size));
   }
   // 2^-N; N outside a sane range is corruption, not a gain setting.
   if (r.weighting_factor < -30 || r.weighting_factor > 30) {
-    result.error = "weighting factor " + std::to_string(r.weighting_factor) + " is outside [-30, 30]";
-    return result;
+    return sss::core::Status::error("weighting factor " + std::to_string(r.weighting_factor) +
+                                    " is outside [-30, 30]");
   }
   const double scale = std::ldexp(1.0, -r.weighting_factor);
   const uint8_t* samples = body + kSonarDataHeaderSize;
@@ -254,8 +253,7 @@ SonarDecodeResult decodeSonarData(const JsfMessageHeader& header, const uint8_t*
       r.samples[i] = static_cast<float>(std::hypot(in_phase, quadrature) * scale);
     }
   }
-  result.record = std::move(r);
-  return result;
+  return r;
 }
 
 }  // namespace sss::edgetech

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/core/status.hpp"
+
 namespace sss::edgetech {
 
 constexpr uint16_t kJsfStartMarker = 0x1601;
@@ -107,12 +109,9 @@ void encodeSonarNavigation(const SonarChannelRecord& record, uint8_t* body);
 std::optional<JsfMessageHeader> decodeHeader(const uint8_t* bytes);
 void encodeHeader(const JsfMessageHeader& header, uint8_t* bytes);
 
-// Decodes a type 80 body (everything after the 16-byte header). Returns an error text when the
+// Decodes a type 80 body (everything after the 16-byte header). Fails with the reason when the
 // body is too short for its header or its samples, or the data format is unknown.
-struct SonarDecodeResult {
-  std::optional<SonarChannelRecord> record;
-  std::string error;
-};
-SonarDecodeResult decodeSonarData(const JsfMessageHeader& header, const uint8_t* body, size_t body_size);
+sss::core::Result<SonarChannelRecord> decodeSonarData(const JsfMessageHeader& header, const uint8_t* body,
+                                                      size_t body_size);
 
 }  // namespace sss::edgetech

@@ -42,17 +42,16 @@ size_t minimumBodySize(uint16_t type) {
 
 bool isNavigationType(uint16_t message_type) { return minimumBodySize(message_type) > 0; }
 
-JsfNavigationDecodeResult decodeNavigation(const JsfMessageHeader& header, const uint8_t* body, size_t body_size) {
-  JsfNavigationDecodeResult result;
+sss::core::Result<JsfNavigationRecord> decodeNavigation(const JsfMessageHeader& header, const uint8_t* body,
+                                                        size_t body_size) {
   const uint16_t type = header.message_type;
   if (!isNavigationType(type)) {
-    result.error = "message type " + std::to_string(type) + " is not a navigation type";
-    return result;
+    return sss::core::Status::error("message type " + std::to_string(type) + " is not a navigation type");
   }
   if (body_size < minimumBodySize(type)) {
-    result.error = "navigation message type " + std::to_string(type) + " of " + std::to_string(body_size) +
-                   " bytes is shorter than its " + std::to_string(minimumBodySize(type)) + "-byte layout";
-    return result;
+    return sss::core::Status::error("navigation message type " + std::to_string(type) + " of " +
+                                    std::to_string(body_size) + " bytes is shorter than its " +
+                                    std::to_string(minimumBodySize(type)) + "-byte layout");
   }
   JsfNavigationRecord r;
   r.message_type = type;
@@ -161,8 +160,7 @@ JsfNavigationDecodeResult decodeNavigation(const JsfMessageHeader& header, const
   sane(r.heading_rad, 2.0 * M_PI + 1e-6);
   sane(r.pitch_rad, M_PI);
   sane(r.roll_rad, M_PI);
-  result.record = std::move(r);
-  return result;
+  return r;
 }
 
 }  // namespace sss::edgetech

@@ -32,14 +32,11 @@ struct JsfNavigationRecord {
   std::optional<double> velocity_starboard_m_s;
 };
 
-struct JsfNavigationDecodeResult {
-  std::optional<JsfNavigationRecord> record;
-  std::string error;
-};
-
 // True for the types decodeNavigation() understands.
 bool isNavigationType(uint16_t message_type);
-// Decodes a navigation message body (after the 16-byte header); error when too short.
-JsfNavigationDecodeResult decodeNavigation(const JsfMessageHeader& header, const uint8_t* body, size_t body_size);
+// Decodes a navigation message body (after the 16-byte header); fails when it is too short or not
+// a navigation type.
+sss::core::Result<JsfNavigationRecord> decodeNavigation(const JsfMessageHeader& header, const uint8_t* body,
+                                                        size_t body_size);
 
 }  // namespace sss::edgetech

@@ -31,22 +31,23 @@ std::vector<JsfNavigationRecord> SonarDriver::takeNavigation() {
 void SonarDriver::handleMessages(int64_t host_utime_us, int64_t monotonic_us) {
   for (const JsfMessage& message : messages_) {
     if (isNavigationType(message.header.message_type)) {
-      JsfNavigationDecodeResult nav = decodeNavigation(message.header, message.body.data(), message.body.size());
-      if (nav.record) {
+      sss::core::Result<JsfNavigationRecord> nav =
+          decodeNavigation(message.header, message.body.data(), message.body.size());
+      if (nav) {
         ++navigation_messages_;
         if (keep_navigation_) {
           if (navigation_records_.size() >= kMaxKeptNavigation) {
             navigation_records_.erase(navigation_records_.begin(),
                                       navigation_records_.begin() + static_cast<std::ptrdiff_t>(kMaxKeptNavigation / 2));
           }
-          navigation_records_.push_back(*nav.record);
+          navigation_records_.push_back(*nav);
         }
-        latest_navigation_ = std::move(nav.record);
+        latest_navigation_ = std::move(*nav);
       } else {
         ++sonar_decode_errors_;
         if (!decode_error_reported_) {
           decode_error_reported_ = true;
-          new_faults_.push_back("JSF message at byte " + std::to_string(message.stream_offset) + ": " + nav.error +
+          new_faults_.push_back("JSF message at byte " + std::to_string(message.stream_offset) + ": " + nav.message() +
                                 "; skipped");
         }
       }
@@ -56,22 +57,23 @@ void SonarDriver::handleMessages(int64_t host_utime_us, int64_t monotonic_us) {
       ++other_messages_;  // system info, bathymetry, ...: skipped by their byte count
       continue;
     }
-    SonarDecodeResult decoded = decodeSonarData(message.header, message.body.data(), message.body.size());
-    if (!decoded.record) {
+    sss::core::Result<SonarChannelRecord> decoded =
+        decodeSonarData(message.header, message.body.data(), message.body.size());
+    if (!decoded) {
       ++sonar_decode_errors_;
       if (!decode_error_reported_) {
         decode_error_reported_ = true;
         new_faults_.push_back("JSF sonar message at byte " + std::to_string(message.stream_offset) + ": " +
-                              decoded.error + "; skipped");
+                              decoded.message() + "; skipped");
       }
       continue;
     }
-    const SonarChannelRecord& r = *decoded.record;
+    const SonarChannelRecord& r = *decoded;
     // The clock sees every channel: the end of acquisition is the last sample's time.
     const int64_t acquisition_us = static_cast<int64_t>(static_cast<double>(r.start_depth_samples + r.samples.size()) *
                                                         r.sample_interval_s * 1e6);
     clock_.add(r.ping_time_us + acquisition_us, host_utime_us);
-    assembler_.add(std::move(*decoded.record), monotonic_us, assembled_);
+    assembler_.add(std::move(*decoded), monotonic_us, assembled_);
   }
 }
 

@@ -92,8 +92,8 @@ int main(int argc, char** argv) {
   }
   loop.addTimer(1.0, [&] { input.updateStatus(); });
 
-  if (const std::string error = input.open(); !error.empty()) {
-    spdlog::critical("{}", error);
+  if (const sss::core::Status opened = input.open(); !opened) {
+    spdlog::critical("{}", opened.message);
     return 1;
   }
   // Step the input; (re)register the TCP socket with the loop as the link comes and goes.

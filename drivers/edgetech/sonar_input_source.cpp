@@ -42,7 +42,7 @@ SonarInputSource::SonarInputSource(SonarInputOptions options, sss::core::HealthM
   }
 }
 
-std::string SonarInputSource::open() {
+sss::core::Status SonarInputSource::open() {
   switch (kind_) {
     case Kind::kTcp:
       tcp_ = std::make_unique<sss::transport::TcpClient>(
@@ -53,22 +53,22 @@ std::string SonarInputSource::open() {
             deliverAll(pings_);
           },
           [this](sss::transport::LinkState state, const std::string& reason) { onLinkState(state, reason); });
-      return {};
+      return sss::core::Status::success();
     case Kind::kJsfFile:
       jsf_file_.open(options_.replay_file, std::ios::binary);
-      if (!jsf_file_.is_open()) return "cannot open sonar file '" + options_.replay_file + "'";
+      if (!jsf_file_.is_open()) return sss::core::Status::error("cannot open sonar file '" + options_.replay_file + "'");
       jsf_chunk_.resize(1 << 16);
-      return {};
+      return sss::core::Status::success();
     case Kind::kXtfFile: {
       sss::xtf::XtfReaderOptions xtf_options;
       xtf_options.pair_index = options_.xtf_pair_index;
       xtf_reader_ = std::make_unique<sss::xtf::XtfReader>(options_.replay_file, xtf_options);
-      if (!xtf_reader_->isOpen()) return xtf_reader_->error();
+      if (!xtf_reader_->isOpen()) return sss::core::Status::error(xtf_reader_->error());
       say(hooks_.info, xtf_reader_->summary());
-      return {};
+      return sss::core::Status::success();
     }
   }
-  return {};
+  return sss::core::Status::success();
 }
 
 int SonarInputSource::fd() const { return tcp_ ? tcp_->fd() : -1; }

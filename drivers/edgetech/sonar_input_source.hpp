@@ -15,6 +15,7 @@
 #include "drivers/edgetech/sonar_driver.hpp"
 #include "drivers/xtf/xtf_reader.hpp"
 #include "pipeline/core/health.hpp"
+#include "pipeline/core/status.hpp"
 #include "pipeline/transport/replay_pacer.hpp"
 #include "pipeline/transport/tcp_client.hpp"
 
@@ -54,9 +55,9 @@ class SonarInputSource {
   SonarInputSource(const SonarInputSource&) = delete;
   SonarInputSource& operator=(const SonarInputSource&) = delete;
 
-  // Replay: "" when the file is open (an XTF file's summary goes to hooks.info), else what failed
-  // (the process cannot run without it). TCP: always "" (the link connects in step()).
-  std::string open();
+  // Replay: fails with what failed when the file cannot be opened (the process cannot run without
+  // it); an XTF file's summary goes to hooks.info. TCP: always succeeds (the link connects in step()).
+  sss::core::Status open();
   // The socket to watch for readability (then call onReadable()): the TCP link while it is up,
   // else -1. It changes as the link reconnects.
   int fd() const;

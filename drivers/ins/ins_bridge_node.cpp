@@ -186,8 +186,8 @@ int main(int argc, char** argv) {
   fix_hooks.chunk = [&](const sss::ins::InsInputChunk& chunk) { publish(service.onFixChunk(chunk)); };
   sss::ins::InsInputSource fix_input(fixInputOptions(options), fix_hooks);
   if (options.fix_udp_port > 0) {
-    if (const std::string error = fix_input.open(); !error.empty()) {
-      spdlog::critical("fixes: {}", error);
+    if (const sss::core::Status opened = fix_input.open(); !opened) {
+      spdlog::critical("fixes: {}", opened.message);
       return 1;
     }
     spdlog::info("absolute fixes (NMEA GGA + GST + ZDA) on UDP {}:{} -> {}", options.input.bind_address,
@@ -204,8 +204,8 @@ int main(int argc, char** argv) {
     if (loop.health().recordError("serial_open", error, sss::core::nowUtime())) spdlog::warn("{}; retrying", error);
   };
   sss::ins::InsInputSource input(options.input, hooks);
-  if (const std::string error = input.open(); !error.empty()) {
-    spdlog::critical("{}", error);
+  if (const sss::core::Status opened = input.open(); !opened) {
+    spdlog::critical("{}", opened.message);
     return 1;
   }
   InputOnLoop input_on_loop(input, loop);

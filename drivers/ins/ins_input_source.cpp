@@ -31,7 +31,7 @@ speed_t baudConstant(int baud) {
   }
 }
 
-int openUdp(const std::string& bind_address, int port, std::string& error) {
+sss::core::Result<int> openUdp(const std::string& bind_address, int port) {
   const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
   const int one = 1;
   ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof(one));
@@ -40,19 +40,16 @@ int openUdp(const std::string& bind_address, int port, std::string& error) {
   address.sin_port = htons(static_cast<uint16_t>(port));
   ::inet_pton(AF_INET, bind_address.c_str(), &address.sin_addr);
   if (::bind(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0) {
-    error = "cannot bind UDP " + bind_address + ":" + std::to_string(port) + ": " + std::strerror(errno);
+    const std::string why = std::strerror(errno);
     ::close(fd);
-    return -1;
+    return sss::core::Status::error("cannot bind UDP " + bind_address + ":" + std::to_string(port) + ": " + why);
   }
   return fd;
 }
 
-int openSerialPort(const std::string& device, int baud, std::string& error) {
+sss::core::Result<int> openSerialPort(const std::string& device, int baud) {
   const int fd = ::open(device.c_str(), O_RDONLY | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) {
-    error = "cannot open serial port '" + device + "': " + std::strerror(errno);
-    return -1;
-  }
+  if (fd < 0) return sss::core::Status::error("cannot open serial port '" + device + "': " + std::strerror(errno));
   termios tty{};
   if (::tcgetattr(fd, &tty) == 0) {
     ::cfmakeraw(&tty);
@@ -89,16 +86,18 @@ InsInputSource::~InsInputSource() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-std::string InsInputSource::open() {
-  std::string error;
+sss::core::Status InsInputSource::open() {
   switch (kind_) {
-    case Kind::kUdp:
-      fd_ = openUdp(options_.bind_address, options_.udp_port, error);
-      if (fd_ >= 0) ++counters_.opens;
-      return error;
+    case Kind::kUdp: {
+      const sss::core::Result<int> socket = openUdp(options_.bind_address, options_.udp_port);
+      if (!socket) return socket.status();
+      fd_ = *socket;
+      ++counters_.opens;
+      return sss::core::Status::success();
+    }
     case Kind::kSerial:
       openSerial();
-      return {};
+      return sss::core::Status::success();
     case Kind::kTcp:
       tcp_ = std::make_unique<sss::transport::TcpClient>(
           options_.tcp,
@@ -118,14 +117,14 @@ std::string InsInputSource::open() {
               say(hooks_.info, "INS link: " + reason);
             }
           });
-      return {};
+      return sss::core::Status::success();
     case Kind::kFile:
       file_.open(options_.file, std::ios::binary);
-      if (!file_) return "cannot open INS file '" + options_.file + "'";
+      if (!file_) return sss::core::Status::error("cannot open INS file '" + options_.file + "'");
       ++counters_.opens;
-      return {};
+      return sss::core::Status::success();
   }
-  return {};
+  return sss::core::Status::success();
 }
 
 int InsInputSource::fd() const {
@@ -172,12 +171,12 @@ int InsInputSource::boundUdpPort() const {
 
 void InsInputSource::openSerial() {
   if (fd_ >= 0) return;
-  std::string error;
-  fd_ = openSerialPort(options_.serial_device, options_.serial_baud, error);
-  if (fd_ < 0) {
-    if (hooks_.open_failed) hooks_.open_failed(error);
+  const sss::core::Result<int> port = openSerialPort(options_.serial_device, options_.serial_baud);
+  if (!port) {
+    if (hooks_.open_failed) hooks_.open_failed(port.message());
     return;
   }
+  fd_ = *port;
   ++counters_.opens;
   say(hooks_.info, "reading INS from " + options_.serial_device);
 }

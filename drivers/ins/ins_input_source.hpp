@@ -10,6 +10,7 @@
 #include <memory>
 #include <string>
 
+#include "pipeline/core/status.hpp"
 #include "pipeline/transport/tcp_client.hpp"
 
 namespace sss::ins {
@@ -65,10 +66,10 @@ class InsInputSource {
   InsInputSource(const InsInputSource&) = delete;
   InsInputSource& operator=(const InsInputSource&) = delete;
 
-  // UDP and file: "" when open, else what failed and where (the process cannot run without it).
-  // Serial: always "" (a missing port goes to hooks.open_failed and is tried again by service()).
-  // TCP: always "" (the link connects in service()).
-  std::string open();
+  // UDP and file: fails with what and where when they cannot be opened (the process cannot run
+  // without them). Serial: always succeeds (a missing port goes to hooks.open_failed and is tried
+  // again by service()). TCP: always succeeds (the link connects in service()).
+  sss::core::Status open();
   // The descriptor to watch for readability; -1 when there is none now (no serial port, TCP link
   // down, file). It changes as a serial port comes back or the TCP link reconnects.
   int fd() const;

@@ -242,8 +242,7 @@ std::vector<PositionFix> PositionFixReader::finish() {
   return take();
 }
 
-bool readPositionFixFile(const std::string& spec, const FixReaderOptions& options, std::vector<PositionFix>& fixes,
-                         FixReaderCounters& counters, std::string& first_problem, std::string& error) {
+sss::core::Result<FixFileContents> readPositionFixFile(const std::string& spec, const FixReaderOptions& options) {
   std::string path = spec;
   std::optional<FixSource> source;
   for (const char* prefix : {"gnss:", "usbl:"}) {
@@ -254,8 +253,7 @@ bool readPositionFixFile(const std::string& spec, const FixReaderOptions& option
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) {
-    error = "cannot read the fix file " + path + " (give PATH, gnss:PATH or usbl:PATH)";
-    return false;
+    return sss::core::Status::error("cannot read the fix file " + path + " (give PATH, gnss:PATH or usbl:PATH)");
   }
   PositionFixReader reader(options, source);
   std::string chunk(64 * 1024, '\0');
@@ -264,10 +262,11 @@ bool readPositionFixFile(const std::string& spec, const FixReaderOptions& option
     const std::streamsize n = in.gcount();
     if (n > 0) reader.feed(std::string_view(chunk.data(), static_cast<size_t>(n)));
   }
-  fixes = reader.finish();
-  counters = reader.counters();
-  first_problem = reader.firstProblem();
-  return true;
+  FixFileContents contents;
+  contents.fixes = reader.finish();
+  contents.counters = reader.counters();
+  contents.first_problem = reader.firstProblem();
+  return contents;
 }
 
 void resolveFixDates(std::vector<PositionFix>& fixes, int64_t reference_utime_us) {

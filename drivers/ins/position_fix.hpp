@@ -14,6 +14,8 @@
 #include <string_view>
 #include <vector>
 
+#include "pipeline/core/status.hpp"
+
 namespace sss::ins {
 
 enum class FixSource { kGnss, kUsbl };
@@ -94,10 +96,16 @@ class PositionFixReader {
   std::string first_problem_;
 };
 
+// What readPositionFixFile found in a file: its fixes and the sentences it skipped.
+struct FixFileContents {
+  std::vector<PositionFix> fixes;
+  FixReaderCounters counters;
+  std::string first_problem;  // the first skipped sentence's cause; empty when none was
+};
+
 // Reads a whole file. `spec` is PATH, gnss:PATH or usbl:PATH (the source of every fix in it).
-// False with the reason in error when the file cannot be read.
-bool readPositionFixFile(const std::string& spec, const FixReaderOptions& options, std::vector<PositionFix>& fixes,
-                         FixReaderCounters& counters, std::string& first_problem, std::string& error);
+// Fails with the reason when the file cannot be read.
+sss::core::Result<FixFileContents> readPositionFixFile(const std::string& spec, const FixReaderOptions& options);
 
 // Dates the fixes that have a time of day only: each takes the day that puts it nearest to
 // reference_utime_us (the mission's first navigation time), and a time of day running backwards by

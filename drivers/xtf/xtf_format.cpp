@@ -137,28 +137,25 @@ size_t requiredHeaderBytes(const uint8_t* data, size_t size) {
   return std::max(kFileHeaderBlockBytes, (end + kFileHeaderBlockBytes - 1) / kFileHeaderBlockBytes * kFileHeaderBlockBytes);
 }
 
-XtfFileInfo parseFileHeader(const uint8_t* data, size_t size, std::string& error) {
+sss::core::Result<XtfFileInfo> parseFileHeader(const uint8_t* data, size_t size) {
+  using sss::core::Status;
   XtfFileInfo info;
-  error.clear();
   if (size < kFileHeaderBlockBytes) {
-    error = "XTF file header: " + std::to_string(size) + " bytes, a header needs 1024; not an XTF file";
-    return info;
+    return Status::error("XTF file header: " + std::to_string(size) + " bytes, a header needs 1024; not an XTF file");
   }
   if (data[0] != kXtfFileFormat) {
-    error = "XTF file header: FileFormat byte is " + std::to_string(data[0]) + ", expected 123 (0x7B); not an XTF file";
-    return info;
+    return Status::error("XTF file header: FileFormat byte is " + std::to_string(data[0]) +
+                         ", expected 123 (0x7B); not an XTF file");
   }
   const size_t channels = declaredChannels(data);
   if (channels > kMaxChannels) {
-    error = "XTF file header declares " + std::to_string(channels) + " channels (limit " + std::to_string(kMaxChannels) +
-            "); the header is corrupt";
-    return info;
+    return Status::error("XTF file header declares " + std::to_string(channels) + " channels (limit " +
+                         std::to_string(kMaxChannels) + "); the header is corrupt");
   }
   info.header_bytes = requiredHeaderBytes(data, size);
   if (size < info.header_bytes) {
-    error = "XTF file header with " + std::to_string(channels) + " channels needs " + std::to_string(info.header_bytes) +
-            " bytes, have " + std::to_string(size);
-    return info;
+    return Status::error("XTF file header with " + std::to_string(channels) + " channels needs " +
+                         std::to_string(info.header_bytes) + " bytes, have " + std::to_string(size));
   }
   info.system_type = data[1];
   info.recording_program = fixedString(data + 2, 8);

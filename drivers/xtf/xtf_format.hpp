@@ -47,6 +47,7 @@
 #include <vector>
 
 #include "drivers/edgetech/sonar_driver.hpp"
+#include "pipeline/core/status.hpp"
 
 namespace sss::xtf {
 
@@ -152,9 +153,9 @@ struct XtfFileInfo {
 };
 
 // Decodes the file header. size must cover the whole header (XtfFileInfo::header_bytes; call
-// with 1024 bytes first: when more are needed the error says how many and requiredHeaderBytes()
-// tells). Returns the info with error empty on success.
-XtfFileInfo parseFileHeader(const uint8_t* data, size_t size, std::string& error);
+// with 1024 bytes first: when more are needed the message says how many and requiredHeaderBytes()
+// tells).
+sss::core::Result<XtfFileInfo> parseFileHeader(const uint8_t* data, size_t size);
 // Bytes the header occupies, from its first 1024 bytes (0 when they are not an XTF header).
 size_t requiredHeaderBytes(const uint8_t* data, size_t size);
 

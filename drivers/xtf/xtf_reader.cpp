@@ -72,11 +72,12 @@ void XtfReader::openWith() {
   }
   const size_t header_bytes = requiredHeaderBytes(buffer_.data(), buffer_.size());
   if (header_bytes > kFileHeaderBlockBytes) ensure(header_bytes);
-  info_ = parseFileHeader(buffer_.data(), buffer_.size(), error_);
-  if (!error_.empty()) {
-    error_ = "XTF '" + source_name_ + "': " + error_;
+  sss::core::Result<XtfFileInfo> header = parseFileHeader(buffer_.data(), buffer_.size());
+  if (!header) {
+    error_ = "XTF '" + source_name_ + "': " + header.message();
     return;
   }
+  info_ = std::move(*header);
   const std::vector<ChannelPair> pairs = sideScanPairs(info_);
   if (pairs.empty()) {
     error_ = "XTF '" + source_name_ + "': no side-scan channel among its " + std::to_string(info_.channels.size()) +

@@ -79,22 +79,22 @@ namespace {
 constexpr const char* kOriginStateFormat = "sss-origin/1";
 }
 
-bool writeOriginState(const std::string& path, const MissionOrigin& origin, std::string& error) {
+Status writeOriginState(const std::string& path, const MissionOrigin& origin) {
   char latitude[32], longitude[32];
   std::snprintf(latitude, sizeof latitude, "%.9f", origin.latitude_deg);
   std::snprintf(longitude, sizeof longitude, "%.9f", origin.longitude_deg);
-  return writeStateFile(path, kOriginStateFormat, {{"latitude_deg", latitude}, {"longitude_deg", longitude}}, error);
+  return writeStateFile(path, kOriginStateFormat, {{"latitude_deg", latitude}, {"longitude_deg", longitude}});
 }
 
-std::optional<MissionOrigin> readOriginState(const std::string& path, std::string& error) {
-  StateValues values;
-  if (!readStateFile(path, kOriginStateFormat, values, error)) return std::nullopt;
+Result<MissionOrigin> readOriginState(const std::string& path) {
+  const Result<StateValues> read = readStateFile(path, kOriginStateFormat);
+  if (!read) return read.status();
+  const StateValues& values = read.value();
   MissionOrigin origin;
   if (!stateNumber(values, "latitude_deg", origin.latitude_deg) ||
       !stateNumber(values, "longitude_deg", origin.longitude_deg) ||
       !isValidOrigin(origin.latitude_deg, origin.longitude_deg)) {
-    error = path + ": no valid latitude_deg / longitude_deg";
-    return std::nullopt;
+    return Status::error(path + ": no valid latitude_deg / longitude_deg");
   }
   return origin;
 }

@@ -51,7 +51,7 @@ std::optional<MissionOrigin> parseOriginCommentLine(const std::string& line);
 
 // A live process keeps the origin it chose in its state directory, so that a restart mid-mission
 // keeps the frame: file `origin` of format "sss-origin/1" with keys latitude_deg, longitude_deg.
-bool writeOriginState(const std::string& path, const MissionOrigin& origin, std::string& error);
-std::optional<MissionOrigin> readOriginState(const std::string& path, std::string& error);
+Status writeOriginState(const std::string& path, const MissionOrigin& origin);
+Result<MissionOrigin> readOriginState(const std::string& path);
 
 }  // namespace sss::core

@@ -20,18 +20,17 @@ std::string resolveSystemdDirectory(const std::string& configured, const char* e
   return directories.substr(0, directories.find(':'));
 }
 
-bool writeStateFile(const std::string& path, const std::string& format, const StateValues& values, std::string& error,
-                    Durability durability) {
+Status writeStateFile(const std::string& path, const std::string& format, const StateValues& values,
+                      Durability durability) {
   std::ostringstream text;
   text << format << '\n';
   for (const auto& [key, value] : values) {
     if (key.empty() || key.find_first_of(" \n") != std::string::npos || value.find('\n') != std::string::npos) {
-      error = "state key '" + key + "' or its value cannot be written as one line";
-      return false;
+      return Status::error("state key '" + key + "' or its value cannot be written as one line");
     }
     text << key << ' ' << value << '\n';
   }
-  return writeFileAtomically(path, text.str(), error, durability);
+  return writeFileAtomically(path, text.str(), durability);
 }
 
 void syncDirectoryOf(const std::string& path) {
@@ -45,65 +44,55 @@ void syncDirectoryOf(const std::string& path) {
   }
 }
 
-bool writeFileAtomically(const std::string& path, const std::function<bool(std::FILE*)>& write_body,
-                         std::string& error, Durability durability) {
+Status writeFileAtomically(const std::string& path, const std::function<bool(std::FILE*)>& write_body,
+                           Durability durability) {
   const bool sync = durability == Durability::kSurvivesPowerLoss;
   const std::string temporary = path + ".tmp";
   std::FILE* file = std::fopen(temporary.c_str(), "wb");
   if (!file) {
-    error = temporary + ": cannot open for writing: " + std::strerror(errno);
-    return false;
+    return Status::error(temporary + ": cannot open for writing: " + std::strerror(errno));
   }
   const bool written = write_body(file) && std::fflush(file) == 0 && (!sync || ::fsync(::fileno(file)) == 0);
   const int write_errno = errno;
   if (std::fclose(file) != 0 || !written) {
     std::remove(temporary.c_str());
-    error = temporary + ": write failed: " + std::strerror(write_errno) + "; the previous file is kept";
-    return false;
+    return Status::error(temporary + ": write failed: " + std::strerror(write_errno) + "; the previous file is kept");
   }
   if (std::rename(temporary.c_str(), path.c_str()) != 0) {
     const int rename_errno = errno;
     std::remove(temporary.c_str());
-    error = path + ": rename failed: " + std::strerror(rename_errno);
-    return false;
+    return Status::error(path + ": rename failed: " + std::strerror(rename_errno));
   }
   if (sync) syncDirectoryOf(path);
-  return true;
+  return Status::success();
 }
 
-bool writeFileAtomically(const std::string& path, const std::string& bytes, std::string& error,
-                         Durability durability) {
+Status writeFileAtomically(const std::string& path, const std::string& bytes, Durability durability) {
   return writeFileAtomically(
-      path, [&](std::FILE* file) { return std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size(); }, error,
+      path, [&](std::FILE* file) { return std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size(); },
       durability);
 }
 
-bool readStateFile(const std::string& path, const std::string& format, StateValues& values, std::string& error) {
+Result<StateValues> readStateFile(const std::string& path, const std::string& format) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    error = path + ": cannot open (" + std::strerror(errno) + ")";
-    return false;
-  }
+  if (!in) return Status::error(path + ": cannot open (" + std::strerror(errno) + ")");
   std::string line;
   if (!std::getline(in, line) || line != format) {
-    error = path + ": not a '" + format + "' file (first line '" + line.substr(0, 60) + "')";
-    return false;
+    return Status::error(path + ": not a '" + format + "' file (first line '" + line.substr(0, 60) + "')");
   }
-  values.clear();
+  StateValues values;
   int number = 1;
   while (std::getline(in, line)) {
     ++number;
     const size_t space = line.find(' ');
     if (space == 0 || space == std::string::npos || space + 1 >= line.size()) {
-      error = path + ": line " + std::to_string(number) + " is not 'key value'";
-      return false;
+      return Status::error(path + ": line " + std::to_string(number) + " is not 'key value'");
     }
     if (!values.emplace(line.substr(0, space), line.substr(space + 1)).second) {
-      error = path + ": line " + std::to_string(number) + " repeats key '" + line.substr(0, space) + "'";
-      return false;
+      return Status::error(path + ": line " + std::to_string(number) + " repeats key '" + line.substr(0, space) + "'");
     }
   }
-  return true;
+  return values;
 }
 
 bool stateNumber(const StateValues& values, const std::string& key, double& number) {

@@ -9,6 +9,8 @@
 #include <map>
 #include <string>
 
+#include "pipeline/core/status.hpp"
+
 namespace sss::core {
 
 // A directory a process writes to: `configured` when set, else the one systemd passes in the
@@ -23,25 +25,24 @@ enum class Durability { kSurvivesPowerLoss, kSurvivesProcessKill };
 
 // Replaces path with what write_body writes (a temporary file renamed over path; with
 // kSurvivesPowerLoss the file is fsynced before and its directory after): a kill at any moment
-// leaves the old or the new file. False with `error` set when it cannot (the old file is then
-// intact).
-bool writeFileAtomically(const std::string& path, const std::function<bool(std::FILE*)>& write_body,
-                         std::string& error, Durability durability = Durability::kSurvivesPowerLoss);
-bool writeFileAtomically(const std::string& path, const std::string& bytes, std::string& error,
-                         Durability durability = Durability::kSurvivesPowerLoss);
+// leaves the old or the new file. An error when it cannot (the old file is then intact).
+Status writeFileAtomically(const std::string& path, const std::function<bool(std::FILE*)>& write_body,
+                           Durability durability = Durability::kSurvivesPowerLoss);
+Status writeFileAtomically(const std::string& path, const std::string& bytes,
+                           Durability durability = Durability::kSurvivesPowerLoss);
 // fsync of the directory holding path (makes a rename durable); best effort.
 void syncDirectoryOf(const std::string& path);
 
 using StateValues = std::map<std::string, std::string>;
 
 // Writes `format` then one `key value` line per entry to path (keys without spaces or newlines,
-// values without newlines). False with `error` set when it cannot; the old file is then intact.
-bool writeStateFile(const std::string& path, const std::string& format, const StateValues& values, std::string& error,
-                    Durability durability = Durability::kSurvivesPowerLoss);
+// values without newlines). An error when it cannot; the old file is then intact.
+Status writeStateFile(const std::string& path, const std::string& format, const StateValues& values,
+                      Durability durability = Durability::kSurvivesPowerLoss);
 
-// Reads a file written by writeStateFile. False with `error` when it is missing, of another
-// format, or malformed (a line without a value, a duplicate key).
-bool readStateFile(const std::string& path, const std::string& format, StateValues& values, std::string& error);
+// Reads a file written by writeStateFile. An error when it is missing, of another format, or
+// malformed (a line without a value, a duplicate key).
+Result<StateValues> readStateFile(const std::string& path, const std::string& format);
 
 // Numeric value of `key`; false when absent or not entirely a finite number / an integer.
 bool stateNumber(const StateValues& values, const std::string& key, double& number);

@@ -144,8 +144,7 @@ std::vector<PairOutcome> MatcherEngine::addSubframe(sss::core::Subframe subframe
   setCorrection(stored, newSubframeCorrection(id, stored.subframe.line_id));
   // On disk before matching: if the process dies while matching, restore() finds the subframe
   // without a state entry and matches it then.
-  std::string error;
-  if (store_ && !store_->writeSubframe(stored.subframe, error)) recordStateError(error);
+  if (store_) recordStateError(store_->writeSubframe(stored.subframe));
   outcomes = matchNewSubframe(id, allFootprints());
   evictBeyondLimit();
   saveState();
@@ -186,8 +185,7 @@ void MatcherEngine::evictBeyondLimit() {
       it = it->first.first == oldest || it->first.second == oldest ? pairs_.erase(it) : std::next(it);
     }
     ++counters_.subframes_evicted;
-    std::string error;
-    if (store_ && !store_->removeSubframe(oldest, error)) recordStateError(error);
+    if (store_) recordStateError(store_->removeSubframe(oldest));
   }
 }
 
@@ -203,13 +201,13 @@ MatcherState MatcherEngine::state() const {
 }
 
 void MatcherEngine::saveState() {
-  std::string error;
-  if (store_ && !store_->writeState(state(), error)) recordStateError(error);
+  if (store_) recordStateError(store_->writeState(state()));
 }
 
-void MatcherEngine::recordStateError(const std::string& error) {
+void MatcherEngine::recordStateError(const sss::core::Status& written) {
+  if (written) return;
   ++counters_.state_write_errors;
-  state_error_ = error;
+  state_error_ = written.message;
 }
 
 std::string MatcherEngine::takeStateError() {
@@ -222,39 +220,37 @@ RestoreReport MatcherEngine::restore(MatcherStateStore& store) {
   if (store_ || !stored_.empty()) throw std::logic_error("MatcherEngine::restore: call once, on an empty engine");
   RestoreReport report;
   report.directory = store.directory();
-  std::string error;
-  if (!store.open(error)) {
+  if (const sss::core::Status opened = store.open(); !opened) {
     ++counters_.state_write_errors;
-    report.problems.push_back(error + "; the matcher's state is not kept");
+    report.problems.push_back(opened.message + "; the matcher's state is not kept");
     return report;
   }
   store_ = &store;
 
-  MatcherState state;
-  const StateFileStatus state_status = store.readState(state, error);
-  report.state_file_found = state_status == StateFileStatus::kOk;
-  if (state_status == StateFileStatus::kCorrupt) {
+  const sss::core::Result<std::optional<MatcherState>> read_state = store.readState();
+  report.state_file_found = read_state && read_state->has_value();
+  if (!read_state) {
     ++counters_.state_files_corrupt;
-    report.problems.push_back(error + "; restoring the subframes without it (no corrections, pairs matched again)");
+    report.problems.push_back(read_state.message() +
+                              "; restoring the subframes without it (no corrections, pairs matched again)");
   }
+  const MatcherState state = report.state_file_found ? **read_state : MatcherState{};
   std::map<int64_t, Pose> corrections;
   for (const SubframeCorrection& c : state.corrections) corrections[c.subframe_id] = c.correction;
 
   std::vector<int64_t> without_state;
   for (const int64_t id : store.subframeIds()) {  // ascending: a missing correction is inherited as when it came
-    sss::core::Subframe subframe;
-    const StateFileStatus status = store.readSubframe(id, subframe, error);
-    if (status == StateFileStatus::kMissing) continue;
-    if (status == StateFileStatus::kCorrupt) {
+    sss::core::Result<std::optional<sss::core::Subframe>> read = store.readSubframe(id);
+    if (!read) {
       ++counters_.state_files_corrupt;
       // Never usable; removed so it is not reported at every start. The LCM log keeps the message.
-      std::string removal_error;
-      report.problems.push_back(error + (store.removeSubframe(id, removal_error) ? "; skipped and removed"
-                                                                                   : "; skipped; " + removal_error));
+      const sss::core::Status removed = store.removeSubframe(id);
+      report.problems.push_back(read.message() + (removed ? "; skipped and removed" : "; skipped; " + removed.message));
       continue;
     }
+    if (!read->has_value()) continue;
     Stored& stored = stored_[id];
-    stored.subframe = std::move(subframe);
+    stored.subframe = std::move(**read);
     const auto correction = corrections.find(id);
     if (correction == corrections.end()) without_state.push_back(id);
     setCorrection(stored, correction != corrections.end() ? correction->second

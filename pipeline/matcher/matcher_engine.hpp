@@ -154,7 +154,7 @@ class MatcherEngine {
   std::vector<PairOutcome> matchNewSubframe(int64_t id, const std::vector<Footprint>& others);
   void evictBeyondLimit();
   void saveState();
-  void recordStateError(const std::string& error);
+  void recordStateError(const sss::core::Status& written);  // counts and keeps a failed write
 
   MatcherEngineOptions options_;
   DenseMatcher dense_;

@@ -75,16 +75,15 @@ void MatcherService::stop() { worker_->stop(); }
 
 void MatcherService::addSubframe(const sss_msgs::subframe_t& message, int64_t arrival_monotonic_us,
                                  sss::core::HealthMonitor& health, sss::core::ServiceLog& log) {
-  sss::core::Subframe subframe;
-  std::string error;
-  if (!sss::messages::fromSubframeMessage(message, subframe, error)) {
+  sss::core::Result<sss::core::Subframe> subframe = sss::messages::fromSubframeMessage(message);
+  if (!subframe) {
     ++rejected_messages_;
-    if (health.recordError("bad_subframe", error, sss::core::nowUtime()))
-      log.warnings.push_back("subframe " + std::to_string(message.subframe_id) + " rejected: " + error +
+    if (health.recordError("bad_subframe", subframe.message(), sss::core::nowUtime()))
+      log.warnings.push_back("subframe " + std::to_string(message.subframe_id) + " rejected: " + subframe.message() +
                              "; further ones are counted in SSS_STATUS");
     return;
   }
-  if (worker_->addSubframe(std::move(subframe), arrival_monotonic_us) && !queue_full_said_) {
+  if (worker_->addSubframe(std::move(subframe).value(), arrival_monotonic_us) && !queue_full_said_) {
     queue_full_said_ = true;
     log.warnings.push_back("matcher queue full (" + std::to_string(options_.max_queued_subframes) +
                            " subframes): dropping the oldest; further drops are counted");
@@ -93,15 +92,14 @@ void MatcherService::addSubframe(const sss_msgs::subframe_t& message, int64_t ar
 
 void MatcherService::setTrajectory(const sss_msgs::trajectory_t& message, sss::core::HealthMonitor& health,
                                    sss::core::ServiceLog& log) {
-  std::vector<TrajectoryNode> nodes;
-  std::string error;
-  if (!sss::messages::fromTrajectoryMessage(message, nodes, error)) {
+  sss::core::Result<std::vector<TrajectoryNode>> nodes = sss::messages::fromTrajectoryMessage(message);
+  if (!nodes) {
     ++rejected_messages_;
-    if (health.recordError("bad_trajectory", error, sss::core::nowUtime()))
-      log.warnings.push_back("trajectory rejected: " + error + "; further ones are counted in SSS_STATUS");
+    if (health.recordError("bad_trajectory", nodes.message(), sss::core::nowUtime()))
+      log.warnings.push_back("trajectory rejected: " + nodes.message() + "; further ones are counted in SSS_STATUS");
     return;
   }
-  worker_->setTrajectory(std::move(nodes));
+  worker_->setTrajectory(std::move(nodes).value());
 }
 
 std::vector<ClosureToPublish> MatcherService::takeResults(int64_t now_utime_us, sss::core::HealthMonitor& health,

@@ -51,30 +51,28 @@ class Fnv1a {
   uint64_t hash_ = 1469598103934665603ull;
 };
 
-bool readWholeFile(const std::string& path, uintmax_t max_bytes, std::string& contents, std::string& error) {
+sss::core::Result<std::string> readWholeFile(const std::string& path, uintmax_t max_bytes) {
+  using sss::core::Status;
   std::error_code ec;
   const uintmax_t size = fs::file_size(path, ec);
   if (ec) {
-    error = path + ": cannot read: " + ec.message();
-    return false;
+    return Status::error(path + ": cannot read: " + ec.message());
   }
   if (size > max_bytes) {
-    error = path + ": " + std::to_string(size) + " bytes, more than the " + std::to_string(max_bytes) + " limit";
-    return false;
+    return Status::error(path + ": " + std::to_string(size) + " bytes, more than the " + std::to_string(max_bytes) +
+                         " limit");
   }
   FILE* file = std::fopen(path.c_str(), "rb");
   if (!file) {
-    error = path + ": cannot open: " + std::strerror(errno);
-    return false;
+    return Status::error(path + ": cannot open: " + std::strerror(errno));
   }
-  contents.resize(static_cast<size_t>(size));
+  std::string contents(static_cast<size_t>(size), '\0');
   const size_t got = std::fread(contents.data(), 1, contents.size(), file);
   std::fclose(file);
   if (got != contents.size()) {
-    error = path + ": read " + std::to_string(got) + " of " + std::to_string(size) + " bytes";
-    return false;
+    return Status::error(path + ": read " + std::to_string(got) + " of " + std::to_string(size) + " bytes");
   }
-  return true;
+  return contents;
 }
 
 // ---- subframe files -------------------------------------------------------------------------------
@@ -143,16 +141,17 @@ class BinaryReader {
   size_t left_;
 };
 
-bool parseSubframeFile(const std::string& contents, const std::string& path, int64_t expected_id,
-                       sss::core::Subframe& subframe, std::string& error) {
+sss::core::Result<sss::core::Subframe> parseSubframeFile(const std::string& contents, const std::string& path,
+                                                        int64_t expected_id) {
+  using sss::core::Status;
   const size_t size = contents.size();
   if (size < sizeof kSubframeMagic + kHeaderBytes + kChecksumBytes ||
       std::memcmp(contents.data(), kSubframeMagic, sizeof kSubframeMagic) != 0) {
-    error = path + ": not a subframe file (" + std::to_string(size) + " bytes, magic 'sss-subframe v1' expected)";
-    return false;
+    return Status::error(path + ": not a subframe file (" + std::to_string(size) +
+                         " bytes, magic 'sss-subframe v1' expected)");
   }
   BinaryReader in(contents.data() + sizeof kSubframeMagic, size - sizeof kSubframeMagic);
-  subframe = sss::core::Subframe{};
+  sss::core::Subframe subframe;
   subframe.id = in.value<int64_t>();
   subframe.line_id = in.value<int32_t>();
   subframe.centre_ping_index = in.value<int32_t>();
@@ -164,30 +163,27 @@ bool parseSubframeFile(const std::string& contents, const std::string& path, int
   // Sizes before allocating: a flipped size must not ask for gigabytes.
   const int32_t bins = subframe.geometry.bins_per_side;
   if (rows < 2 || rows > 1000000 || bins < 1 || bins > 1000000) {
-    error = path + ": implausible sizes (" + std::to_string(rows) + " pings, " + std::to_string(bins) +
-            " bins per side)";
-    return false;
+    return Status::error(path + ": implausible sizes (" + std::to_string(rows) + " pings, " + std::to_string(bins) +
+                         " bins per side)");
   }
   const size_t pixels = static_cast<size_t>(rows) * 2 * static_cast<size_t>(bins);
   const size_t expected_size = sizeof kSubframeMagic + kHeaderBytes + static_cast<size_t>(rows) * kPingBytes +
                                pixels * (sizeof(float) + 1) + kChecksumBytes;
   if (size != expected_size) {
-    error = path + ": " + std::to_string(size) + " bytes where its header (" + std::to_string(rows) + " pings, " +
-            std::to_string(bins) + " bins per side) needs " + std::to_string(expected_size) + " (truncated?)";
-    return false;
+    return Status::error(path + ": " + std::to_string(size) + " bytes where its header (" + std::to_string(rows) +
+                         " pings, " + std::to_string(bins) + " bins per side) needs " + std::to_string(expected_size) +
+                         " (truncated?)");
   }
   Fnv1a hash;
   hash.add(contents.data(), size - kChecksumBytes);
   uint64_t stored_checksum = 0;
   std::memcpy(&stored_checksum, contents.data() + size - kChecksumBytes, kChecksumBytes);
   if (hash.value() != stored_checksum) {
-    error = path + ": checksum mismatch (corrupt bytes)";
-    return false;
+    return Status::error(path + ": checksum mismatch (corrupt bytes)");
   }
   if (subframe.id != expected_id || subframe.centre_ping_index < 0 || subframe.centre_ping_index >= rows) {
-    error = path + ": holds subframe " + std::to_string(subframe.id) + " with centre ping " +
-            std::to_string(subframe.centre_ping_index) + " of " + std::to_string(rows);
-    return false;
+    return Status::error(path + ": holds subframe " + std::to_string(subframe.id) + " with centre ping " +
+                         std::to_string(subframe.centre_ping_index) + " of " + std::to_string(rows));
   }
   subframe.pings.resize(static_cast<size_t>(rows));
   for (sss::core::SubframePing& ping : subframe.pings) {
@@ -201,7 +197,7 @@ bool parseSubframeFile(const std::string& contents, const std::string& path, int
   in.bytes(subframe.image.data(), pixels * sizeof(float));
   subframe.mask.resize(pixels);
   in.bytes(subframe.mask.data(), pixels);
-  return true;
+  return subframe;
 }
 
 // ---- state file ------------------------------------------------------------------------------------
@@ -233,22 +229,19 @@ std::string MatcherStateStore::subframePath(int64_t subframe_id) const {
 
 std::string MatcherStateStore::statePath() const { return directory_ + "/matcher.state"; }
 
-bool MatcherStateStore::open(std::string& error) {
+sss::core::Status MatcherStateStore::open() {
   std::error_code ec;
   fs::create_directories(directory_ + "/subframes", ec);
-  if (ec) {
-    error = directory_ + "/subframes: cannot create: " + ec.message();
-    return false;
-  }
+  if (ec) return sss::core::Status::error(directory_ + "/subframes: cannot create: " + ec.message());
   for (const std::string& folder : {directory_, directory_ + "/subframes"}) {
     for (const auto& entry : fs::directory_iterator(folder, ec)) {
       if (entry.path().extension() == ".tmp") fs::remove(entry.path(), ec);
     }
   }
-  return true;
+  return sss::core::Status::success();
 }
 
-bool MatcherStateStore::writeSubframe(const sss::core::Subframe& s, std::string& error) {
+sss::core::Status MatcherStateStore::writeSubframe(const sss::core::Subframe& s) {
   return sss::core::writeFileAtomically(
       subframePath(s.id),
       [&](FILE* file) {
@@ -272,22 +265,18 @@ bool MatcherStateStore::writeSubframe(const sss::core::Subframe& s, std::string&
         out.bytes(s.image.data(), s.image.size() * sizeof(float));
         out.bytes(s.mask.data(), s.mask.size());
         return out.finish();
-      },
-      error);
+      });
 }
 
-bool MatcherStateStore::removeSubframe(int64_t subframe_id, std::string& error) {
+sss::core::Status MatcherStateStore::removeSubframe(int64_t subframe_id) {
   const std::string path = subframePath(subframe_id);
   std::error_code ec;
   fs::remove(path, ec);  // false without error when there was no file
-  if (ec) {
-    error = path + ": cannot remove: " + ec.message();
-    return false;
-  }
-  return true;
+  if (ec) return sss::core::Status::error(path + ": cannot remove: " + ec.message());
+  return sss::core::Status::success();
 }
 
-bool MatcherStateStore::writeState(const MatcherState& state, std::string& error) {
+sss::core::Status MatcherStateStore::writeState(const MatcherState& state) {
   std::string text = std::string(kStateMagic) + " " + std::to_string(kStateVersion) + "\n";
   for (const SubframeCorrection& c : state.corrections) {
     text += "subframe " + std::to_string(c.subframe_id);
@@ -306,7 +295,7 @@ bool MatcherStateStore::writeState(const MatcherState& state, std::string& error
   std::snprintf(checksum, sizeof checksum, "checksum %016" PRIx64 "\n", hash.value());
   text += checksum;
   return sss::core::writeFileAtomically(
-      statePath(), [&](FILE* file) { return std::fwrite(text.data(), 1, text.size(), file) == text.size(); }, error);
+      statePath(), [&](FILE* file) { return std::fwrite(text.data(), 1, text.size(), file) == text.size(); });
 }
 
 std::vector<int64_t> MatcherStateStore::subframeIds() const {
@@ -326,23 +315,25 @@ std::vector<int64_t> MatcherStateStore::subframeIds() const {
   return ids;
 }
 
-StateFileStatus MatcherStateStore::readSubframe(int64_t subframe_id, sss::core::Subframe& subframe,
-                                                std::string& error) const {
+sss::core::Result<std::optional<sss::core::Subframe>> MatcherStateStore::readSubframe(int64_t subframe_id) const {
   const std::string path = subframePath(subframe_id);
   std::error_code ec;
-  if (!fs::exists(path, ec)) return StateFileStatus::kMissing;
-  std::string contents;
-  if (!readWholeFile(path, kMaxSubframeFileBytes, contents, error)) return StateFileStatus::kCorrupt;
-  return parseSubframeFile(contents, path, subframe_id, subframe, error) ? StateFileStatus::kOk
-                                                                         : StateFileStatus::kCorrupt;
+  if (!fs::exists(path, ec)) return std::optional<sss::core::Subframe>{};
+  const sss::core::Result<std::string> contents = readWholeFile(path, kMaxSubframeFileBytes);
+  if (!contents) return contents.status();
+  sss::core::Result<sss::core::Subframe> subframe = parseSubframeFile(*contents, path, subframe_id);
+  if (!subframe) return subframe.status();
+  return std::optional<sss::core::Subframe>(std::move(*subframe));
 }
 
-StateFileStatus MatcherStateStore::readState(MatcherState& state, std::string& error) const {
+sss::core::Result<std::optional<MatcherState>> MatcherStateStore::readState() const {
+  using sss::core::Status;
   const std::string path = statePath();
   std::error_code ec;
-  if (!fs::exists(path, ec)) return StateFileStatus::kMissing;
-  std::string text;
-  if (!readWholeFile(path, kMaxStateFileBytes, text, error)) return StateFileStatus::kCorrupt;
+  if (!fs::exists(path, ec)) return std::optional<MatcherState>{};
+  const sss::core::Result<std::string> read = readWholeFile(path, kMaxStateFileBytes);
+  if (!read) return read.status();
+  const std::string& text = *read;
   // The checksum line is the last one and covers every byte before it.
   const size_t checksum_at = text.rfind("checksum ");
   unsigned long long stored_checksum = 0;
@@ -350,24 +341,21 @@ StateFileStatus MatcherStateStore::readState(MatcherState& state, std::string& e
   if (checksum_at == std::string::npos || (checksum_at > 0 && text[checksum_at - 1] != '\n') ||
       std::sscanf(text.c_str() + checksum_at, "checksum %16llx%c", &stored_checksum, &tail) != 2 || tail != '\n' ||
       checksum_at + 26 != text.size()) {
-    error = path + ": no checksum line at the end (truncated?)";
-    return StateFileStatus::kCorrupt;
+    return Status::error(path + ": no checksum line at the end (truncated?)");
   }
   Fnv1a hash;
   hash.add(text.data(), checksum_at);
   if (hash.value() != stored_checksum) {
-    error = path + ": checksum mismatch (corrupt bytes)";
-    return StateFileStatus::kCorrupt;
+    return Status::error(path + ": checksum mismatch (corrupt bytes)");
   }
   std::istringstream lines(text.substr(0, checksum_at));
   std::string line;
   std::getline(lines, line);
   if (line != std::string(kStateMagic) + " " + std::to_string(kStateVersion)) {
-    error = path + ": first line '" + line.substr(0, 40) + "', expected '" + kStateMagic + " " +
-            std::to_string(kStateVersion) + "'";
-    return StateFileStatus::kCorrupt;
+    return Status::error(path + ": first line '" + line.substr(0, 40) + "', expected '" + kStateMagic + " " +
+                         std::to_string(kStateVersion) + "'");
   }
-  state = MatcherState{};
+  MatcherState state;
   for (int number = 2; std::getline(lines, line); ++number) {
     std::istringstream in(line);
     std::string keyword;
@@ -386,12 +374,10 @@ StateFileStatus MatcherStateStore::readState(MatcherState& state, std::string& e
     }
     in >> std::ws;
     if (!ok || !in.eof()) {
-      error = path + ": line " + std::to_string(number) + " not understood: '" + line.substr(0, 80) + "'";
-      state = MatcherState{};
-      return StateFileStatus::kCorrupt;
+      return Status::error(path + ": line " + std::to_string(number) + " not understood: '" + line.substr(0, 80) + "'");
     }
   }
-  return StateFileStatus::kOk;
+  return std::optional<MatcherState>(std::move(state));
 }
 
 }  // namespace sss::matcher

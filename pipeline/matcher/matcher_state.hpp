@@ -3,10 +3,12 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "pipeline/core/pose.hpp"
+#include "pipeline/core/status.hpp"
 #include "pipeline/core/subframe_types.hpp"
 
 namespace sss::matcher {
@@ -27,8 +29,6 @@ struct MatcherState {
   std::vector<PairRecord> pairs;
 };
 
-enum class StateFileStatus { kOk, kMissing, kCorrupt };
-
 // Files in the state directory; each is written to <name>.tmp, fsync'ed and renamed into place, so a
 // kill or a power cut leaves the previous file or the new one, never half of one:
 //   subframes/<id>.subframe  one stored subframe, exact (float image), binary with an FNV-1a checksum
@@ -43,16 +43,17 @@ class MatcherStateStore {
   std::string statePath() const;
 
   // Creates the directories and removes the temporary files a kill mid-write left behind.
-  bool open(std::string& error);
+  sss::core::Status open();
 
-  bool writeSubframe(const sss::core::Subframe& subframe, std::string& error);
-  bool removeSubframe(int64_t subframe_id, std::string& error);
-  bool writeState(const MatcherState& state, std::string& error);
+  sss::core::Status writeSubframe(const sss::core::Subframe& subframe);
+  sss::core::Status removeSubframe(int64_t subframe_id);  // ok when there was no file
+  sss::core::Status writeState(const MatcherState& state);
 
   // Ids of the subframe files, ascending (other names are ignored).
   std::vector<int64_t> subframeIds() const;
-  StateFileStatus readSubframe(int64_t subframe_id, sss::core::Subframe& subframe, std::string& error) const;
-  StateFileStatus readState(MatcherState& state, std::string& error) const;
+  // nullopt when there is no such file; an error when there is one that cannot be trusted.
+  sss::core::Result<std::optional<sss::core::Subframe>> readSubframe(int64_t subframe_id) const;
+  sss::core::Result<std::optional<MatcherState>> readState() const;
 
  private:
   std::string directory_;

@@ -68,31 +68,28 @@ sss_msgs::loop_closure_t toLoopClosureMessage(const LoopClosure& c, int64_t utim
   return m;
 }
 
-bool fromLoopClosureMessage(const sss_msgs::loop_closure_t& m, LoopClosure& c, std::string& error) {
+Result<LoopClosure> fromLoopClosureMessage(const sss_msgs::loop_closure_t& m) {
   const size_t n = m.num_correspondences < 0 ? 0 : static_cast<size_t>(m.num_correspondences);
   if (m.num_correspondences < 0 || m.ping_index_a.size() != n || m.column_a.size() != n ||
       m.ping_index_b.size() != n || m.column_b.size() != n || m.slant_range_a_m.size() != n ||
       m.slant_range_b_m.size() != n || m.landmark_a_m.size() != n) {
-    error = "loop closure " + std::to_string(m.subframe_id_a) + "-" + std::to_string(m.subframe_id_b) +
-            ": correspondence arrays disagree with num_correspondences";
-    return false;
+    return Status::error("loop closure " + std::to_string(m.subframe_id_a) + "-" + std::to_string(m.subframe_id_b) +
+                         ": correspondence arrays disagree with num_correspondences");
   }
-  c = LoopClosure{};
+  LoopClosure c;
   c.subframe_id_a = m.subframe_id_a;
   c.subframe_id_b = m.subframe_id_b;
   c.centre_utime_a_us = m.centre_utime_a;
   c.centre_utime_b_us = m.centre_utime_b;
   if (!finite(m.translation_ab_m, 3) || !quaternionFrom(m.rotation_ab_wxyz, c.T_a_b.rotation)) {
-    error = "loop closure " + std::to_string(m.subframe_id_a) + "-" + std::to_string(m.subframe_id_b) +
-            ": relative pose is not finite or its quaternion is zero";
-    return false;
+    return Status::error("loop closure " + std::to_string(m.subframe_id_a) + "-" + std::to_string(m.subframe_id_b) +
+                         ": relative pose is not finite or its quaternion is zero");
   }
   c.T_a_b.translation = Eigen::Vector3d(m.translation_ab_m[0], m.translation_ab_m[1], m.translation_ab_m[2]);
   for (int r = 0; r < 6; ++r) {
     if (!finite(m.covariance[r], 6)) {
-      error = "loop closure " + std::to_string(m.subframe_id_a) + "-" + std::to_string(m.subframe_id_b) +
-              ": covariance is not finite";
-      return false;
+      return Status::error("loop closure " + std::to_string(m.subframe_id_a) + "-" + std::to_string(m.subframe_id_b) +
+                           ": covariance is not finite");
     }
     for (int k = 0; k < 6; ++k) c.covariance(r, k) = m.covariance[r][k];
   }
@@ -113,12 +110,11 @@ bool fromLoopClosureMessage(const sss_msgs::loop_closure_t& m, LoopClosure& c, s
     cc.slant_range_a_m = m.slant_range_a_m[i];
     cc.slant_range_b_m = m.slant_range_b_m[i];
     if (m.landmark_a_m[i].size() != 3) {
-      error = "loop closure: a landmark without 3 coordinates";
-      return false;
+      return Status::error("loop closure: a landmark without 3 coordinates");
     }
     cc.landmark_a_m = Eigen::Vector3f(m.landmark_a_m[i][0], m.landmark_a_m[i][1], m.landmark_a_m[i][2]);
   }
-  return true;
+  return c;
 }
 
 sss_msgs::trajectory_t toTrajectoryMessage(const std::vector<TrajectoryNode>& nodes, int64_t utime_us) {
@@ -140,14 +136,13 @@ sss_msgs::trajectory_t toTrajectoryMessage(const std::vector<TrajectoryNode>& no
   return m;
 }
 
-bool fromTrajectoryMessage(const sss_msgs::trajectory_t& m, std::vector<TrajectoryNode>& nodes, std::string& error) {
+Result<std::vector<TrajectoryNode>> fromTrajectoryMessage(const sss_msgs::trajectory_t& m) {
   const size_t n = m.num_nodes < 0 ? 0 : static_cast<size_t>(m.num_nodes);
   if (m.num_nodes < 0 || m.subframe_id.size() != n || m.node_utime.size() != n || m.position_ned_m.size() != n ||
       m.orientation_wxyz.size() != n) {
-    error = "trajectory: arrays disagree with num_nodes";
-    return false;
+    return Status::error("trajectory: arrays disagree with num_nodes");
   }
-  nodes.clear();
+  std::vector<TrajectoryNode> nodes;
   nodes.reserve(n);
   for (size_t i = 0; i < n; ++i) {
     TrajectoryNode node;
@@ -155,13 +150,13 @@ bool fromTrajectoryMessage(const sss_msgs::trajectory_t& m, std::vector<Trajecto
     node.utime_us = m.node_utime[i];
     if (m.position_ned_m[i].size() != 3 || m.orientation_wxyz[i].size() != 4 || !finite(m.position_ned_m[i].data(), 3) ||
         !quaternionFrom(m.orientation_wxyz[i].data(), node.T_world_body.rotation)) {
-      error = "trajectory: node " + std::to_string(node.subframe_id) + " has a non-finite pose or a zero quaternion";
-      return false;
+      return Status::error("trajectory: node " + std::to_string(node.subframe_id) +
+                           " has a non-finite pose or a zero quaternion");
     }
     node.T_world_body.translation = Eigen::Vector3d(m.position_ned_m[i][0], m.position_ned_m[i][1], m.position_ned_m[i][2]);
     nodes.push_back(node);
   }
-  return true;
+  return nodes;
 }
 
 }  // namespace sss::messages

@@ -65,19 +65,19 @@ sss_msgs::subframe_t toSubframeMessage(const Subframe& subframe, int intensity_b
   return m;
 }
 
-bool fromSubframeMessage(const sss_msgs::subframe_t& m, Subframe& subframe, std::string& error) {
+Result<Subframe> fromSubframeMessage(const sss_msgs::subframe_t& m) {
   const int rows = m.num_pings;
   const size_t pixels = static_cast<size_t>(rows) * 2 * static_cast<size_t>(std::max(0, m.num_bins_per_side));
   const size_t bytes_per_pixel = m.intensity_bits == 8 ? 1 : 2;
   if (rows <= 0 || m.num_bins_per_side <= 0 || (m.intensity_bits != 8 && m.intensity_bits != 16) ||
       m.image.size() != pixels * bytes_per_pixel || m.mask.size() != pixels || m.centre_ping_index < 0 ||
       m.centre_ping_index >= rows) {
-    error = "subframe " + std::to_string(m.subframe_id) + ": inconsistent sizes (pings " + std::to_string(rows) +
-            ", bins per side " + std::to_string(m.num_bins_per_side) + ", bits " + std::to_string(m.intensity_bits) +
-            ", image bytes " + std::to_string(m.image.size()) + ", mask bytes " + std::to_string(m.mask.size()) + ")";
-    return false;
+    return Status::error("subframe " + std::to_string(m.subframe_id) + ": inconsistent sizes (pings " +
+                         std::to_string(rows) + ", bins per side " + std::to_string(m.num_bins_per_side) + ", bits " +
+                         std::to_string(m.intensity_bits) + ", image bytes " + std::to_string(m.image.size()) +
+                         ", mask bytes " + std::to_string(m.mask.size()) + ")");
   }
-  subframe = Subframe{};
+  Subframe subframe;
   subframe.id = m.subframe_id;
   subframe.line_id = m.line_id;
   subframe.centre_ping_index = m.centre_ping_index;
@@ -105,7 +105,7 @@ bool fromSubframeMessage(const sss_msgs::subframe_t& m, Subframe& subframe, std:
     subframe.image[i] = static_cast<float>(code * static_cast<double>(m.intensity_scale));
   }
   subframe.mask = m.mask;
-  return true;
+  return subframe;
 }
 
 }  // namespace sss::messages

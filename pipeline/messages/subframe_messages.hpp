@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "pipeline/core/status.hpp"
 #include "pipeline/core/subframe_types.hpp"
 #include "sss_msgs/subframe_t.hpp"
 
@@ -11,12 +12,14 @@ namespace sss::messages {
 
 using sss::core::Subframe;
 using sss::core::SubframePing;
+using sss::core::Result;
+using sss::core::Status;
 
 // Quantises the image: code = round(value / scale), scale = max_intensity / (2^bits - 1),
 // little-endian for 16 bits. Angles of the mounting come from geometry.T_body_sonar.
 sss_msgs::subframe_t toSubframeMessage(const Subframe& subframe, int intensity_bits, double max_intensity,
                                        float horizontal_beam_width_rad = 0.0f, float vertical_beam_width_rad = 0.0f);
-// The inverse (matcher side); false with a reason when the message is inconsistent.
-bool fromSubframeMessage(const sss_msgs::subframe_t& message, Subframe& subframe, std::string& error);
+// The inverse (matcher side); an error with the reason when the message is inconsistent.
+Result<Subframe> fromSubframeMessage(const sss_msgs::subframe_t& message);
 
 }  // namespace sss::messages

@@ -17,6 +17,8 @@
 
 namespace sss::optimiser {
 
+using sss::core::Status;
+
 namespace {
 // Residual weights of the fit: slant ranges are known to a few centimetres (bin size), the fan
 // plane only to the horizontal beam width times the range (~0.4 m at 50 m for 0.5 deg).
@@ -156,7 +158,7 @@ std::string stripYamlExtension(const std::string& path) {
 
 // Depth as colour (turbo, shallow blue .. deep red), north up, no data dark grey, with a colour
 // bar and its depth range written below.
-bool writeHeightmapPng(const std::string& path, const HeightmapGrid& grid, std::string& error) {
+Status writeHeightmapPng(const std::string& path, const HeightmapGrid& grid) {
   float shallow = std::numeric_limits<float>::infinity(), deep = -shallow;
   for (float d : grid.depth_m) {
     if (!std::isfinite(d)) continue;
@@ -203,23 +205,20 @@ bool writeHeightmapPng(const std::string& path, const HeightmapGrid& grid, std::
               cv::LINE_AA);
   try {
     if (!cv::imwrite(path, canvas)) {
-      error = "cannot write " + path;
-      return false;
+      return Status::error("cannot write " + path);
     }
   } catch (const cv::Exception& e) {
-    error = "cannot write " + path + ": " + e.what();
-    return false;
+    return Status::error("cannot write " + path + ": " + e.what());
   }
-  return true;
+  return Status::success();
 }
 
 }  // namespace
 
-bool writeHeightmapFiles(const std::string& yaml_path, const HeightmapGrid& grid, const std::string& description,
-                         std::string& error, const std::optional<sss::core::MissionOrigin>& origin) {
+Status writeHeightmapFiles(const std::string& yaml_path, const HeightmapGrid& grid, const std::string& description,
+                           const std::optional<sss::core::MissionOrigin>& origin) {
   if (grid.rows < 1 || grid.cols < 1 || grid.depth_m.size() != static_cast<size_t>(grid.rows) * grid.cols) {
-    error = "heightmap " + yaml_path + " has no cells (no seabed points)";
-    return false;
+    return Status::error("heightmap " + yaml_path + " has no cells (no seabed points)");
   }
   const std::string prefix = stripYamlExtension(yaml_path);
   const std::string depth_path = prefix + "_depth.f32";
@@ -227,8 +226,7 @@ bool writeHeightmapFiles(const std::string& yaml_path, const HeightmapGrid& grid
   depth.write(reinterpret_cast<const char*>(grid.depth_m.data()),
               static_cast<std::streamsize>(grid.depth_m.size() * sizeof(float)));
   if (!depth) {
-    error = "cannot write " + depth_path;
-    return false;
+    return Status::error("cannot write " + depth_path);
   }
   std::ostringstream yaml;
   yaml.precision(12);
@@ -243,14 +241,13 @@ bool writeHeightmapFiles(const std::string& yaml_path, const HeightmapGrid& grid
   std::ofstream out(prefix + ".yaml");
   out << yaml.str();
   if (!out) {
-    error = "cannot write " + prefix + ".yaml";
-    return false;
+    return Status::error("cannot write " + prefix + ".yaml");
   }
-  return writeHeightmapPng(prefix + ".png", grid, error);
+  return writeHeightmapPng(prefix + ".png", grid);
 }
 
-bool writeSeabedPly(const std::string& path, const std::vector<SeabedPoint>& points, std::string& error,
-                    const std::optional<sss::core::MissionOrigin>& origin) {
+Status writeSeabedPly(const std::string& path, const std::vector<SeabedPoint>& points,
+                      const std::optional<sss::core::MissionOrigin>& origin) {
   std::ofstream out(path, std::ios::binary);
   out << "ply\nformat binary_little_endian 1.0\n"
       << "comment sss-slam quasi-dense bathymetry: x north, y east, z down (m, local NED of the mission origin)\n";
@@ -266,10 +263,9 @@ bool writeSeabedPly(const std::string& path, const std::vector<SeabedPoint>& poi
     out.write(reinterpret_cast<const char*>(&point.plane_residual_m), sizeof(float));
   }
   if (!out) {
-    error = "cannot write " + path;
-    return false;
+    return Status::error("cannot write " + path);
   }
-  return true;
+  return Status::success();
 }
 
 }  // namespace sss::optimiser

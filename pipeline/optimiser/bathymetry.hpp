@@ -15,6 +15,7 @@
 #include "pipeline/core/config.hpp"
 #include "pipeline/core/mission_origin.hpp"
 #include "pipeline/core/pose.hpp"
+#include "pipeline/core/status.hpp"
 
 namespace sss::optimiser {
 
@@ -76,12 +77,13 @@ HeightmapGrid gridSeabedPoints(const std::vector<SeabedPoint>& points, const Bat
 // Writes PREFIX.yaml + PREFIX_depth.f32 (readable by sss-eval's readHeightmap), PREFIX.png
 // (colour-coded depth, north up, with a scale) and returns false with a message on failure.
 // origin, when known, names the frame (YAML keys origin_latitude_deg / origin_longitude_deg).
-bool writeHeightmapFiles(const std::string& yaml_path, const HeightmapGrid& grid, const std::string& description,
-                         std::string& error, const std::optional<sss::core::MissionOrigin>& origin = std::nullopt);
+sss::core::Status writeHeightmapFiles(const std::string& yaml_path, const HeightmapGrid& grid,
+                                      const std::string& description,
+                                      const std::optional<sss::core::MissionOrigin>& origin = std::nullopt);
 
 // Binary little-endian PLY: x = north, y = east, z = down (metres, local NED), plus the residuals.
 // origin, when known, goes into a header comment ("comment origin_latitude_deg .. origin_longitude_deg ..").
-bool writeSeabedPly(const std::string& path, const std::vector<SeabedPoint>& points, std::string& error,
-                    const std::optional<sss::core::MissionOrigin>& origin = std::nullopt);
+sss::core::Status writeSeabedPly(const std::string& path, const std::vector<SeabedPoint>& points,
+                                 const std::optional<sss::core::MissionOrigin>& origin = std::nullopt);
 
 }  // namespace sss::optimiser

@@ -177,44 +177,39 @@ void appendChecksum(std::string& text) {
   text += line;
 }
 
-bool readChecked(const std::string& path, size_t max_bytes, std::string& text, std::string& error) {
+sss::core::Result<std::string> readChecked(const std::string& path, size_t max_bytes) {
+  using sss::core::Status;
   std::ifstream in(path, std::ios::binary);
   if (!in) {
-    error = std::string("cannot open: ") + std::strerror(errno);
-    return false;
+    return Status::error(std::string("cannot open: ") + std::strerror(errno));
   }
   in.seekg(0, std::ios::end);
   const std::streamoff size = in.tellg();
   if (size < 0 || static_cast<uint64_t>(size) > max_bytes) {
-    error = "unreadable size or larger than " + std::to_string(max_bytes) + " bytes";
-    return false;
+    return Status::error("unreadable size or larger than " + std::to_string(max_bytes) + " bytes");
   }
   in.seekg(0, std::ios::beg);
-  text.assign(static_cast<size_t>(size), '\0');
+  std::string text(static_cast<size_t>(size), '\0');
   if (!in.read(text.data(), size)) {
-    error = "read failed";
-    return false;
+    return Status::error("read failed");
   }
   // Checksum line: the last line, over every byte before it.
   const size_t line = text.rfind("checksum ");
   if (line == std::string::npos || (line > 0 && text[line - 1] != '\n')) {
-    error = "no checksum line (truncated?)";
-    return false;
+    return Status::error("no checksum line (truncated?)");
   }
   const std::string checksum_line = text.substr(line);
   uint64_t stored = 0;
   char tail = 0;
   if (std::sscanf(checksum_line.c_str(), "checksum %16" SCNx64 "%c", &stored, &tail) != 2 || tail != '\n' ||
       checksum_line.size() != 9 + 16 + 1) {
-    error = "malformed checksum line (truncated?)";
-    return false;
+    return Status::error("malformed checksum line (truncated?)");
   }
   if (fnv1a(text.data(), line) != stored) {
-    error = "checksum mismatch: the file is corrupt";
-    return false;
+    return Status::error("checksum mismatch: the file is corrupt");
   }
   text.resize(line);
-  return true;
+  return text;
 }
 
 

@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "pipeline/core/pose.hpp"
+#include "pipeline/core/status.hpp"
 
 namespace sss::optimiser::checkpoint {
 
@@ -66,8 +67,8 @@ class TextReader {
 // Appends "checksum <16 hex digits>\n" over every byte of text.
 void appendChecksum(std::string& text);
 // Reads the whole file (at most max_bytes), checks its last line "checksum ..." and returns the
-// text before it; false with `error` ("cannot open: ...", "checksum mismatch: ...") otherwise.
-bool readChecked(const std::string& path, size_t max_bytes, std::string& text, std::string& error);
+// text before it; an error ("cannot open: ...", "checksum mismatch: ...") otherwise.
+sss::core::Result<std::string> readChecked(const std::string& path, size_t max_bytes);
 // Whole files are replaced with sss::core::writeFileAtomically (pipeline/core/state_file.hpp).
 
 }  // namespace sss::optimiser::checkpoint

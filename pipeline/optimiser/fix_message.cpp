@@ -7,10 +7,10 @@
 
 namespace sss::optimiser {
 
-std::optional<AbsoluteFix> fromFixMessage(const sss_msgs::fix_t& m, std::string& error) {
+sss::core::Result<AbsoluteFix> fromFixMessage(const sss_msgs::fix_t& m) {
+  using sss::core::Status;
   if (m.source != "gnss" && m.source != "usbl") {
-    error = "fix source '" + m.source + "' is neither gnss nor usbl";
-    return std::nullopt;
+    return Status::error("fix source '" + m.source + "' is neither gnss nor usbl");
   }
   AbsoluteFix fix;
   fix.utime_us = m.utime;
@@ -20,14 +20,12 @@ std::optional<AbsoluteFix> fromFixMessage(const sss_msgs::fix_t& m, std::string&
   fix.dr_position_m = Eigen::Vector3d(m.dr_position_ned_m[0], m.dr_position_ned_m[1], m.dr_position_ned_m[2]);
   fix.dr_distance_m = m.dr_distance_travelled_m;
   if (!fix.position_ne_m.allFinite() || !fix.dr_position_m.allFinite() || !std::isfinite(fix.dr_distance_m)) {
-    error = "fix position, DR position or distance is not finite";
-    return std::nullopt;
+    return Status::error("fix position, DR position or distance is not finite");
   }
   const double scale = std::max(1.0, fix.covariance_m2.cwiseAbs().maxCoeff());
   if (!fix.covariance_m2.allFinite() || std::abs(fix.covariance_m2(0, 1) - fix.covariance_m2(1, 0)) > 1e-9 * scale ||
       Eigen::LLT<Eigen::Matrix2d>(fix.covariance_m2).info() != Eigen::Success || !(fix.covariance_m2.determinant() > 0.0)) {
-    error = "fix covariance is not finite, symmetric and positive definite";
-    return std::nullopt;
+    return Status::error("fix covariance is not finite, symmetric and positive definite");
   }
   return fix;
 }

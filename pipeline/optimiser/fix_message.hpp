@@ -13,7 +13,7 @@ namespace sss::optimiser {
 
 // nullopt with the reason in error when the message is not usable: an unknown source, a non-finite
 // field, a covariance that is not symmetric positive definite.
-std::optional<AbsoluteFix> fromFixMessage(const sss_msgs::fix_t& message, std::string& error);
+sss::core::Result<AbsoluteFix> fromFixMessage(const sss_msgs::fix_t& message);
 // The mission origin the message's positions are in.
 sss::core::MissionOrigin fixMessageOrigin(const sss_msgs::fix_t& message);
 

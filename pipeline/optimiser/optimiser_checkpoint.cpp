@@ -129,12 +129,9 @@ bool journalId(const std::string& path, uint64_t min_bytes, uint64_t& id) {
 }
 
 // Appends bytes at offset `at` of an existing file (cutting off anything after `at` first), fsyncs.
-bool appendAt(const std::string& path, uint64_t at, const std::string& bytes, std::string& error) {
+Status appendAt(const std::string& path, uint64_t at, const std::string& bytes) {
   const int fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
-  if (fd < 0) {
-    error = path + ": cannot open for appending: " + std::strerror(errno);
-    return false;
-  }
+  if (fd < 0) return Status::error(path + ": cannot open for appending: " + std::strerror(errno));
   bool ok = ::ftruncate(fd, static_cast<off_t>(at)) == 0;
   size_t done = 0;
   while (ok && done < bytes.size()) {
@@ -146,8 +143,10 @@ bool appendAt(const std::string& path, uint64_t at, const std::string& bytes, st
   ok = ok && ::fsync(fd) == 0;
   const int write_errno = errno;
   ::close(fd);
-  if (!ok) error = path + ": append failed: " + std::strerror(write_errno) + "; the previous checkpoint is kept";
-  return ok;
+  if (!ok) {
+    return Status::error(path + ": append failed: " + std::strerror(write_errno) + "; the previous checkpoint is kept");
+  }
+  return Status::success();
 }
 
 uint64_t newJournalId() {
@@ -207,12 +206,10 @@ Status OptimiserEngine::saveCheckpoint(const std::string& path) {
     }
     for (const auto& key : unjournaled_pairs_) appendCorrespondences(key, correspondences_.at(key));
   }
-  std::string error;
-  if (fresh) {
-    if (!sss::core::writeFileAtomically(journal_path, journalHeader(journal.id) + records, error)) return fail(error);
-  } else if (!records.empty() && !appendAt(journal_path, journal.bytes, records, error)) {
-    return fail(error);
-  }
+  const Status journal_written = fresh ? sss::core::writeFileAtomically(journal_path, journalHeader(journal.id) + records)
+                                 : records.empty() ? Status::success()
+                                                   : appendAt(journal_path, journal.bytes, records);
+  if (!journal_written) return fail(journal_written.message);
   journal.bytes += records.size();
 
   // 2. The rewritten file: engine state, waiting closures, the graph.
@@ -267,7 +264,7 @@ Status OptimiserEngine::saveCheckpoint(const std::string& path) {
   w.raw(graph);
   std::string& text = w.text();
   checkpoint::appendChecksum(text);
-  if (!sss::core::writeFileAtomically(path, text, error)) return fail(error);
+  if (const Status written = sss::core::writeFileAtomically(path, text); !written) return fail(written.message);
 
   journal_ = journal;
   unjournaled_subframes_.clear();
@@ -281,8 +278,9 @@ Status OptimiserEngine::loadCheckpoint(const std::string& path) {
   auto fail = [&](const std::string& why) {
     return Status::error("checkpoint " + path + ": " + why + "; the optimiser state is left unchanged");
   };
-  std::string text, error;
-  if (!checkpoint::readChecked(path, kMaxFileBytes, text, error)) return fail(error);
+  const sss::core::Result<std::string> read = checkpoint::readChecked(path, kMaxFileBytes);
+  if (!read) return fail(read.message());
+  const std::string& text = read.value();
   TextReader r(text);
   std::string magic;
   int64_t version = 0;

@@ -53,13 +53,10 @@ std::vector<std::string> validateOptimiserEngineOptions(const OptimiserEngineOpt
   return errors;
 }
 
-bool writeTum(const std::string& path, const std::vector<StampedPose>& poses, const std::string& comment,
-              std::string& error, const std::optional<sss::core::MissionOrigin>& origin) {
+Status writeTum(const std::string& path, const std::vector<StampedPose>& poses, const std::string& comment,
+                const std::optional<sss::core::MissionOrigin>& origin) {
   std::FILE* f = std::fopen(path.c_str(), "w");
-  if (!f) {
-    error = "cannot write " + path;
-    return false;
-  }
+  if (!f) return Status::error("cannot write " + path);
   // Every line of the comment behind a '#'.
   for (size_t start = 0; start <= comment.size();) {
     const size_t end = std::min(comment.find('\n', start), comment.size());
@@ -74,9 +71,8 @@ bool writeTum(const std::string& path, const std::vector<StampedPose>& poses, co
     std::fprintf(f, "%lld.%06lld %.4f %.4f %.4f %.9f %.9f %.9f %.9f\n", static_cast<long long>(p.utime_us / 1000000),
                  static_cast<long long>(p.utime_us % 1000000), t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
   }
-  const bool ok = std::fclose(f) == 0;
-  if (!ok) error = "cannot write " + path;
-  return ok;
+  if (std::fclose(f) != 0) return Status::error("cannot write " + path);
+  return Status::success();
 }
 
 OptimiserEngine::OptimiserEngine(const OptimiserEngineOptions& options) : options_(options), graph_(options.graph) {}
@@ -145,7 +141,7 @@ Status OptimiserEngine::addSubframe(const sss::core::Subframe& subframe) {
   for (sss::core::LoopClosure& closure : waiting_) {
     const bool known = graph_.estimate(closure.subframe_id_a) && graph_.estimate(closure.subframe_id_b);
     if (known) {
-      addToGraph(closure);
+      static_cast<void>(addToGraph(closure));  // a refusal is counted in closures_refused
     } else if (std::max(closure.subframe_id_a, closure.subframe_id_b) > newest_subframe_id_) {
       still_waiting.push_back(std::move(closure));
     } else {

@@ -61,8 +61,8 @@ struct StampedPose {
 
 // Writes poses as TUM (timestamp_s north east down qx qy qz qw, local NED) with a comment line
 // and, when known, the line naming the frame's origin (pipeline/core/mission_origin.hpp).
-bool writeTum(const std::string& path, const std::vector<StampedPose>& poses, const std::string& comment,
-              std::string& error, const std::optional<sss::core::MissionOrigin>& origin = std::nullopt);
+Status writeTum(const std::string& path, const std::vector<StampedPose>& poses, const std::string& comment,
+                const std::optional<sss::core::MissionOrigin>& origin = std::nullopt);
 
 // One closure for the loop_closures.csv table: the graph's record and the two centres under the
 // current estimate.

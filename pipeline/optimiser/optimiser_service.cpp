@@ -126,41 +126,37 @@ std::optional<CorrectedPose> OptimiserService::addNav(const sss_msgs::nav_t& mes
 
 void OptimiserService::addSubframe(const sss_msgs::subframe_t& message, sss::core::HealthMonitor& health,
                                    sss::core::ServiceLog& log) {
-  sss::core::Subframe subframe;
-  std::string error;
-  if (!sss::messages::fromSubframeMessage(message, subframe, error)) {
-    reject("bad_subframe", "subframe " + std::to_string(message.subframe_id), error, health, log);
+  sss::core::Result<sss::core::Subframe> subframe = sss::messages::fromSubframeMessage(message);
+  if (!subframe) {
+    reject("bad_subframe", "subframe " + std::to_string(message.subframe_id), subframe.message(), health, log);
     return;
   }
   // The image travels to the worker, which keeps it for the products at mosaic resolution (off the
   // loop, which answers every nav sample); the graph keeps poses only.
-  worker_.addSubframe(std::move(subframe));
+  worker_.addSubframe(std::move(subframe).value());
 }
 
 void OptimiserService::addLoopClosure(const sss_msgs::loop_closure_t& message, sss::core::HealthMonitor& health,
                                       sss::core::ServiceLog& log) {
-  sss::core::LoopClosure closure;
-  std::string error;
-  if (!sss::messages::fromLoopClosureMessage(message, closure, error)) {
-    reject("bad_loop_closure", "loop closure", error, health, log);
+  sss::core::Result<sss::core::LoopClosure> closure = sss::messages::fromLoopClosureMessage(message);
+  if (!closure) {
+    reject("bad_loop_closure", "loop closure", closure.message(), health, log);
     return;
   }
-  worker_.addLoopClosure(std::move(closure));
+  worker_.addLoopClosure(std::move(closure).value());
 }
 
 void OptimiserService::addFix(const sss_msgs::fix_t& message, sss::core::HealthMonitor& health,
                               sss::core::ServiceLog& log) {
-  std::string error;
-  std::optional<AbsoluteFix> fix = fromFixMessage(message, error);
+  sss::core::Result<AbsoluteFix> fix = fromFixMessage(message);
   const sss::core::MissionOrigin origin = fixMessageOrigin(message);
   const std::optional<sss::core::MissionOrigin> nav_origin = worker_.origin();
   if (fix && nav_origin && (std::abs(origin.latitude_deg - nav_origin->latitude_deg) > 1e-9 ||
                             std::abs(origin.longitude_deg - nav_origin->longitude_deg) > 1e-9)) {
-    error = "the fix's mission origin differs from the navigation's (another INS bridge?)";
-    fix.reset();
+    fix = sss::core::Status::error("the fix's mission origin differs from the navigation's (another INS bridge?)");
   }
   if (!fix) {
-    reject("bad_fix", "fix", error, health, log);
+    reject("bad_fix", "fix", fix.message(), health, log);
     return;
   }
   worker_.addFix(*fix);

@@ -18,6 +18,7 @@
 
 #include "pipeline/core/config.hpp"
 #include "pipeline/core/pose.hpp"
+#include "pipeline/core/status.hpp"
 
 namespace ceres {
 class CostFunction;
@@ -177,12 +178,7 @@ std::vector<std::string> validatePoseGraphOptions(const PoseGraphOptions& option
 void readPoseGraphOptions(sss::core::ConfigSection& section, PoseGraphOptions& options);
 
 // Result of an input call: ok, or why the input was refused (the graph is unchanged then).
-struct Status {
-  bool ok = true;
-  std::string message;
-  static Status success() { return {}; }
-  static Status error(std::string text) { return {false, std::move(text)}; }
-};
+using Status = sss::core::Status;
 
 // A loop closure from the matcher (SSS_LOOP).
 struct LoopClosure {

@@ -158,16 +158,15 @@ std::string SlidingWindowPoseGraph::checkpointText() const {
 Status SlidingWindowPoseGraph::saveCheckpoint(const std::string& path) const {
   std::string text = checkpointText();
   checkpoint::appendChecksum(text);
-  std::string error;
-  if (!sss::core::writeFileAtomically(path, text, error)) return Status::error("checkpoint " + error);
+  const Status written = sss::core::writeFileAtomically(path, text);
+  if (!written) return Status::error("checkpoint " + written.message);
   return Status::success();
 }
 
 Status SlidingWindowPoseGraph::loadCheckpoint(const std::string& path) {
-  std::string text, error;
-  if (!checkpoint::readChecked(path, kMaxFileBytes, text, error))
-    return Status::error("checkpoint " + path + ": " + error + "; graph left unchanged");
-  const Status restored = restoreCheckpointText(text);
+  const sss::core::Result<std::string> read = checkpoint::readChecked(path, kMaxFileBytes);
+  if (!read) return Status::error("checkpoint " + path + ": " + read.message() + "; graph left unchanged");
+  const Status restored = restoreCheckpointText(read.value());
   if (!restored.ok) return Status::error("checkpoint " + path + ": " + restored.message + "; graph left unchanged");
   return restored;
 }

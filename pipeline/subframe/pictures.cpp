@@ -14,8 +14,11 @@
 
 namespace sss::subframe {
 
-std::vector<std::string> writeWaterfalls(const std::vector<Subframe>& subframes, const std::string& dir,
-                                         const PictureOptions& options, std::string& error) {
+using sss::core::Result;
+using sss::core::Status;
+
+Result<std::vector<std::string>> writeWaterfalls(const std::vector<Subframe>& subframes, const std::string& dir,
+                                                 const PictureOptions& options) {
   std::map<int, std::vector<const Subframe*>> lines;
   for (const Subframe& s : subframes) lines[s.line_id].push_back(&s);
   std::vector<std::string> files;
@@ -53,20 +56,18 @@ std::vector<std::string> writeWaterfalls(const std::vector<Subframe>& subframes,
     }
     const std::string path = dir + "/waterfall_line_" + std::to_string(line_id) + ".png";
     if (!cv::imwrite(path, image)) {
-      error = "cannot write " + path;
-      return files;
+      return Status::error("cannot write " + path);
     }
     files.push_back(path);
   }
   return files;
 }
 
-std::optional<MosaicRaster> renderMosaic(const std::vector<Subframe>& subframes,
-                                         const std::map<int64_t, std::vector<sss::core::Pose>>& poses_by_subframe,
-                                         const PictureOptions& options, std::string& error) {
+Result<MosaicRaster> renderMosaic(const std::vector<Subframe>& subframes,
+                                  const std::map<int64_t, std::vector<sss::core::Pose>>& poses_by_subframe,
+                                  const PictureOptions& options) {
   if (subframes.empty()) {
-    error = "no subframes for the mosaic";
-    return std::nullopt;
+    return Status::error("no subframes for the mosaic");
   }
   struct Point {
     double north, east;
@@ -99,8 +100,7 @@ std::optional<MosaicRaster> renderMosaic(const std::vector<Subframe>& subframes,
     }
   }
   if (points.empty()) {
-    error = "no valid pixels for the mosaic";
-    return std::nullopt;
+    return Status::error("no valid pixels for the mosaic");
   }
   MosaicRaster mosaic;
   const double res = options.mosaic_resolution_m;
@@ -131,12 +131,11 @@ std::optional<MosaicRaster> renderMosaic(const std::vector<Subframe>& subframes,
   return mosaic;
 }
 
-bool writeMosaic(const MosaicRaster& mosaic, const std::string& path, std::string& error,
-                 const std::optional<sss::core::MissionOrigin>& origin) {
+Status writeMosaic(const MosaicRaster& mosaic, const std::string& path,
+                   const std::optional<sss::core::MissionOrigin>& origin) {
   cv::Mat image(mosaic.rows, mosaic.cols, CV_8UC1, const_cast<uint8_t*>(mosaic.gray.data()));
   if (!cv::imwrite(path, image)) {
-    error = "cannot write " + path;
-    return false;
+    return Status::error("cannot write " + path);
   }
   // Its geo-reference, in the simulator's mosaic.yaml format.
   const std::string yaml_path = std::filesystem::path(path).replace_extension(".yaml").string();
@@ -150,22 +149,17 @@ bool writeMosaic(const MosaicRaster& mosaic, const std::string& path, std::strin
        << "\neast_min_m: " << mosaic.east_min_m << "\nrows: " << mosaic.rows << "\ncols: " << mosaic.cols << "\n";
   if (origin) yaml << sss::core::originYamlKeys(*origin);
   if (!yaml) {
-    error = "cannot write " + yaml_path;
-    return false;
+    return Status::error("cannot write " + yaml_path);
   }
-  return true;
+  return Status::success();
 }
 
-bool writeMosaic(const std::vector<Subframe>& subframes,
-                 const std::map<int64_t, std::vector<sss::core::Pose>>& poses_by_subframe, const std::string& path,
-                 const PictureOptions& options, std::string& error,
-                 const std::optional<sss::core::MissionOrigin>& origin) {
-  const std::optional<MosaicRaster> mosaic = renderMosaic(subframes, poses_by_subframe, options, error);
-  if (!mosaic) {
-    error += " " + path;
-    return false;
-  }
-  return writeMosaic(*mosaic, path, error, origin);
+Status writeMosaic(const std::vector<Subframe>& subframes,
+                   const std::map<int64_t, std::vector<sss::core::Pose>>& poses_by_subframe, const std::string& path,
+                   const PictureOptions& options, const std::optional<sss::core::MissionOrigin>& origin) {
+  const Result<MosaicRaster> mosaic = renderMosaic(subframes, poses_by_subframe, options);
+  if (!mosaic) return Status::error(mosaic.message() + " " + path);
+  return writeMosaic(*mosaic, path, origin);
 }
 
 Subframe decimateForMosaic(const Subframe& s, int factor) {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "pipeline/core/mission_origin.hpp"
+#include "pipeline/core/status.hpp"
 #include "pipeline/core/pose.hpp"
 #include "pipeline/subframe/subframe_builder.hpp"
 
@@ -24,9 +25,9 @@ struct PictureOptions {
 
 // Writes <dir>/waterfall_line_<id>.png for every line (subframes stacked in time order, oldest row
 // at the top; masked pixels dark blue, subframe boundaries as a red tick at the left edge).
-// Returns the files written; error says why when one could not be written.
-std::vector<std::string> writeWaterfalls(const std::vector<Subframe>& subframes, const std::string& dir,
-                                         const PictureOptions& options, std::string& error);
+// Returns the files written, or why one could not be written.
+sss::core::Result<std::vector<std::string>> writeWaterfalls(const std::vector<Subframe>& subframes,
+                                                            const std::string& dir, const PictureOptions& options);
 
 // A north-up mosaic raster: row 0 is the northernmost; cell (row, col) covers north
 // north_max_m - (row + 1) * resolution_m .. north_max_m - row * resolution_m and east
@@ -41,25 +42,25 @@ struct MosaicRaster {
 };
 
 // The mosaic's mean normalised intensity per cell of every valid pixel geo-referenced with the
-// given poses per subframe id (DR when a subframe has none there); nullopt (and error) when
-// nothing can be placed.
-std::optional<MosaicRaster> renderMosaic(const std::vector<Subframe>& subframes,
-                                         const std::map<int64_t, std::vector<sss::core::Pose>>& poses_by_subframe,
-                                         const PictureOptions& options, std::string& error);
+// given poses per subframe id (DR when a subframe has none there); an error when nothing can be
+// placed.
+sss::core::Result<MosaicRaster> renderMosaic(const std::vector<Subframe>& subframes,
+                                             const std::map<int64_t, std::vector<sss::core::Pose>>& poses_by_subframe,
+                                             const PictureOptions& options);
 
 // Writes a rendered mosaic as an 8-bit grey PNG (black = no data) with its geo-reference beside it
 // (same name, .yaml; keys as below).
-bool writeMosaic(const MosaicRaster& mosaic, const std::string& path, std::string& error,
-                 const std::optional<sss::core::MissionOrigin>& origin = std::nullopt);
+sss::core::Status writeMosaic(const MosaicRaster& mosaic, const std::string& path,
+                              const std::optional<sss::core::MissionOrigin>& origin = std::nullopt);
 
 // Renders and writes a north-up mosaic: mean normalised intensity per cell of every valid pixel geo-referenced
 // with the given poses per subframe id (DR when a subframe has none there); black = no data. Its geo-reference goes
 // beside it as the same name with .yaml (keys resolution_m, north_max_m, east_min_m, rows, cols,
 // and origin_latitude_deg / origin_longitude_deg when the frame's origin is given).
-bool writeMosaic(const std::vector<Subframe>& subframes,
-                 const std::map<int64_t, std::vector<sss::core::Pose>>& poses_by_subframe, const std::string& path,
-                 const PictureOptions& options, std::string& error,
-                 const std::optional<sss::core::MissionOrigin>& origin = std::nullopt);
+sss::core::Status writeMosaic(const std::vector<Subframe>& subframes,
+                              const std::map<int64_t, std::vector<sss::core::Pose>>& poses_by_subframe,
+                              const std::string& path, const PictureOptions& options,
+                              const std::optional<sss::core::MissionOrigin>& origin = std::nullopt);
 
 // A copy of a subframe with `factor` bins averaged into one (masked if any is masked): mosaics
 // are drawn at ~0.5 m, so a long mission's mosaics need not keep full-resolution images. A subframe

@@ -17,16 +17,15 @@ namespace {
 SubframeNumbering loadNumbering(const std::string& path, ServiceLog& log) {
   SubframeNumbering numbering;
   if (path.empty() || access(path.c_str(), F_OK) != 0) return numbering;
-  sss::core::StateValues values;
-  std::string error;
+  const sss::core::Result<sss::core::StateValues> read =
+      sss::core::readStateFile(path, SubframeBufferService::kNumberingFormat);
   long long subframe_id = 0, line_id = 0;
-  if (!sss::core::readStateFile(path, SubframeBufferService::kNumberingFormat, values, error) ||
-      !sss::core::stateInteger(values, "next_subframe_id", subframe_id) ||
-      !sss::core::stateInteger(values, "next_line_id", line_id) || subframe_id < 0 || line_id < 0 ||
+  if (!read || !sss::core::stateInteger(*read, "next_subframe_id", subframe_id) ||
+      !sss::core::stateInteger(*read, "next_line_id", line_id) || subframe_id < 0 || line_id < 0 ||
       line_id > std::numeric_limits<int>::max()) {
     log.errors.push_back("subframe numbering not resumed, starting from 0 (subframes the optimiser already has will "
                          "be refused as duplicates): " +
-                         (error.empty() ? path + ": bad next_subframe_id / next_line_id" : error));
+                         (read ? path + ": bad next_subframe_id / next_line_id" : read.message()));
     return numbering;
   }
   numbering.next_subframe_id = subframe_id;
@@ -52,13 +51,13 @@ std::vector<Subframe> SubframeBufferService::takeCompleted(ServiceLog& log) {
   // reuses one.
   if (!completed_.empty() && !options_.numbering_path.empty()) {
     const SubframeNumbering numbering = buffer_.numbering();
-    std::string error;
-    if (!sss::core::writeStateFile(options_.numbering_path, kNumberingFormat,
-                                   {{"next_subframe_id", std::to_string(numbering.next_subframe_id)},
-                                    {"next_line_id", std::to_string(numbering.next_line_id)}},
-                                   error)) {
+    const sss::core::Status saved =
+        sss::core::writeStateFile(options_.numbering_path, kNumberingFormat,
+                                  {{"next_subframe_id", std::to_string(numbering.next_subframe_id)},
+                                   {"next_line_id", std::to_string(numbering.next_line_id)}});
+    if (!saved) {
       if (numbering_write_failures_++ == 0)
-        log.errors.push_back("subframe numbering not saved (counted from now on): " + error);
+        log.errors.push_back("subframe numbering not saved (counted from now on): " + saved.message);
     }
   }
   return std::exchange(completed_, {});

@@ -2,6 +2,8 @@
 // message (a restarted process must never resume from a torn or foreign file).
 #include "pipeline/core/state_file.hpp"
 
+#include "tests/support/status_assertions.hpp"
+
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -28,12 +30,12 @@ class StateFileTest : public ::testing::Test {
 };
 
 TEST_F(StateFileTest, RoundTripAndReplacement) {
-  std::string error;
-  ASSERT_TRUE(writeStateFile(path_, "demo 1", {{"next_id", "41"}, {"distance_m", "317.25"}}, error)) << error;
-  ASSERT_TRUE(writeStateFile(path_, "demo 1", {{"next_id", "42"}, {"distance_m", "1e3"}}, error)) << error;
+  ASSERT_OK(writeStateFile(path_, "demo 1", {{"next_id", "41"}, {"distance_m", "317.25"}}));
+  ASSERT_OK(writeStateFile(path_, "demo 1", {{"next_id", "42"}, {"distance_m", "1e3"}}));
   EXPECT_FALSE(fs::exists(path_ + ".tmp"));
-  StateValues values;
-  ASSERT_TRUE(readStateFile(path_, "demo 1", values, error)) << error;
+  const Result<StateValues> read = readStateFile(path_, "demo 1");
+  ASSERT_OK(read);
+  const StateValues& values = read.value();
   long long id = 0;
   double distance_m = 0.0;
   EXPECT_TRUE(stateInteger(values, "next_id", id));
@@ -44,33 +46,38 @@ TEST_F(StateFileTest, RoundTripAndReplacement) {
 }
 
 TEST_F(StateFileTest, RefusesForeignTornAndMalformedFiles) {
-  StateValues values;
-  std::string error;
-  EXPECT_FALSE(readStateFile(path_, "demo 1", values, error));  // missing
-  EXPECT_NE(error.find("cannot open"), std::string::npos) << error;
+  Result<StateValues> read = readStateFile(path_, "demo 1");
+  EXPECT_FALSE(read.ok());  // missing
+  EXPECT_NE(read.message().find("cannot open"), std::string::npos) << read.message();
   writeRaw("demo 2\nnext_id 4\n");
-  EXPECT_FALSE(readStateFile(path_, "demo 1", values, error));
-  EXPECT_NE(error.find("not a 'demo 1' file"), std::string::npos) << error;
+  read = readStateFile(path_, "demo 1");
+  EXPECT_FALSE(read.ok());
+  EXPECT_NE(read.message().find("not a 'demo 1' file"), std::string::npos) << read.message();
   writeRaw("demo 1\nnext_id\n");
-  EXPECT_FALSE(readStateFile(path_, "demo 1", values, error));
-  EXPECT_NE(error.find("line 2"), std::string::npos) << error;
+  read = readStateFile(path_, "demo 1");
+  EXPECT_FALSE(read.ok());
+  EXPECT_NE(read.message().find("line 2"), std::string::npos) << read.message();
   writeRaw("demo 1\nnext_id 4\nnext_id 5\n");
-  EXPECT_FALSE(readStateFile(path_, "demo 1", values, error));
-  EXPECT_NE(error.find("repeats"), std::string::npos) << error;
+  read = readStateFile(path_, "demo 1");
+  EXPECT_FALSE(read.ok());
+  EXPECT_NE(read.message().find("repeats"), std::string::npos) << read.message();
   // Values that are not numbers, or not whole ones, are not read as numbers.
   writeRaw("demo 1\nnext_id 4x\ndistance_m nan\nbig 99999999999999999999\n");
-  ASSERT_TRUE(readStateFile(path_, "demo 1", values, error)) << error;
+  read = readStateFile(path_, "demo 1");
+  ASSERT_OK(read);
+  const StateValues& values = read.value();
   long long id = 0;
   double distance_m = 0.0;
   EXPECT_FALSE(stateInteger(values, "next_id", id));
   EXPECT_FALSE(stateNumber(values, "distance_m", distance_m));
   EXPECT_FALSE(stateInteger(values, "big", id));
   // Keys or values that would break the line format are refused before anything is written.
-  EXPECT_FALSE(writeStateFile(path_, "demo 1", {{"two words", "1"}}, error));
-  EXPECT_FALSE(writeStateFile(path_, "demo 1", {{"key", "a\nb"}}, error));
+  EXPECT_FALSE(writeStateFile(path_, "demo 1", {{"two words", "1"}}).ok);
+  EXPECT_FALSE(writeStateFile(path_, "demo 1", {{"key", "a\nb"}}).ok);
   // A directory that does not exist: an error, no exception.
-  EXPECT_FALSE(writeStateFile((dir_ / "no" / "state").string(), "demo 1", {{"k", "v"}}, error));
-  EXPECT_NE(error.find("state.tmp: cannot open for writing"), std::string::npos) << error;
+  const Status written = writeStateFile((dir_ / "no" / "state").string(), "demo 1", {{"k", "v"}});
+  EXPECT_FALSE(written.ok);
+  EXPECT_NE(written.message.find("state.tmp: cannot open for writing"), std::string::npos) << written.message;
 }
 
 TEST(ResolveSystemdDirectory, ConfiguredThenTheFirstEntryOfTheEnvironmentThenNone) {

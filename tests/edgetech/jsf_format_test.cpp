@@ -6,6 +6,7 @@
 #include <cstring>
 
 #include "jsf_test_data.hpp"
+#include "tests/support/status_assertions.hpp"
 
 namespace sss::edgetech {
 namespace {
@@ -65,9 +66,9 @@ TEST(JsfFormat, DecodeGivesBackTheRecordWithinTheWireResolution) {
   const std::vector<uint8_t> bytes = test::encodeRecord(sent, 1000);
   const auto header = decodeHeader(bytes.data());
   ASSERT_TRUE(header);
-  const SonarDecodeResult result = decodeSonarData(*header, bytes.data() + 16, bytes.size() - 16);
-  ASSERT_TRUE(result.record) << result.error;
-  const SonarChannelRecord& r = *result.record;
+  const sss::core::Result<SonarChannelRecord> result = decodeSonarData(*header, bytes.data() + 16, bytes.size() - 16);
+  ASSERT_OK(result);
+  const SonarChannelRecord& r = *result;
   EXPECT_EQ(r.ping_number, 77u);
   EXPECT_EQ(r.channel, kChannelPort);
   EXPECT_EQ(r.ping_time_us, sent.ping_time_us);  // whole milliseconds survive
@@ -98,13 +99,13 @@ TEST(JsfFormat, ProjectedCoordinateUnitsGiveEastingAndNorthing) {
     std::memcpy(bytes.data() + 16 + 88, &units, 2);
     const auto header = decodeHeader(bytes.data());
     ASSERT_TRUE(header);
-    const SonarDecodeResult result = decodeSonarData(*header, bytes.data() + 16, bytes.size() - 16);
-    ASSERT_TRUE(result.record) << result.error;
-    EXPECT_EQ(result.record->validity & kValidLatLon, 0) << units;
-    EXPECT_EQ(result.record->projected_position, metres_per_unit > 0.0) << units;
+    const sss::core::Result<SonarChannelRecord> result = decodeSonarData(*header, bytes.data() + 16, bytes.size() - 16);
+    ASSERT_OK(result);
+    EXPECT_EQ(result->validity & kValidLatLon, 0) << units;
+    EXPECT_EQ(result->projected_position, metres_per_unit > 0.0) << units;
     if (metres_per_unit > 0.0) {
-      EXPECT_DOUBLE_EQ(result.record->easting_m, x * metres_per_unit);
-      EXPECT_DOUBLE_EQ(result.record->northing_m, y * metres_per_unit);
+      EXPECT_DOUBLE_EQ(result->easting_m, x * metres_per_unit);
+      EXPECT_DOUBLE_EQ(result->northing_m, y * metres_per_unit);
     }
   }
 }
@@ -133,21 +134,21 @@ TEST(JsfFormat, DecodesAnalyticIqAsMagnitude) {
     bytes.push_back(static_cast<uint8_t>((v >> 8) & 0xFF));
   }
   const auto header = decodeHeader(bytes.data());
-  const SonarDecodeResult result = decodeSonarData(*header, bytes.data() + 16, bytes.size() - 16);
-  ASSERT_TRUE(result.record) << result.error;
-  EXPECT_FLOAT_EQ(result.record->samples[0], 5.0f);
-  EXPECT_FLOAT_EQ(result.record->samples[1], 10.0f);
+  const sss::core::Result<SonarChannelRecord> result = decodeSonarData(*header, bytes.data() + 16, bytes.size() - 16);
+  ASSERT_OK(result);
+  EXPECT_FLOAT_EQ(result->samples[0], 5.0f);
+  EXPECT_FLOAT_EQ(result->samples[1], 10.0f);
 }
 
 TEST(JsfFormat, BadBodiesAreErrorsNotCrashes) {
   const std::vector<uint8_t> bytes = test::encodeRecord(test::makeRecord(1, kChannelPort), 100);
   const auto header = decodeHeader(bytes.data());
-  EXPECT_NE(decodeSonarData(*header, bytes.data() + 16, 100).error.find("shorter than its 240-byte header"),
+  EXPECT_NE(decodeSonarData(*header, bytes.data() + 16, 100).message().find("shorter than its 240-byte header"),
             std::string::npos);
-  EXPECT_NE(decodeSonarData(*header, bytes.data() + 16, 240 + 10).error.find("needs 440 bytes"), std::string::npos);
+  EXPECT_NE(decodeSonarData(*header, bytes.data() + 16, 240 + 10).message().find("needs 440 bytes"), std::string::npos);
   std::vector<uint8_t> odd = bytes;
   odd[16 + 34] = 7;
-  EXPECT_NE(decodeSonarData(*header, odd.data() + 16, odd.size() - 16).error.find("format 7"), std::string::npos);
+  EXPECT_NE(decodeSonarData(*header, odd.data() + 16, odd.size() - 16).message().find("format 7"), std::string::npos);
   std::vector<uint8_t> wrong_marker = bytes;
   wrong_marker[1] = 0x17;
   EXPECT_FALSE(decodeHeader(wrong_marker.data()));

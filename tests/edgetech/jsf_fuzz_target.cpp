@@ -24,10 +24,10 @@ int fuzzJsf(const uint8_t* data, size_t size) {
   for (const JsfMessage& message : messages) {
     if (message.body.size() != static_cast<size_t>(message.header.byte_count)) std::abort();
     if (message.header.message_type == kJsfSonarData) {
-      const SonarDecodeResult result = decodeSonarData(message.header, message.body.data(), message.body.size());
-      if (result.record) ++decoded;
+      const sss::core::Result<SonarChannelRecord> result = decodeSonarData(message.header, message.body.data(), message.body.size());
+      if (result) ++decoded;
     } else if (isNavigationType(message.header.message_type)) {
-      decodeNavigation(message.header, message.body.data(), message.body.size());
+      static_cast<void>(decodeNavigation(message.header, message.body.data(), message.body.size()));
     }
   }
   if (parser.counters().messages != messages.size()) std::abort();

@@ -1,5 +1,6 @@
 // JSF navigation messages decoded from bodies laid out byte by byte from the published layout.
 #include "drivers/edgetech/jsf_navigation.hpp"
+#include "tests/support/status_assertions.hpp"
 
 #include <gtest/gtest.h>
 
@@ -38,8 +39,8 @@ TEST(JsfNavigation, PitchRoll2020) {
   put<uint16_t>(body, 34, 27050);   // heading 270.50 deg
   put<int32_t>(body, 36, (1 << 6) | (1 << 7) | (1 << 8) | (1 << 9));
   const auto result = decodeNavigation(headerOf(kJsfPitchRoll, body.size()), body.data(), body.size());
-  ASSERT_TRUE(result.record) << result.error;
-  const JsfNavigationRecord& r = *result.record;
+  ASSERT_OK(result);
+  const JsfNavigationRecord& r = *result;
   EXPECT_EQ(r.time_us, 1780300800250000LL);
   EXPECT_NEAR(*r.pitch_rad, 5.625 * kDeg, 1e-12);
   EXPECT_NEAR(*r.roll_rad, -2.8125 * kDeg, 1e-12);
@@ -60,8 +61,8 @@ TEST(JsfNavigation, Dvl2080ShipCoordinatesAndBeamAltitude) {
   put<uint16_t>(body, 44, 425);  // depth 42.5 m
   put<uint16_t>(body, 50, 9000); // heading 90 deg
   const auto result = decodeNavigation(headerOf(kJsfDvl, body.size()), body.data(), body.size());
-  ASSERT_TRUE(result.record) << result.error;
-  const JsfNavigationRecord& r = *result.record;
+  ASSERT_OK(result);
+  const JsfNavigationRecord& r = *result;
   EXPECT_NEAR(*r.altitude_m, 19.0, 1e-12);
   EXPECT_NEAR(*r.velocity_forward_m_s, 2.0, 1e-12);
   EXPECT_NEAR(*r.velocity_starboard_m_s, 0.05, 1e-12);
@@ -86,12 +87,12 @@ TEST(JsfNavigation, Situation2090AndVersion2) {
   put<double>(body, 132, 1.3);
   put<double>(body, 140, 0.02);
   auto result = decodeNavigation(headerOf(kJsfSituation, body.size()), body.data(), body.size());
-  ASSERT_TRUE(result.record) << result.error;
-  EXPECT_EQ(result.record->time_us, 1780300800123456LL);
-  EXPECT_DOUBLE_EQ(*result.record->latitude_deg, 59.351);
-  EXPECT_DOUBLE_EQ(*result.record->longitude_deg, 18.072);
-  EXPECT_NEAR(*result.record->heading_rad, M_PI / 4, 1e-12);
-  EXPECT_NEAR(*result.record->velocity_east_m_s, 1.3, 1e-12);
+  ASSERT_OK(result);
+  EXPECT_EQ(result->time_us, 1780300800123456LL);
+  EXPECT_DOUBLE_EQ(*result->latitude_deg, 59.351);
+  EXPECT_DOUBLE_EQ(*result->longitude_deg, 18.072);
+  EXPECT_NEAR(*result->heading_rad, M_PI / 4, 1e-12);
+  EXPECT_NEAR(*result->velocity_east_m_s, 1.3, 1e-12);
 
   std::vector<uint8_t> v2 = timedBody(100);
   put<uint32_t>(v2, 12, 0x7FFu);
@@ -105,13 +106,13 @@ TEST(JsfNavigation, Situation2090AndVersion2) {
   put<float>(v2, 60, -1.0f);
   put<float>(v2, 76, 359.0f);
   result = decodeNavigation(headerOf(kJsfSituation2, v2.size()), v2.data(), v2.size());
-  ASSERT_TRUE(result.record) << result.error;
-  EXPECT_EQ(result.record->time_us, 1780300800123456LL);
-  EXPECT_DOUBLE_EQ(*result.record->latitude_deg, -33.5);
-  EXPECT_DOUBLE_EQ(*result.record->longitude_deg, 151.25);
-  EXPECT_FLOAT_EQ(static_cast<float>(*result.record->altitude_m), 17.75f);
-  EXPECT_FLOAT_EQ(static_cast<float>(*result.record->velocity_east_m_s), -1.0f);
-  EXPECT_NEAR(*result.record->heading_rad, 359.0 * kDeg, 1e-6);
+  ASSERT_OK(result);
+  EXPECT_EQ(result->time_us, 1780300800123456LL);
+  EXPECT_DOUBLE_EQ(*result->latitude_deg, -33.5);
+  EXPECT_DOUBLE_EQ(*result->longitude_deg, 151.25);
+  EXPECT_FLOAT_EQ(static_cast<float>(*result->altitude_m), 17.75f);
+  EXPECT_FLOAT_EQ(static_cast<float>(*result->velocity_east_m_s), -1.0f);
+  EXPECT_NEAR(*result->heading_rad, 359.0 * kDeg, 1e-6);
 }
 
 TEST(JsfNavigation, NmeaStringAndBadBodies) {
@@ -119,21 +120,21 @@ TEST(JsfNavigation, NmeaStringAndBadBodies) {
   const std::string sentence = "$GPZDA,080000.25,01,06,2026,00,00*6A\r\n";
   body.insert(body.end(), sentence.begin(), sentence.end());
   auto result = decodeNavigation(headerOf(kJsfNmea, body.size()), body.data(), body.size());
-  ASSERT_TRUE(result.record);
-  EXPECT_EQ(*result.record->nmea, "$GPZDA,080000.25,01,06,2026,00,00*6A");
+  ASSERT_TRUE(result.ok());
+  EXPECT_EQ(*result->nmea, "$GPZDA,080000.25,01,06,2026,00,00*6A");
   // Too short for its layout: an error, not a read past the end.
   result = decodeNavigation(headerOf(kJsfSituation, 100), body.data(), 100 > body.size() ? body.size() : 100);
-  EXPECT_FALSE(result.record);
-  EXPECT_NE(result.error.find("shorter than its 244-byte layout"), std::string::npos);
+  EXPECT_FALSE(result.ok());
+  EXPECT_NE(result.message().find("shorter than its 244-byte layout"), std::string::npos);
   // Impossible values are dropped, the rest kept.
   std::vector<uint8_t> bad = timedBody(276);
   put<uint32_t>(bad, 12, 0x6u);
   put<double>(bad, 28, 123.0);  // latitude 123 deg
   put<double>(bad, 36, 18.0);
   result = decodeNavigation(headerOf(kJsfSituation, bad.size()), bad.data(), bad.size());
-  ASSERT_TRUE(result.record);
-  EXPECT_FALSE(result.record->latitude_deg);
-  EXPECT_DOUBLE_EQ(*result.record->longitude_deg, 18.0);
+  ASSERT_TRUE(result.ok());
+  EXPECT_FALSE(result->latitude_deg);
+  EXPECT_DOUBLE_EQ(*result->longitude_deg, 18.0);
 }
 
 }  // namespace

@@ -28,8 +28,8 @@ std::vector<JsfMessage> parseAll(const std::vector<uint8_t>& stream, size_t chun
 std::vector<uint32_t> pingNumbers(const std::vector<JsfMessage>& messages) {
   std::vector<uint32_t> numbers;
   for (const JsfMessage& m : messages) {
-    const SonarDecodeResult r = decodeSonarData(m.header, m.body.data(), m.body.size());
-    numbers.push_back(r.record ? r.record->ping_number : 0);
+    const sss::core::Result<SonarChannelRecord> r = decodeSonarData(m.header, m.body.data(), m.body.size());
+    numbers.push_back(r.ok() ? r->ping_number : 0);
   }
   return numbers;
 }

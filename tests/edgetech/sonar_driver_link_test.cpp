@@ -21,6 +21,7 @@
 #include "sss_msgs/ping_t.hpp"
 #include "sss_msgs/status_t.hpp"
 #include "tools/emulators/recorded_streams.hpp"
+#include "tests/support/status_assertions.hpp"
 
 extern char** environ;
 
@@ -36,9 +37,10 @@ TEST(SonarDriverLink, EveryGoodPingSurvivesALinkWithFaults) {
     const auto bytes = test::concatenate(test::makeMessages(kPings, 800));
     file.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   }
-  std::string error;
-  std::vector<emulators::TimedChunk> chunks = emulators::loadJsfChunks(jsf_path, error);
-  ASSERT_EQ(chunks.size(), 2u * kPings) << error;
+  const sss::core::Result<std::vector<emulators::TimedChunk>> loaded = emulators::loadJsfChunks(jsf_path);
+  ASSERT_OK(loaded);
+  const std::vector<emulators::TimedChunk>& chunks = *loaded;
+  ASSERT_EQ(chunks.size(), 2u * kPings);
 
   emulators::StreamServerOptions server_options;
   server_options.port = 0;
@@ -49,7 +51,7 @@ TEST(SonarDriverLink, EveryGoodPingSurvivesALinkWithFaults) {
   server_options.faults.pause_every = 150;
   server_options.faults.pause_s = 0.3;
   emulators::TcpStreamServer server(server_options, chunks);
-  ASSERT_TRUE(server.listen(error)) << error;
+  ASSERT_OK(server.listen());
 
   const int lcm_port = 19000 + static_cast<int>(getpid() % 2000);
   const std::string lcm_url = "udpm://239.255.76.67:" + std::to_string(lcm_port) + "?ttl=0&recv_buf_size=16777216";

@@ -19,6 +19,7 @@
 #include "pipeline/core/time.hpp"
 #include "tests/support/loopback_socket.hpp"
 #include "tests/support/poll_until.hpp"
+#include "tests/support/status_assertions.hpp"
 #include "tests/xtf/xtf_test_data.hpp"
 
 namespace sss::edgetech {
@@ -95,7 +96,7 @@ TEST_F(SonarInputFileTest, JsfReplayDeliversEveryPingInOrderOnTheSonarClockAndSa
   ASSERT_EQ(options.driver.time_source, TimeSource::kEstimateOffset);  // the live default
   Recorder recorder;
   SonarInputSource input(options, health_, recorder.hooks());
-  ASSERT_EQ(input.open(), "");
+  ASSERT_OK(input.open());
   EXPECT_EQ(input.fd(), -1);
   EXPECT_EQ(input.stepPeriodS(), 0.002);
 
@@ -140,7 +141,7 @@ TEST_F(SonarInputFileTest, JsfReplayHandsOverALoneLastSideAndReportsTheFaultBefo
   options.replay_speed = 0.0;
   Recorder recorder;
   SonarInputSource input(options, health_, recorder.hooks());
-  ASSERT_EQ(input.open(), "");
+  ASSERT_OK(input.open());
   ASSERT_TRUE(within1s([&] { input.step(); }, [&] { return input.done(); }));
 
   ASSERT_EQ(recorder.pings.size(), 10u);
@@ -165,7 +166,7 @@ TEST_F(SonarInputFileTest, JsfReplayKeepsTheRecordedPace) {
   options.replay_speed = 10.0;  // 25 ms apart
   Recorder recorder;
   SonarInputSource input(options, health_, recorder.hooks());
-  ASSERT_EQ(input.open(), "");
+  ASSERT_OK(input.open());
   input.step();
   // The whole file is decoded, but only the first ping is due: the next one is 25 ms later.
   EXPECT_EQ(recorder.pings.size(), 1u);
@@ -182,7 +183,7 @@ TEST_F(SonarInputFileTest, MissingJsfFileSaysWhich) {
   options.replay_file = stem_ + ".jsf";
   Recorder recorder;
   SonarInputSource input(options, health_, recorder.hooks());
-  EXPECT_EQ(input.open(), "cannot open sonar file '" + stem_ + ".jsf'");
+  EXPECT_EQ(input.open().message, "cannot open sonar file '" + stem_ + ".jsf'");
   input.step();  // harmless: the process exits instead
   EXPECT_FALSE(input.done());
   EXPECT_TRUE(recorder.pings.empty());
@@ -206,7 +207,7 @@ TEST_F(SonarInputFileTest, XtfReplayDeliversEveryPingWithTheFilesSummaryFaultsAn
   options.replay_speed = 0.0;
   Recorder recorder;
   SonarInputSource input(options, health_, recorder.hooks());
-  ASSERT_EQ(input.open(), "");
+  ASSERT_OK(input.open());
   ASSERT_EQ(recorder.info.size(), 1u);  // the file's facts, said on opening
   EXPECT_EQ(recorder.info[0].rfind("XTF '" + path + "'", 0), 0u) << recorder.info[0];
   EXPECT_NE(recorder.info[0].find("0 pings"), std::string::npos) << recorder.info[0];
@@ -238,7 +239,7 @@ TEST_F(SonarInputFileTest, MissingXtfFileSaysWhichAndWhy) {
   options.replay_file = stem_ + ".xtf";
   Recorder recorder;
   SonarInputSource input(options, health_, recorder.hooks());
-  EXPECT_EQ(input.open(), "cannot open XTF file '" + stem_ + ".xtf': No such file or directory");
+  EXPECT_EQ(input.open().message, "cannot open XTF file '" + stem_ + ".xtf': No such file or directory");
   EXPECT_TRUE(recorder.info.empty());
 }
 
@@ -277,7 +278,7 @@ class SonarInputLinkTest : public ::testing::Test {
 TEST_F(SonarInputLinkTest, DeliversPingsAndReconnectsAfterThePeerCloses) {
   Recorder recorder;
   SonarInputSource input(options_, health_, recorder.hooks());
-  ASSERT_EQ(input.open(), "");
+  ASSERT_OK(input.open());
   EXPECT_EQ(input.fd(), -1);  // connects in step(), not before
   EXPECT_EQ(input.stepPeriodS(), 0.05);
 
@@ -325,7 +326,7 @@ TEST_F(SonarInputLinkTest, HandsOverALoneSideAfterTheMissingSideTimeout) {
   options_.driver.assembler.missing_side_timeout_s = 0.02;
   Recorder recorder;
   SonarInputSource input(options_, health_, recorder.hooks());
-  ASSERT_EQ(input.open(), "");
+  ASSERT_OK(input.open());
   const int peer = connect(input);
   send(peer, test::encodeRecord(test::makeRecord(1000, kChannelPort), 500));  // the starboard side never comes
   ASSERT_TRUE(within1s([&] { input.onReadable(); }, [&] { return input.driver().parserCounters().messages >= 1; }));
@@ -346,7 +347,7 @@ TEST_F(SonarInputLinkTest, RefusedConnectionIsAWarningNamingTheLink) {
   options_.tcp.port = boundPort(closed);
   Recorder recorder;
   SonarInputSource input(options_, health_, recorder.hooks());
-  ASSERT_EQ(input.open(), "");
+  ASSERT_OK(input.open());
   ASSERT_TRUE(within1s([&] { input.step(); }, [&] { return !recorder.warnings.empty(); }));
   ::close(closed);
   EXPECT_EQ(recorder.warnings[0].rfind("sonar link: ", 0), 0u) << recorder.warnings[0];

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "pipeline/core/time.hpp"
+#include "tests/support/status_assertions.hpp"
 
 namespace sss::emulators {
 namespace {
@@ -70,8 +71,7 @@ TEST(TcpStreamServer, DeliversEveryChunkInOrderAtTheRequestedPace) {
   options.port = 0;
   options.speed = 2.0;  // 2 s in 1 s: one chunk every 50 ms
   TcpStreamServer server(options, chunks);
-  std::string error;
-  ASSERT_TRUE(server.listen(error)) << error;
+  ASSERT_OK(server.listen());
   std::atomic<bool> stop{false};
   std::thread thread([&] { server.run(stop); });
   const int fd = connectTo(server.port());
@@ -105,8 +105,7 @@ TEST(TcpStreamServer, ClientThatReconnectsGetsTheRest) {
   options.speed = 0.0;
   options.faults.drop_connection_every = 4;  // closes after chunks 3 and 7
   TcpStreamServer server(options, chunks);
-  std::string error;
-  ASSERT_TRUE(server.listen(error)) << error;
+  ASSERT_OK(server.listen());
   std::atomic<bool> stop{false};
   std::thread thread([&] { server.run(stop); });
   std::vector<uint8_t> all;
@@ -141,9 +140,8 @@ TEST(UdpStreamSender, SendsOneDatagramPerChunkInOrder) {
   options.speed = 10.0;
   UdpStreamSender sender(options, chunks);
   std::atomic<bool> stop{false};
-  std::string error;
   const int64_t start = sss::core::monotonicUtime();
-  ASSERT_TRUE(sender.run(stop, error)) << error;
+  ASSERT_OK(sender.run(stop));
   const double elapsed_ms = static_cast<double>(sss::core::monotonicUtime() - start) * 1e-3;
   EXPECT_NEAR(elapsed_ms, 29 * 5.0, 40.0);  // 29 periods of 50 ms at 10x; unpaced it is ~1 ms
   for (const auto& chunk : chunks) {
@@ -176,9 +174,8 @@ TEST(UdpStreamSender, APauseIsAStallOrAnOutage) {
     options.faults.pause_skips = outage;
     UdpStreamSender sender(options, chunks);
     std::atomic<bool> stop{false};
-    std::string error;
     const int64_t start = sss::core::monotonicUtime();
-    ASSERT_TRUE(sender.run(stop, error)) << error;
+    ASSERT_OK(sender.run(stop));
     const double elapsed_ms = static_cast<double>(sss::core::monotonicUtime() - start) * 1e-3;
     std::vector<int> received;
     uint8_t buffer[4096];

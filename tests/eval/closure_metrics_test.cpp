@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -50,7 +52,8 @@ class ClosureMetrics : public ::testing::Test {
  protected:
   void SetUp() override {
     truth_ = test::lawnmower(3, 200.0, 60.0);  // 0.5 m per pose; lines: 0..400, 588..988, 1177..1577
-    path_ = (fs::temp_directory_path() / "sss_closure_metrics_test.csv").string();
+    // One file per process: ctest -j runs this fixture's tests side by side.
+    path_ = (fs::temp_directory_path() / ("sss_closure_metrics_test_" + std::to_string(::getpid()) + ".csv")).string();
   }
   void TearDown() override { fs::remove(path_); }
 

@@ -16,6 +16,7 @@
 #include "pipeline/core/georeference.hpp"
 #include "tools/process/match_writer.hpp"
 #include "tools/sim/simulated_survey.hpp"
+#include "tests/support/status_assertions.hpp"
 
 namespace sss::eval {
 namespace {
@@ -83,8 +84,7 @@ TEST(MatchFile, EvaluationFromTheFileEqualsTheInProcessOne) {
   const sss::matcher::PairMatcherOptions options;
   const sss::matcher::DenseMatcher dense(options.dense);
   sss::offline::MatchCsvWriter writer;
-  std::string error;
-  ASSERT_TRUE(writer.open((dir / "matches.csv").string(), options.dense.stride, 4, error)) << error;
+  ASSERT_OK(writer.open((dir / "matches.csv").string(), options.dense.stride, 4));
   std::vector<MatchEvaluation> in_process;
   for (const PairType type : {PairType::kAntiParallel, PairType::kCrossing}) {
     const auto& a = *full[best[static_cast<int>(type)].first];
@@ -98,7 +98,8 @@ TEST(MatchFile, EvaluationFromTheFileEqualsTheInProcessOne) {
                 pairTypeName(type), static_cast<long long>(a.id), static_cast<long long>(b.id), e.matches,
                 e.withinFraction(), e.recall(), e.meanErrorPx(), e.meanErrorM());
   }
-  ASSERT_TRUE(writer.close(error)) << error;
+  ASSERT_OK(writer.close());
+  std::string error;
 
   MatchFileEvaluation file;
   ASSERT_TRUE(evaluateMatchFile((dir / "matches.csv").string(), dir.string(), file, error)) << error;

@@ -5,6 +5,7 @@
 #include "tools/eval/run_report.hpp"
 #include "tools/eval/trajectory_io.hpp"
 #include "tools/sim/mission.hpp"
+#include "tests/support/status_assertions.hpp"
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -63,8 +64,7 @@ class RunReport : public ::testing::Test {
     options.seabed.resolution_m = 0.3;
     options.dead_reckoning.drift_scale = 10.0;
     sim::MissionReport report;
-    std::string error;
-    ASSERT_TRUE(sim::writeMission(sim::Mission(options), mission_dir_.string(), report, error)) << error;
+    ASSERT_OK(sim::writeMission(sim::Mission(options), mission_dir_.string(), report));
   }
   static void TearDownTestSuite() { fs::remove_all(mission_dir_); }
 

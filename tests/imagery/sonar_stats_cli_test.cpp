@@ -1,6 +1,7 @@
 // sss-sonar-stats end to end: a simulated JSF gives its figures, JSON and a waterfall PNG; bad
 // arguments exit 2, a file with no side-scan ping exits 1 and says what to try.
 #include "tools/sim/mission.hpp"
+#include "tests/support/status_assertions.hpp"
 
 #include <gtest/gtest.h>
 
@@ -50,8 +51,7 @@ TEST(SonarStatsCli, SimulatedJsfGivesFiguresJsonAndAWaterfall) {
   options.seabed.resolution_m = 0.2;
   options.sonar.samples_per_side = 2000;
   sss::sim::MissionReport report;
-  std::string error;
-  ASSERT_TRUE(sss::sim::writeMission(sss::sim::Mission(options), (dir / "mission").string(), report, error)) << error;
+  ASSERT_OK(sss::sim::writeMission(sss::sim::Mission(options), (dir / "mission").string(), report));
   const ToolRun r = run("--sonar " + (dir / "mission" / "sonar.jsf").string() + " --json " + (dir / "s.json").string() +
                     " --waterfall " + (dir / "w.png").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;

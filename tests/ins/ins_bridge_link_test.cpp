@@ -23,6 +23,7 @@
 #include "sss_msgs/nav_t.hpp"
 #include "sss_msgs/status_t.hpp"
 #include "tools/emulators/recorded_streams.hpp"
+#include "tests/support/status_assertions.hpp"
 
 extern char** environ;
 
@@ -37,9 +38,10 @@ TEST(InsBridgeLink, PublishesEveryEpochGoesStaleInAPauseAndRecovers) {
     std::ofstream file(ins_path, std::ios::binary);
     file << test::eastboundStream(kEpochs);
   }
-  std::string error;
-  std::vector<emulators::TimedChunk> chunks = emulators::loadInsChunks(ins_path, error);
-  ASSERT_EQ(chunks.size(), static_cast<size_t>(kEpochs)) << error;
+  const sss::core::Result<std::vector<emulators::TimedChunk>> loaded = emulators::loadInsChunks(ins_path);
+  ASSERT_OK(loaded);
+  const std::vector<emulators::TimedChunk>& chunks = *loaded;
+  ASSERT_EQ(chunks.size(), static_cast<size_t>(kEpochs));
 
   const int udp_port = 21000 + static_cast<int>(getpid() % 2000);
   const int lcm_port = 23000 + static_cast<int>(getpid() % 2000);
@@ -78,10 +80,7 @@ TEST(InsBridgeLink, PublishesEveryEpochGoesStaleInAPauseAndRecovers) {
   emulators::UdpStreamSender sender(sender_options, chunks);
   std::atomic<bool> stop{false};
   int64_t pause_start_us = 0;
-  std::thread send_thread([&] {
-    std::string send_error;
-    sender.run(stop, send_error);
-  });
+  std::thread send_thread([&] { EXPECT_OK(sender.run(stop)); });
   const int64_t deadline = sss::core::monotonicUtime() + 15'000'000;
   while (sss::core::monotonicUtime() < deadline && sender.stats().chunks_sent + sender.stats().chunks_faulted < chunks.size()) {
     bus.handleTimeout(20);
@@ -183,9 +182,8 @@ TEST(InsBridgeLink, WithoutConfiguredOriginTheFirstFixIsKeptAcrossARestart) {
   EXPECT_NEAR(navs.front().origin_latitude_deg, first_fix.latitude_deg, 1e-8);
   EXPECT_NEAR(navs.front().origin_longitude_deg, first_fix.longitude_deg, 1e-8);
   EXPECT_NEAR(navs.front().position_ned_m[1], 0.0, 0.01);
-  std::string error;
-  const auto saved = sss::core::readOriginState(dir + "/origin", error);
-  ASSERT_TRUE(saved) << error;
+  const auto saved = sss::core::readOriginState(dir + "/origin");
+  ASSERT_TRUE(saved) << saved.message();
   EXPECT_DOUBLE_EQ(saved->latitude_deg, navs.front().origin_latitude_deg);
   EXPECT_DOUBLE_EQ(status_origin_latitude_deg, saved->latitude_deg) << "SSS_STATUS names the origin";
 

@@ -21,6 +21,7 @@
 #include "pipeline/core/time.hpp"
 #include "tests/support/loopback_socket.hpp"
 #include "tests/support/poll_until.hpp"
+#include "tests/support/status_assertions.hpp"
 
 namespace sss::ins {
 namespace {
@@ -70,7 +71,7 @@ TEST(InsInputSource, UdpHandsOverEachDatagramWithAStreamBreakAfterIt) {
   options.udp_port = 0;
   Recorder recorder;
   InsInputSource source(options, recorder.hooks());
-  ASSERT_EQ(source.open(), "");
+  ASSERT_OK(source.open());
   ASSERT_GT(source.boundUdpPort(), 0);
   EXPECT_GE(source.fd(), 0);
   EXPECT_EQ(source.servicePeriodS(), 0.0);
@@ -102,9 +103,10 @@ TEST(InsInputSource, UdpPortAlreadyTakenSaysWhichPortAndWhy) {
   options.bind_address = "127.0.0.1";
   options.udp_port = port;
   InsInputSource source(options, {});
-  const std::string error = source.open();
+  const sss::core::Status opened = source.open();
   ::close(taken);
-  EXPECT_EQ(error, "cannot bind UDP 127.0.0.1:" + std::to_string(port) + ": Address already in use");
+  EXPECT_FALSE(opened.ok);
+  EXPECT_EQ(opened.message, "cannot bind UDP 127.0.0.1:" + std::to_string(port) + ": Address already in use");
   EXPECT_EQ(source.fd(), -1);
   EXPECT_EQ(source.boundUdpPort(), 0);
 }
@@ -128,7 +130,7 @@ TEST_F(InsInputFileTest, DeliversTheFileInChunksAndSignalsItsEnd) {
   options.file = path_;
   Recorder recorder;
   InsInputSource source(options, recorder.hooks());
-  ASSERT_EQ(source.open(), "");
+  ASSERT_OK(source.open());
   EXPECT_EQ(source.fd(), -1);  // read when the replay wants more, not when a descriptor says so
 
   EXPECT_EQ(source.read(0.0), 16384u);
@@ -150,7 +152,7 @@ TEST_F(InsInputFileTest, MissingFileSaysWhich) {
   options.source = "file";
   options.file = path_ + ".missing";
   InsInputSource source(options, {});
-  EXPECT_EQ(source.open(), "cannot open INS file '" + path_ + ".missing'");
+  EXPECT_EQ(source.open().message, "cannot open INS file '" + path_ + ".missing'");
 }
 
 TEST(InsInputSource, TcpReconnectsAfterThePeerClosesAndBreaksTheStreamAtTheDrop) {
@@ -164,7 +166,7 @@ TEST(InsInputSource, TcpReconnectsAfterThePeerClosesAndBreaksTheStreamAtTheDrop)
   options.tcp.reconnect_min_s = 0.01;  // the default 0.2 s would only slow the test
   Recorder recorder;
   InsInputSource source(options, recorder.hooks());
-  ASSERT_EQ(source.open(), "");
+  ASSERT_OK(source.open());
   EXPECT_EQ(source.fd(), -1);  // connects in service(), not before
   EXPECT_EQ(source.servicePeriodS(), 0.05);
 
@@ -204,7 +206,7 @@ TEST(InsInputSource, TcpRefusedConnectionIsAWarningNamingTheLinkAndNotALoss) {
   options.tcp.port = boundPort(closed);
   Recorder recorder;
   InsInputSource source(options, recorder.hooks());
-  ASSERT_EQ(source.open(), "");
+  ASSERT_OK(source.open());
   ASSERT_TRUE(within1s([&] { source.service(sss::core::monotonicUtime()); },
                        [&] { return !recorder.warnings.empty(); }));
   ::close(closed);
@@ -255,7 +257,7 @@ TEST_F(InsInputSerialTest, ReadsThePortAndReopensItWhenItComesBack) {
   options.serial_baud = 9600;
   Recorder recorder;
   InsInputSource source(options, recorder.hooks());
-  ASSERT_EQ(source.open(), "");
+  ASSERT_OK(source.open());
   ASSERT_GE(source.fd(), 0);
   EXPECT_EQ(source.servicePeriodS(), 2.0);
   EXPECT_EQ(recorder.info, std::vector<std::string>({"reading INS from " + link_}));
@@ -287,7 +289,7 @@ TEST(InsInputSource, MissingSerialPortIsReportedWithItsNameAndTriedAgain) {
   options.serial_device = "/nonexistent/ttyINS";
   Recorder recorder;
   InsInputSource source(options, recorder.hooks());
-  EXPECT_EQ(source.open(), "");  // not fatal: the port may appear later
+  EXPECT_OK(source.open());  // not fatal: the port may appear later
   EXPECT_EQ(source.fd(), -1);
   source.service(sss::core::monotonicUtime());
   const std::string error = "cannot open serial port '/nonexistent/ttyINS': No such file or directory";

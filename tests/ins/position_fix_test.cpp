@@ -171,10 +171,9 @@ TEST(PositionFix, ByteByByteGivesTheSameFixes) {
 }
 
 TEST(PositionFix, MissingFileNamesThePathAndTheForm) {
-  std::vector<PositionFix> fixes;
-  FixReaderCounters counters;
-  std::string problem, error;
-  EXPECT_FALSE(readPositionFixFile("usbl:/nonexistent/fixes.nmea", FixReaderOptions{}, fixes, counters, problem, error));
+  const sss::core::Result<FixFileContents> read = readPositionFixFile("usbl:/nonexistent/fixes.nmea", FixReaderOptions{});
+  EXPECT_FALSE(read.ok());
+  const std::string& error = read.message();
   EXPECT_NE(error.find("/nonexistent/fixes.nmea"), std::string::npos) << error;
   EXPECT_NE(error.find("usbl:PATH"), std::string::npos) << error;
 }

@@ -13,6 +13,7 @@
 #include <set>
 
 #include "tests/matcher/matcher_test_survey.hpp"
+#include "tests/support/status_assertions.hpp"
 
 namespace sss::matcher {
 namespace {
@@ -343,9 +344,10 @@ TEST_F(MatcherEngineRestartTest, EvictionDeletesTheSubframeFile) {
     EXPECT_EQ(engine.counters().subframes_evicted, 1u);
     EXPECT_FALSE(fs::exists(store.subframePath(0)));
     EXPECT_EQ(store.subframeIds(), (std::vector<int64_t>{1, 2, 3}));
-    MatcherState saved;
-    std::string error;
-    ASSERT_EQ(store.readState(saved, error), StateFileStatus::kOk) << error;
+    const auto read = store.readState();
+    ASSERT_OK(read);
+    ASSERT_TRUE(read->has_value());
+    const MatcherState& saved = **read;
     ASSERT_EQ(saved.corrections.size(), 3u);
     EXPECT_EQ(saved.corrections[0].subframe_id, 1);
   }
@@ -414,9 +416,8 @@ TEST_F(MatcherEngineRestartTest, CorruptFilesAreCountedAndSkippedAndTheRestResto
   EXPECT_EQ(storedIds(again), (std::vector<int64_t>{0, 2, 4, 5}));
   for (const auto& c : again.state().corrections) EXPECT_EQ(c.correction.translation, Eigen::Vector3d::Zero());
   // The state file is whole again for the next start.
-  MatcherState saved;
-  std::string error;
-  EXPECT_EQ(again_store.readState(saved, error), StateFileStatus::kOk) << error;
+  const auto saved = again_store.readState();
+  EXPECT_TRUE(saved.ok() && saved->has_value()) << saved.message();
 }
 
 }  // namespace

@@ -50,9 +50,8 @@ TEST(MatcherNode, SubframesInLoopClosuresOutBadMessagesCounted) {
   std::vector<LoopClosure> closures;
   int decode_failures = 0;
   bus.subscribe<sss_msgs::loop_closure_t>("SSS_LOOP", [&](const sss_msgs::loop_closure_t& message) {
-    LoopClosure closure;
-    std::string error;
-    fromLoopClosureMessage(message, closure, error) ? closures.push_back(closure) : void(++decode_failures);
+    const sss::core::Result<LoopClosure> closure = fromLoopClosureMessage(message);
+    closure ? closures.push_back(*closure) : void(++decode_failures);
   });
   double rejected_in_status = -1.0;
   bus.subscribe<sss_msgs::status_t>("SSS_STATUS", [&](const sss_msgs::status_t& message) {

@@ -14,6 +14,7 @@
 #include <fstream>
 
 #include "pipeline/matcher/matcher_engine.hpp"
+#include "tests/support/status_assertions.hpp"
 
 namespace sss::matcher {
 namespace {
@@ -78,8 +79,7 @@ class MatcherStateStoreTest : public ::testing::Test {
  protected:
   void SetUp() override {
     fs::remove_all(dir_);
-    std::string error;
-    ASSERT_TRUE(store_.open(error)) << error;
+    ASSERT_OK(store_.open());
   }
   void TearDown() override { fs::remove_all(dir_); }
 
@@ -89,12 +89,13 @@ class MatcherStateStoreTest : public ::testing::Test {
 
 TEST_F(MatcherStateStoreTest, SubframeFileRoundTripsExactly) {
   const sss::core::Subframe s = testSubframe(42, 20, 30);
-  std::string error;
-  ASSERT_TRUE(store_.writeSubframe(s, error)) << error;
+  ASSERT_OK(store_.writeSubframe(s));
   EXPECT_EQ(fs::file_size(store_.subframePath(42)), subframeFileBytes(20, 30));
   EXPECT_FALSE(fs::exists(store_.subframePath(42) + ".tmp"));
-  sss::core::Subframe back;
-  ASSERT_EQ(store_.readSubframe(42, back, error), StateFileStatus::kOk) << error;
+  const auto read = store_.readSubframe(42);
+  ASSERT_OK(read);
+  ASSERT_TRUE(read->has_value());
+  const sss::core::Subframe& back = **read;
   EXPECT_EQ(back.id, 42);
   EXPECT_EQ(back.line_id, s.line_id);
   EXPECT_EQ(back.centre_ping_index, s.centre_ping_index);
@@ -113,36 +114,37 @@ TEST_F(MatcherStateStoreTest, SubframeFileRoundTripsExactly) {
   EXPECT_EQ(back.image, s.image);  // exact: the image is stored as the engine holds it
   EXPECT_EQ(back.mask, s.mask);
   // Missing and removed.
-  EXPECT_EQ(store_.readSubframe(43, back, error), StateFileStatus::kMissing);
-  ASSERT_TRUE(store_.removeSubframe(42, error)) << error;
+  const auto missing = store_.readSubframe(43);
+  EXPECT_TRUE(missing.ok() && !missing->has_value());
+  ASSERT_OK(store_.removeSubframe(42));
   EXPECT_FALSE(fs::exists(store_.subframePath(42)));
-  EXPECT_TRUE(store_.removeSubframe(42, error)) << "removing a file that is gone is not an error";
+  EXPECT_OK(store_.removeSubframe(42)) << "removing a file that is gone is not an error";
 }
 
 TEST_F(MatcherStateStoreTest, EveryFlippedByteAndEveryTruncationOfASubframeFileIsRefused) {
-  std::string error;
-  ASSERT_TRUE(store_.writeSubframe(testSubframe(7, 3, 4), error)) << error;
+  ASSERT_OK(store_.writeSubframe(testSubframe(7, 3, 4)));
   const std::string path = store_.subframePath(7);
   const std::string good = readBytes(path);
   ASSERT_EQ(good.size(), subframeFileBytes(3, 4));
-  sss::core::Subframe back;
   for (size_t i = 0; i < good.size(); ++i) {
     patchByte(path, i, static_cast<char>(good[i] ^ 0x10));
-    error.clear();
-    ASSERT_EQ(store_.readSubframe(7, back, error), StateFileStatus::kCorrupt) << "byte " << i;
-    EXPECT_NE(error.find(path), std::string::npos) << error;
+    const auto read = store_.readSubframe(7);
+    ASSERT_FALSE(read.ok()) << "byte " << i;
+    EXPECT_NE(read.message().find(path), std::string::npos) << read.message();
     patchByte(path, i, good[i]);
   }
   for (size_t size = good.size(); size-- > 0;) {
     fs::resize_file(path, size);
-    ASSERT_EQ(store_.readSubframe(7, back, error), StateFileStatus::kCorrupt) << "truncated to " << size;
+    ASSERT_FALSE(store_.readSubframe(7).ok()) << "truncated to " << size;
   }
   // A good file under another subframe's name.
   writeBytes(store_.subframePath(8), good);
-  EXPECT_EQ(store_.readSubframe(8, back, error), StateFileStatus::kCorrupt);
-  EXPECT_NE(error.find("holds subframe 7"), std::string::npos) << error;
+  const auto renamed = store_.readSubframe(8);
+  EXPECT_FALSE(renamed.ok());
+  EXPECT_NE(renamed.message().find("holds subframe 7"), std::string::npos) << renamed.message();
   writeBytes(path, good);
-  EXPECT_EQ(store_.readSubframe(7, back, error), StateFileStatus::kOk) << error;
+  const auto restored = store_.readSubframe(7);
+  EXPECT_TRUE(restored.ok() && restored->has_value()) << restored.message();
 }
 
 MatcherState testState() {
@@ -157,11 +159,13 @@ MatcherState testState() {
 
 TEST_F(MatcherStateStoreTest, StateFileRoundTripsExactly) {
   const MatcherState state = testState();
-  std::string error;
-  MatcherState back;
-  EXPECT_EQ(store_.readState(back, error), StateFileStatus::kMissing);
-  ASSERT_TRUE(store_.writeState(state, error)) << error;
-  ASSERT_EQ(store_.readState(back, error), StateFileStatus::kOk) << error;
+  const auto missing = store_.readState();
+  EXPECT_TRUE(missing.ok() && !missing->has_value());
+  ASSERT_OK(store_.writeState(state));
+  const auto read = store_.readState();
+  ASSERT_OK(read);
+  ASSERT_TRUE(read->has_value());
+  const MatcherState& back = **read;
   ASSERT_EQ(back.corrections.size(), 2u);
   ASSERT_EQ(back.pairs.size(), 2u);
   for (size_t i = 0; i < 2; ++i) {
@@ -175,31 +179,29 @@ TEST_F(MatcherStateStoreTest, StateFileRoundTripsExactly) {
 }
 
 TEST_F(MatcherStateStoreTest, EveryFlippedByteAndEveryTruncationOfTheStateFileIsRefused) {
-  std::string error;
-  ASSERT_TRUE(store_.writeState(testState(), error)) << error;
+  ASSERT_OK(store_.writeState(testState()));
   const std::string path = store_.statePath();
   const std::string good = readBytes(path);
-  MatcherState back;
   for (size_t i = 0; i < good.size(); ++i) {
     patchByte(path, i, static_cast<char>(good[i] ^ 0x01));
-    ASSERT_EQ(store_.readState(back, error), StateFileStatus::kCorrupt) << "byte " << i;
-    EXPECT_NE(error.find(path), std::string::npos) << error;
+    const auto read = store_.readState();
+    ASSERT_FALSE(read.ok()) << "byte " << i;
+    EXPECT_NE(read.message().find(path), std::string::npos) << read.message();
     patchByte(path, i, good[i]);
   }
   for (size_t size = good.size(); size-- > 0;) {
     fs::resize_file(path, size);
-    ASSERT_EQ(store_.readState(back, error), StateFileStatus::kCorrupt) << "truncated to " << size;
+    ASSERT_FALSE(store_.readState().ok()) << "truncated to " << size;
   }
 }
 
 TEST_F(MatcherStateStoreTest, IdsComeFromWellFormedNamesAndOpenRemovesTemporaryFiles) {
-  std::string error;
-  for (int64_t id : {12, 7, -3}) ASSERT_TRUE(store_.writeSubframe(testSubframe(id, 2, 1), error)) << error;
+  for (int64_t id : {12, 7, -3}) ASSERT_OK(store_.writeSubframe(testSubframe(id, 2, 1)));
   for (const char* name : {"x.subframe", "007.subframe", "12.subframe.tmp", "5.lcm", "+5.subframe"})
     writeBytes(dir_ + "/subframes/" + name, "junk");
   writeBytes(dir_ + "/matcher.state.tmp", "junk");
   EXPECT_EQ(store_.subframeIds(), (std::vector<int64_t>{-3, 7, 12}));
-  ASSERT_TRUE(store_.open(error)) << error;
+  ASSERT_OK(store_.open());
   EXPECT_FALSE(fs::exists(dir_ + "/subframes/12.subframe.tmp"));
   EXPECT_FALSE(fs::exists(dir_ + "/matcher.state.tmp"));
   EXPECT_TRUE(fs::exists(dir_ + "/subframes/x.subframe"));  // not ours to remove
@@ -208,11 +210,11 @@ TEST_F(MatcherStateStoreTest, IdsComeFromWellFormedNamesAndOpenRemovesTemporaryF
 TEST_F(MatcherStateStoreTest, UnwritableDirectoryIsReportedNotThrown) {
   writeBytes(dir_ + "/file", "not a directory");
   MatcherStateStore store(dir_ + "/file/state");
-  std::string error;
-  EXPECT_FALSE(store.open(error));
-  EXPECT_NE(error.find(dir_ + "/file/state"), std::string::npos) << error;
-  EXPECT_FALSE(store.writeSubframe(testSubframe(1, 2, 1), error));
-  EXPECT_FALSE(store.writeState(testState(), error));
+  const sss::core::Status opened = store.open();
+  EXPECT_FALSE(opened.ok);
+  EXPECT_NE(opened.message.find(dir_ + "/file/state"), std::string::npos) << opened.message;
+  EXPECT_FALSE(store.writeSubframe(testSubframe(1, 2, 1)).ok);
+  EXPECT_FALSE(store.writeState(testState()).ok);
 }
 
 // Figures at the deployment's size (200 pings x 2 x 1250 bins), printed for the README; the engine
@@ -235,13 +237,12 @@ TEST_F(MatcherStateStoreTest, FullSizeFiguresAndRestoreOfTenSubframes) {
   }
   EXPECT_EQ(engine.counters().state_write_errors, 0u);
   EXPECT_EQ(fs::file_size(store_.subframePath(0)), subframeFileBytes(200, 1250));
-  std::string error;
   const auto write_start = Clock::now();
-  ASSERT_TRUE(store_.writeSubframe(testSubframe(99, 200, 1250), error)) << error;
+  ASSERT_OK(store_.writeSubframe(testSubframe(99, 200, 1250)));
   const double write_subframe_s = seconds(write_start);
-  ASSERT_TRUE(store_.removeSubframe(99, error)) << error;
+  ASSERT_OK(store_.removeSubframe(99));
   const auto state_start = Clock::now();
-  ASSERT_TRUE(store_.writeState(engine.state(), error)) << error;
+  ASSERT_OK(store_.writeState(engine.state()));
   const double write_state_s = seconds(state_start);
 
   MatcherEngine restored(options);

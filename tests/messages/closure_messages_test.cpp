@@ -5,6 +5,8 @@
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
 #include "pipeline/messages/closure_messages.hpp"
 
+#include "tests/support/status_assertions.hpp"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -57,9 +59,9 @@ TEST(LoopClosureMessage, RoundTripsThroughTheWire) {
   sss_msgs::loop_closure_t message;
   ASSERT_EQ(message.decode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
   EXPECT_EQ(message.utime, 42);
-  LoopClosure back;
-  std::string error;
-  ASSERT_TRUE(fromLoopClosureMessage(message, back, error)) << error;
+  const Result<LoopClosure> read = fromLoopClosureMessage(message);
+  ASSERT_OK(read);
+  const LoopClosure& back = read.value();
   EXPECT_EQ(back.subframe_id_a, 3);
   EXPECT_EQ(back.subframe_id_b, 17);
   EXPECT_EQ(back.centre_utime_b_us, c.centre_utime_b_us);
@@ -75,19 +77,19 @@ TEST(LoopClosureMessage, RoundTripsThroughTheWire) {
 
 TEST(LoopClosureMessage, RejectsInconsistentArraysAndNonFinitePoses) {
   auto message = toLoopClosureMessage(sampleClosure(), 1);
-  LoopClosure out;
-  std::string error;
   auto short_arrays = message;
   short_arrays.column_b.pop_back();
-  EXPECT_FALSE(fromLoopClosureMessage(short_arrays, out, error));
-  EXPECT_NE(error.find("num_correspondences"), std::string::npos);
+  const Result<LoopClosure> short_read = fromLoopClosureMessage(short_arrays);
+  EXPECT_FALSE(short_read.ok());
+  EXPECT_NE(short_read.message().find("num_correspondences"), std::string::npos);
   auto zero_quaternion = message;
   for (double& v : zero_quaternion.rotation_ab_wxyz) v = 0.0;
-  EXPECT_FALSE(fromLoopClosureMessage(zero_quaternion, out, error));
+  EXPECT_FALSE(fromLoopClosureMessage(zero_quaternion).ok());
   auto nan_covariance = message;
   nan_covariance.covariance[2][3] = std::nan("");
-  EXPECT_FALSE(fromLoopClosureMessage(nan_covariance, out, error));
-  EXPECT_NE(error.find("covariance"), std::string::npos);
+  const Result<LoopClosure> nan_read = fromLoopClosureMessage(nan_covariance);
+  EXPECT_FALSE(nan_read.ok());
+  EXPECT_NE(nan_read.message().find("covariance"), std::string::npos);
 }
 
 TEST(TrajectoryMessage, RoundTripsAndRejectsBadNodes) {
@@ -100,19 +102,19 @@ TEST(TrajectoryMessage, RoundTripsAndRejectsBadNodes) {
   const std::vector<uint8_t> bytes = encode(toTrajectoryMessage(nodes, 7));
   sss_msgs::trajectory_t message;
   ASSERT_EQ(message.decode(bytes.data(), 0, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
-  std::vector<TrajectoryNode> back;
-  std::string error;
-  ASSERT_TRUE(fromTrajectoryMessage(message, back, error)) << error;
+  const Result<std::vector<TrajectoryNode>> read = fromTrajectoryMessage(message);
+  ASSERT_OK(read);
+  const std::vector<TrajectoryNode>& back = read.value();
   ASSERT_EQ(back.size(), 3u);
   EXPECT_EQ(back[2].subframe_id, 12);
   EXPECT_LT((back[2].T_world_body.translation - nodes[2].T_world_body.translation).norm(), 1e-12);
   EXPECT_LT(back[1].T_world_body.rotation.angularDistance(nodes[1].T_world_body.rotation), 1e-12);
   auto bad = message;
   bad.position_ned_m[1][0] = std::numeric_limits<double>::infinity();
-  EXPECT_FALSE(fromTrajectoryMessage(bad, back, error));
+  EXPECT_FALSE(fromTrajectoryMessage(bad).ok());
   auto short_message = message;
   short_message.node_utime.pop_back();
-  EXPECT_FALSE(fromTrajectoryMessage(short_message, back, error));
+  EXPECT_FALSE(fromTrajectoryMessage(short_message).ok());
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
 // SSS_SUBFRAME translation: quantisation round trip (8 and 16 bits), geometry, poses and masks.
 #include "pipeline/messages/subframe_messages.hpp"
 
+#include "tests/support/status_assertions.hpp"
+
 #include <gtest/gtest.h>
 
 namespace sss::messages {
@@ -33,9 +35,9 @@ TEST(SubframeMessage, RoundTripsWithinHalfAQuantisationStep) {
     const sss_msgs::subframe_t m = toSubframeMessage(s, bits, 4.0);
     EXPECT_EQ(m.num_image_bytes, 24 * bits / 8);
     EXPECT_EQ(m.utime, 1002);
-    Subframe back;
-    std::string error;
-    ASSERT_TRUE(fromSubframeMessage(m, back, error)) << error;
+    const Result<Subframe> read = fromSubframeMessage(m);
+    ASSERT_OK(read);
+    const Subframe& back = read.value();
     for (size_t i = 0; i < s.image.size(); ++i) {
       EXPECT_NEAR(back.image[i], std::min(s.image[i], 4.0f), 0.5 * m.intensity_scale + 1e-6);
     }
@@ -52,10 +54,9 @@ TEST(SubframeMessage, RejectsInconsistentSizes) {
   sss_msgs::subframe_t m = toSubframeMessage(smallSubframe(), 16, 4.0);
   m.image.pop_back();
   m.num_image_bytes -= 1;
-  Subframe back;
-  std::string error;
-  EXPECT_FALSE(fromSubframeMessage(m, back, error));
-  EXPECT_NE(error.find("inconsistent"), std::string::npos);
+  const Result<Subframe> read = fromSubframeMessage(m);
+  EXPECT_FALSE(read.ok());
+  EXPECT_NE(read.message().find("inconsistent"), std::string::npos);
 }
 
 }  // namespace

@@ -44,9 +44,8 @@ TEST(FixMessage, BridgeToOptimiserOverLcm) {
   const std::optional<sss_msgs::fix_t> received = overTheBus(sss::ins::toFixMessage(usblFix(), origin));
   ASSERT_TRUE(received);
   const sss_msgs::fix_t& message = *received;
-  std::string error;
-  const std::optional<AbsoluteFix> fix = fromFixMessage(message, error);
-  ASSERT_TRUE(fix) << error;
+  const sss::core::Result<AbsoluteFix> fix = fromFixMessage(message);
+  ASSERT_TRUE(fix) << fix.message();
   EXPECT_EQ(fix->utime_us, 1780300860123456);
   EXPECT_EQ(fix->source, "usbl");
   EXPECT_EQ(fix->position_ne_m, Eigen::Vector2d(111.25, 57.5));
@@ -60,22 +59,24 @@ TEST(FixMessage, BridgeToOptimiserOverLcm) {
 
 TEST(FixMessage, UnusableMessagesAreRefusedWithTheReason) {
   const sss_msgs::fix_t good = sss::ins::toFixMessage(usblFix(), {59.35, 18.07});
-  std::string error;
   sss_msgs::fix_t m = good;
   m.source = "radio";
-  EXPECT_FALSE(fromFixMessage(m, error));
-  EXPECT_NE(error.find("neither gnss nor usbl"), std::string::npos) << error;
+  sss::core::Result<AbsoluteFix> fix = fromFixMessage(m);
+  EXPECT_FALSE(fix);
+  EXPECT_NE(fix.message().find("neither gnss nor usbl"), std::string::npos) << fix.message();
   m = good;
   m.position_ne_m[0] = std::nan("");
-  EXPECT_FALSE(fromFixMessage(m, error));
-  EXPECT_NE(error.find("not finite"), std::string::npos) << error;
+  fix = fromFixMessage(m);
+  EXPECT_FALSE(fix);
+  EXPECT_NE(fix.message().find("not finite"), std::string::npos) << fix.message();
   m = good;
   m.covariance_ne_m2[1] = 5.0;  // not symmetric
-  EXPECT_FALSE(fromFixMessage(m, error));
-  EXPECT_NE(error.find("positive definite"), std::string::npos) << error;
+  fix = fromFixMessage(m);
+  EXPECT_FALSE(fix);
+  EXPECT_NE(fix.message().find("positive definite"), std::string::npos) << fix.message();
   m = good;
   m.covariance_ne_m2[0] = -1.0;
-  EXPECT_FALSE(fromFixMessage(m, error));
+  EXPECT_FALSE(fromFixMessage(m));
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 
 #include "tools/fixtures/synthetic_mission.hpp"
 #include "tests/optimiser/pose_graph_test_helpers.hpp"
+#include "tests/support/status_assertions.hpp"
 
 namespace sss::optimiser {
 namespace {
@@ -66,7 +67,7 @@ TEST(NavCorrector, AnswersWithTheGraphsCorrectionOnceThereAreNodes) {
   const synthetic::Mission mission = synthetic::makeLawnmowerMission(test_helpers::missionOptions(4));
   SlidingWindowPoseGraph graph(test_helpers::graphOptions());
   for (const synthetic::Node& n : mission.nodes) ASSERT_TRUE(graph.addNode(n.subframe_id, n.utime_us, n.dr, n.distance_m).ok);
-  for (const auto& c : mission.closures) graph.addLoopClosure(c.closure);
+  for (const auto& c : mission.closures) EXPECT_OK(graph.addLoopClosure(c.closure));
   ASSERT_TRUE(graph.optimize().ok);
   const synthetic::Node& last = mission.nodes.back();
   sss::core::NavSample nav = sampleAt(last.utime_us);

@@ -81,7 +81,8 @@ void runSteps(OptimiserEngine& engine, const Scenario& s, size_t begin, size_t e
   for (size_t i = begin; i < end; ++i) {
     const Status added = engine.addSubframe(s.subframes[i]);
     ASSERT_TRUE(added.ok) << added.message;
-    for (const sss::core::LoopClosure& c : s.closures_at[i]) engine.addLoopClosure(c);
+    // A later round of a pair whose first is marginalised is refused, as live; counted by the engine.
+    for (const sss::core::LoopClosure& c : s.closures_at[i]) static_cast<void>(engine.addLoopClosure(c));
     ASSERT_TRUE(engine.update().ok);
   }
 }
@@ -326,7 +327,8 @@ TEST(OptimiserEngineOdometer, ResetIsAcceptedWithTheStraightLineDistanceAndClosu
     } else {
       EXPECT_TRUE(added.message.empty()) << added.message;
     }
-    for (const sss::core::LoopClosure& c : s.closures_at[i]) engine.addLoopClosure(c);
+    // A later round of a pair whose first is marginalised is refused, as live; counted by the engine.
+    for (const sss::core::LoopClosure& c : s.closures_at[i]) static_cast<void>(engine.addLoopClosure(c));
     ASSERT_TRUE(engine.update().ok);
   }
   EXPECT_EQ(engine.counters().odometer_resets, 1u);

@@ -11,6 +11,7 @@
 
 #include "tools/fixtures/synthetic_mission.hpp"
 #include "tests/optimiser/pose_graph_test_helpers.hpp"
+#include "tests/support/status_assertions.hpp"
 
 namespace sss::optimiser {
 namespace {
@@ -153,7 +154,7 @@ TEST(PoseGraph, WindowStaysBoundedOverThousandsOfNodes) {
     const synthetic::Node& n = mission.nodes[i];
     ASSERT_TRUE(graph.addNode(n.subframe_id, n.utime_us, n.dr, n.distance_m).ok);
     while (next_closure < mission.closures.size() && mission.closures[next_closure].newer_node == static_cast<int>(i))
-      graph.addLoopClosure(mission.closures[next_closure++].closure);
+      EXPECT_OK(graph.addLoopClosure(mission.closures[next_closure++].closure));
     ASSERT_TRUE(graph.optimize().ok);
     if (i < 100) continue;
     const WindowStats& s = graph.windowStats();

@@ -23,6 +23,7 @@
 #include "tests/support/geotiff_read.hpp"
 #include "tools/eval/trajectory_io.hpp"
 #include "tools/process/offline_runner.hpp"
+#include "tests/support/status_assertions.hpp"
 
 namespace fs = std::filesystem;
 
@@ -194,10 +195,10 @@ TEST_F(SurveyProductsTest, CorrectedJsfCarriesSlamInEveryPingAndIsOtherwiseTheIn
     for (size_t k = 136; k < 140; ++k) allowed.insert(message.stream_offset + 16 + k);
     for (size_t k = 172; k < 178; ++k) allowed.insert(message.stream_offset + 16 + k);
     const auto decoded = sss::edgetech::decodeSonarData(message.header, message.body.data(), message.body.size());
-    ASSERT_TRUE(decoded.record) << decoded.error;
-    const auto found = slam_at.find(decoded.record->ping_time_us);
+    ASSERT_OK(decoded);
+    const auto found = slam_at.find(decoded->ping_time_us);
     ASSERT_NE(found, slam_at.end()) << "a ping time slam.tum does not have";
-    const auto& r = *decoded.record;
+    const auto& r = *decoded;
     const Eigen::Vector3d read_back = frame.toNed({r.latitude_deg, r.longitude_deg, r.depth_m});
     worst_horizontal_m = std::max(worst_horizontal_m, (read_back - found->second.translation).head<2>().norm());
     worst_depth_m = std::max(worst_depth_m, std::abs(read_back.z() - found->second.translation.z()));

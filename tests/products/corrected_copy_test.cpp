@@ -19,6 +19,7 @@
 #include "drivers/xtf/xtf_reader.hpp"
 #include "drivers/xtf/xtf_writer.hpp"
 #include "products/corrected_copy.hpp"
+#include "tests/support/status_assertions.hpp"
 
 namespace fs = std::filesystem;
 
@@ -97,12 +98,11 @@ TEST_F(CorrectedCopyTest, JsfPingsCarryTheNewNavigationAndNothingElseChanges) {
   writeBytes(in, file);
 
   CorrectedCopyCounters counters;
-  std::string error;
   const auto navigation = [](int64_t t) -> std::optional<PingNavigation> {
     if (t >= kStartUs + 19 * 250000LL) return std::nullopt;  // the last ping has no pose
     return correctedAt(t, false);
   };
-  ASSERT_TRUE(writeCorrectedJsf(in, out, navigation, counters, error)) << error;
+  ASSERT_OK(writeCorrectedJsf(in, out, navigation, counters));
   EXPECT_EQ(counters.records_corrected, 38u);
   EXPECT_EQ(counters.records_without_pose, 2u);
 
@@ -114,8 +114,8 @@ TEST_F(CorrectedCopyTest, JsfPingsCarryTheNewNavigationAndNothingElseChanges) {
   while (reader.next(message)) {
     if (message.header.message_type != sss::edgetech::kJsfSonarData) continue;
     const auto decoded = sss::edgetech::decodeSonarData(message.header, message.body.data(), message.body.size());
-    ASSERT_TRUE(decoded.record) << decoded.error;
-    const auto& r = *decoded.record;
+    ASSERT_OK(decoded);
+    const auto& r = *decoded;
     ++pings;
     if (r.ping_number == 19) {
       EXPECT_NEAR(r.latitude_deg, 59.35 + 19 * 2.5e-6, 1e-6) << "no pose: left as recorded";
@@ -190,10 +190,7 @@ TEST_F(CorrectedCopyTest, XtfPingsInProjectedMetresCarryTheNewGridPosition) {
     }
   }
   CorrectedCopyCounters counters;
-  std::string error;
-  ASSERT_TRUE(writeCorrectedXtf(in, out, [](int64_t t) { return std::optional(correctedAt(t, true)); }, counters,
-                                error))
-      << error;
+  ASSERT_OK(writeCorrectedXtf(in, out, [](int64_t t) { return std::optional(correctedAt(t, true)); }, counters));
   EXPECT_EQ(counters.records_corrected, 12u);
   EXPECT_EQ(counters.records_without_pose, 0u);
 
@@ -235,15 +232,17 @@ TEST_F(CorrectedCopyTest, XtfPingsInProjectedMetresCarryTheNewGridPosition) {
 
 TEST_F(CorrectedCopyTest, UnreadableInputOrTheInputItselfAsOutputAreRefused) {
   CorrectedCopyCounters counters;
-  std::string error;
   const auto navigation = [](int64_t t) { return std::optional(correctedAt(t, false)); };
-  EXPECT_FALSE(writeCorrectedJsf(dir_ + "/missing.jsf", dir_ + "/out/missing.jsf", navigation, counters, error));
-  EXPECT_NE(error.find("missing.jsf"), std::string::npos) << error;
+  const sss::core::Status missing =
+      writeCorrectedJsf(dir_ + "/missing.jsf", dir_ + "/out/missing.jsf", navigation, counters);
+  EXPECT_FALSE(missing.ok);
+  EXPECT_NE(missing.message.find("missing.jsf"), std::string::npos) << missing.message;
   writeBytes(dir_ + "/tiny.jsf", {1, 2, 3});
-  EXPECT_FALSE(writeCorrectedJsf(dir_ + "/tiny.jsf", dir_ + "/tiny.jsf", navigation, counters, error));
-  EXPECT_NE(error.find("would overwrite its input"), std::string::npos) << error;
+  const sss::core::Status onto_itself = writeCorrectedJsf(dir_ + "/tiny.jsf", dir_ + "/tiny.jsf", navigation, counters);
+  EXPECT_FALSE(onto_itself.ok);
+  EXPECT_NE(onto_itself.message.find("would overwrite its input"), std::string::npos) << onto_itself.message;
   EXPECT_EQ(readBytes(dir_ + "/tiny.jsf"), (std::vector<uint8_t>{1, 2, 3}));
-  EXPECT_FALSE(writeCorrectedXtf(dir_ + "/tiny.jsf", dir_ + "/out/tiny.xtf", navigation, counters, error));
+  EXPECT_FALSE(writeCorrectedXtf(dir_ + "/tiny.jsf", dir_ + "/out/tiny.xtf", navigation, counters).ok);
   EXPECT_FALSE(fs::exists(dir_ + "/out/tiny.xtf"));
 }
 

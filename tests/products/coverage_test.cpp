@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "products/coverage.hpp"
+#include "tests/support/status_assertions.hpp"
 
 namespace sss::products {
 namespace {
@@ -49,15 +50,15 @@ TEST(Coverage, FilesAreWrittenAndNothingIsAnError) {
   const CoverageGrid grid = computeCoverage({strip(0, -50.0, 50.0), strip(1, 0.0, 100.0)}, 5.0);
   const std::string dir = (std::filesystem::temp_directory_path() / "sss_coverage_test").string();
   std::filesystem::create_directories(dir);
-  std::string error;
-  ASSERT_TRUE(writeCoverageFiles(dir + "/coverage.yaml", grid, error, sss::core::MissionOrigin{59.35, 18.07})) << error;
+  ASSERT_OK(writeCoverageFiles(dir + "/coverage.yaml", grid, sss::core::MissionOrigin{59.35, 18.07}));
   EXPECT_EQ(std::filesystem::file_size(dir + "/coverage_lines.u8"), grid.lines.size());
   EXPECT_TRUE(std::filesystem::is_regular_file(dir + "/coverage.png"));
   std::filesystem::remove_all(dir);
   const CoverageGrid empty = computeCoverage({}, 5.0);
   EXPECT_EQ(empty.rows, 0);
-  EXPECT_FALSE(writeCoverageFiles(dir + "/none.yaml", empty, error, std::nullopt));
-  EXPECT_NE(error.find("no cells"), std::string::npos) << error;
+  const sss::core::Status nothing = writeCoverageFiles(dir + "/none.yaml", empty, std::nullopt);
+  EXPECT_FALSE(nothing.ok);
+  EXPECT_NE(nothing.message.find("no cells"), std::string::npos) << nothing.message;
 }
 
 }  // namespace

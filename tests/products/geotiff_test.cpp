@@ -15,6 +15,7 @@
 #include "products/mosaic_products.hpp"
 #include "products/survey_rasters.hpp"
 #include "tests/support/geotiff_read.hpp"
+#include "tests/support/status_assertions.hpp"
 
 namespace fs = std::filesystem;
 
@@ -83,10 +84,9 @@ TEST_F(GeoTiffTest, DepthRasterLandsInTheOriginsUtmZoneWithKnownCellsAtTheirTrue
   raster.description = "test depth";
   RasterFrame frame;
   frame.origin = origin;
-  std::string error;
   GeoTiffInfo info;
   const std::string path = dir_ + "/depth.tif";
-  ASSERT_TRUE(writeGeoTiff(path, raster, frame, error, &info)) << error;
+  ASSERT_OK(writeGeoTiff(path, raster, frame, &info));
   EXPECT_EQ(info.epsg, 32634);
   EXPECT_EQ(info.crs_name, "WGS 84 / UTM zone 34N");
   EXPECT_EQ(info.overview_count, 0) << "small rasters need no overviews";
@@ -145,9 +145,8 @@ TEST_F(GeoTiffTest, SouthernHemisphereMosaicIsEightBitWithZeroAsNoData) {
   RasterFrame frame;
   frame.origin = origin;
   const FrameRaster raster = blockRaster(RasterType::kByte, 50, 60, 0.25, blocks);
-  std::string error;
   const std::string path = dir_ + "/mosaic.tif";
-  ASSERT_TRUE(writeGeoTiff(path, raster, frame, error)) << error;
+  ASSERT_OK(writeGeoTiff(path, raster, frame));
   const auto back = sss::test::readGeoTiff(path);
   ASSERT_TRUE(back.ok) << back.error;
   EXPECT_EQ(back.epsg, 32756);
@@ -172,9 +171,8 @@ TEST_F(GeoTiffTest, ProjectedGridKeepsTheFilesCoordinatesAndTheNamedCrs) {
   frame.grid_easting_offset_m = 652000.0;
   frame.grid_northing_offset_m = 6580000.0;
   frame.projected_crs = "EPSG:32633";
-  std::string error;
   GeoTiffInfo info;
-  ASSERT_TRUE(writeGeoTiff(dir_ + "/grid.tif", raster, frame, error, &info)) << error;
+  ASSERT_OK(writeGeoTiff(dir_ + "/grid.tif", raster, frame, &info));
   EXPECT_EQ(info.crs_name, "WGS 84 / UTM zone 33N");
   EXPECT_EQ(info.epsg, 32633);
   auto back = sss::test::readGeoTiff(dir_ + "/grid.tif");
@@ -190,7 +188,7 @@ TEST_F(GeoTiffTest, ProjectedGridKeepsTheFilesCoordinatesAndTheNamedCrs) {
 
   // Without a CRS the grid's coordinates are still there, and the file has no CRS (not a guess).
   frame.projected_crs.clear();
-  ASSERT_TRUE(writeGeoTiff(dir_ + "/grid_no_crs.tif", raster, frame, error, &info)) << error;
+  ASSERT_OK(writeGeoTiff(dir_ + "/grid_no_crs.tif", raster, frame, &info));
   EXPECT_EQ(info.crs_name, "");
   EXPECT_EQ(info.epsg, 0);
   back = sss::test::readGeoTiff(dir_ + "/grid_no_crs.tif");
@@ -204,40 +202,53 @@ TEST_F(GeoTiffTest, LargeRastersGetOverviews) {
   for (size_t i = 0; i < raster.values.size(); i += 3) raster.values[i] = 90.0f;
   RasterFrame frame;
   frame.origin = sss::core::MissionOrigin{59.35, 18.07};
-  std::string error;
   GeoTiffInfo info;
-  ASSERT_TRUE(writeGeoTiff(dir_ + "/large.tif", raster, frame, error, &info)) << error;
+  ASSERT_OK(writeGeoTiff(dir_ + "/large.tif", raster, frame, &info));
   EXPECT_EQ(info.overview_count, 2) << "1500+ px: 2x and 4x (the next, 8x, would be under 256 px)";
   EXPECT_EQ(sss::test::readGeoTiff(dir_ + "/large.tif").overviews, 2);
 }
 
 TEST_F(GeoTiffTest, ProblemsAreNamedNotCrashes) {
   const FrameRaster raster = blockRaster(RasterType::kFloat32, 10, 10, 1.0, {{5, 5, 1.0f}});
-  std::string error;
   RasterFrame nowhere;
-  EXPECT_FALSE(writeGeoTiff(dir_ + "/a.tif", raster, nowhere, error));
-  EXPECT_NE(error.find("no origin on Earth"), std::string::npos) << error;
+  {
+    const sss::core::Status status = writeGeoTiff(dir_ + "/a.tif", raster, nowhere);
+    EXPECT_FALSE(status.ok);
+    EXPECT_NE(status.message.find("no origin on Earth"), std::string::npos) << status.message;
+  }
 
-  EXPECT_TRUE(isKnownCrs("EPSG:32633", error));
-  EXPECT_TRUE(isKnownCrs("+proj=utm +zone=33 +datum=WGS84", error));
-  EXPECT_FALSE(isKnownCrs("EPSG:not-a-code", error));
-  EXPECT_NE(error.find("use e.g. EPSG:32633"), std::string::npos) << error;
+  EXPECT_OK(isKnownCrs("EPSG:32633"));
+  EXPECT_OK(isKnownCrs("+proj=utm +zone=33 +datum=WGS84"));
+  {
+    const sss::core::Status status = isKnownCrs("EPSG:not-a-code");
+    EXPECT_FALSE(status.ok);
+    EXPECT_NE(status.message.find("use e.g. EPSG:32633"), std::string::npos) << status.message;
+  }
 
   RasterFrame bad_crs;
   bad_crs.projected = true;
   bad_crs.projected_crs = "EPSG:not-a-code";
-  EXPECT_FALSE(writeGeoTiff(dir_ + "/b.tif", raster, bad_crs, error));
-  EXPECT_NE(error.find("products.projected_crs 'EPSG:not-a-code'"), std::string::npos) << error;
+  {
+    const sss::core::Status status = writeGeoTiff(dir_ + "/b.tif", raster, bad_crs);
+    EXPECT_FALSE(status.ok);
+    EXPECT_NE(status.message.find("products.projected_crs 'EPSG:not-a-code'"), std::string::npos) << status.message;
+  }
 
   RasterFrame frame;
   frame.origin = sss::core::MissionOrigin{59.35, 18.07};
-  EXPECT_FALSE(writeGeoTiff(dir_ + "/no/such/folder/c.tif", raster, frame, error));
-  EXPECT_NE(error.find("c.tif"), std::string::npos) << error;
+  {
+    const sss::core::Status status = writeGeoTiff(dir_ + "/no/such/folder/c.tif", raster, frame);
+    EXPECT_FALSE(status.ok);
+    EXPECT_NE(status.message.find("c.tif"), std::string::npos) << status.message;
+  }
 
   FrameRaster inconsistent = raster;
   inconsistent.values.pop_back();
-  EXPECT_FALSE(writeGeoTiff(dir_ + "/d.tif", inconsistent, frame, error));
-  EXPECT_NE(error.find("inconsistent raster"), std::string::npos) << error;
+  {
+    const sss::core::Status status = writeGeoTiff(dir_ + "/d.tif", inconsistent, frame);
+    EXPECT_FALSE(status.ok);
+    EXPECT_NE(status.message.find("inconsistent raster"), std::string::npos) << status.message;
+  }
 }
 
 TEST(SurveyRasters, HeightmapCellCentresAndMosaicEdgesBecomeTheRightGeotransform) {

@@ -4,6 +4,7 @@
 #include "pipeline/core/mission_origin.hpp"
 
 #include "drivers/edgetech/jsf_format.hpp"
+#include "tests/support/status_assertions.hpp"
 
 #include <gtest/gtest.h>
 #include <omp.h>
@@ -53,13 +54,12 @@ T readLe(const std::string& bytes, size_t offset) {
 
 TEST(Mission, SameSeedGivesSameBytesOnAnyThreadCountDifferentSeedDiffers) {
   const std::string a = tempDir("a"), b = tempDir("b"), c = tempDir("c");
-  std::string error;
   MissionReport report;
   omp_set_num_threads(1);
-  ASSERT_TRUE(writeMission(Mission(shortMission(5)), a, report, error)) << error;
+  ASSERT_OK(writeMission(Mission(shortMission(5)), a, report));
   omp_set_num_threads(2);
-  ASSERT_TRUE(writeMission(Mission(shortMission(5)), b, report, error)) << error;
-  ASSERT_TRUE(writeMission(Mission(shortMission(6)), c, report, error)) << error;
+  ASSERT_OK(writeMission(Mission(shortMission(5)), b, report));
+  ASSERT_OK(writeMission(Mission(shortMission(6)), c, report));
   for (const char* file : {"sonar.jsf", "ground_truth.tum", "dead_reckoning.tum", "ins.nmea", "seabed_depth.f32",
                            "seabed_reflectivity.f32", "waterfall_line_00.png", "mosaic.png"}) {
     const std::string bytes_a = readFile(a + "/" + file);
@@ -103,10 +103,10 @@ TEST(Mission, JsfSonarDataFieldsAtExactOffsets) {
     const std::optional<edgetech::JsfMessageHeader> header =
         edgetech::decodeHeader(reinterpret_cast<const uint8_t*>(bytes.data() + base));
     ASSERT_TRUE(header.has_value());
-    const edgetech::SonarDecodeResult decoded =
+    const sss::core::Result<edgetech::SonarChannelRecord> decoded =
         edgetech::decodeSonarData(*header, reinterpret_cast<const uint8_t*>(bytes.data() + h), message_size - 16);
-    ASSERT_TRUE(decoded.record.has_value()) << decoded.error;
-    const edgetech::SonarChannelRecord& record = *decoded.record;
+    ASSERT_OK(decoded);
+    const edgetech::SonarChannelRecord& record = *decoded;
     EXPECT_EQ(record.ping_number, ping);
     EXPECT_EQ(record.channel, channel);
     EXPECT_EQ(record.ping_time_us / 1000, utime / 1000);  // JSF carries milliseconds
@@ -131,8 +131,7 @@ TEST(Mission, OutputsHaveOneTumLinePerPingAndAConsistentSeabedRaster) {
   const std::string dir = tempDir("outputs");
   const Mission mission(shortMission(3));
   MissionReport report;
-  std::string error;
-  ASSERT_TRUE(writeMission(mission, dir, report, error)) << error;
+  ASSERT_OK(writeMission(mission, dir, report));
   std::istringstream tum(readFile(dir + "/ground_truth.tum"));
   // The first line names the frame's origin (sss-eval re-expresses runs with another origin).
   std::string header;

@@ -77,11 +77,10 @@ class SubframeBufferServiceTest : public ::testing::Test {
     return o;
   }
   static long long savedNextSubframeId(const std::string& path) {
-    sss::core::StateValues values;
-    std::string error;
+    const sss::core::Result<sss::core::StateValues> read =
+        sss::core::readStateFile(path, SubframeBufferService::kNumberingFormat);
     long long id = -1;
-    if (!sss::core::readStateFile(path, SubframeBufferService::kNumberingFormat, values, error) ||
-        !sss::core::stateInteger(values, "next_subframe_id", id))
+    if (!read || !sss::core::stateInteger(*read, "next_subframe_id", id))
       return -1;
     return id;
   }

@@ -43,10 +43,9 @@ TEST(SubframeChain, SimulatedMissionThroughDriverBridgeAndBufferProcesses) {
   std::vector<sss::core::Subframe> subframes;
   int decode_failures = 0;
   bus.subscribe<sss_msgs::subframe_t>("SSS_SUBFRAME", [&](const sss_msgs::subframe_t& message) {
-    sss::core::Subframe subframe;
-    std::string error;
-    if (sss::messages::fromSubframeMessage(message, subframe, error)) {
-      subframes.push_back(std::move(subframe));
+    sss::core::Result<sss::core::Subframe> subframe = sss::messages::fromSubframeMessage(message);
+    if (subframe) {
+      subframes.push_back(std::move(subframe).value());
     } else {
       ++decode_failures;
     }

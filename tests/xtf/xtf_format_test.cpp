@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "tests/support/status_assertions.hpp"
 #include "tests/xtf/xtf_test_data.hpp"
 
 namespace sss {
@@ -14,9 +15,9 @@ namespace {
 TEST(XtfFormat, ParsesFileHeaderChannels) {
   const xtf::XtfWriterOptions options = test::makeXtfOptions({100.0f, 400.0f}, 1, xtf::kNavUnitsMetres);
   const std::vector<uint8_t> bytes = xtf::encodeFileHeader(options);
-  std::string error;
-  const xtf::XtfFileInfo info = xtf::parseFileHeader(bytes.data(), bytes.size(), error);
-  ASSERT_TRUE(error.empty()) << error;
+  const sss::core::Result<xtf::XtfFileInfo> header = xtf::parseFileHeader(bytes.data(), bytes.size());
+  ASSERT_OK(header);
+  const xtf::XtfFileInfo& info = *header;
   EXPECT_EQ(info.nav_units, xtf::kNavUnitsMetres);
   ASSERT_EQ(info.channels.size(), 4u);
   EXPECT_EQ(info.channels[2].type_of_channel, xtf::kChannelPort);
@@ -28,26 +29,29 @@ TEST(XtfFormat, ParsesFileHeaderChannels) {
 
 TEST(XtfFormat, RejectsWhatIsNoXtfHeader) {
   std::vector<uint8_t> bytes(1024, 0);
-  std::string error;
-  xtf::parseFileHeader(bytes.data(), bytes.size(), error);
-  EXPECT_NE(error.find("0x7B"), std::string::npos);
-  xtf::parseFileHeader(bytes.data(), 100, error);
-  EXPECT_FALSE(error.empty());
+  const sss::core::Result<xtf::XtfFileInfo> zeros = xtf::parseFileHeader(bytes.data(), bytes.size());
+  EXPECT_FALSE(zeros.ok());
+  EXPECT_NE(zeros.message().find("0x7B"), std::string::npos);
+  const sss::core::Result<xtf::XtfFileInfo> short_header = xtf::parseFileHeader(bytes.data(), 100);
+  EXPECT_FALSE(short_header.ok());
+  EXPECT_FALSE(short_header.message().empty());
   bytes[0] = 0x7B;
   bytes[166] = 0xFF;  // 255 sonar channels
-  xtf::parseFileHeader(bytes.data(), bytes.size(), error);
-  EXPECT_NE(error.find("corrupt"), std::string::npos);
+  const sss::core::Result<xtf::XtfFileInfo> corrupt = xtf::parseFileHeader(bytes.data(), bytes.size());
+  EXPECT_FALSE(corrupt.ok());
+  EXPECT_NE(corrupt.message().find("corrupt"), std::string::npos);
 }
 
 TEST(XtfFormat, EightChannelHeaderNeedsTwoBlocks) {
   const xtf::XtfWriterOptions options = test::makeXtfOptions({100.0f, 200.0f, 300.0f, 400.0f}, 2);
   const std::vector<uint8_t> bytes = xtf::encodeFileHeader(options);
   EXPECT_EQ(xtf::requiredHeaderBytes(bytes.data(), 1024), 2048u);
-  std::string error;
-  xtf::parseFileHeader(bytes.data(), 1024, error);
-  EXPECT_NE(error.find("2048"), std::string::npos);
-  const xtf::XtfFileInfo info = xtf::parseFileHeader(bytes.data(), bytes.size(), error);
-  ASSERT_TRUE(error.empty()) << error;
+  const sss::core::Result<xtf::XtfFileInfo> first_block = xtf::parseFileHeader(bytes.data(), 1024);
+  EXPECT_FALSE(first_block.ok());
+  EXPECT_NE(first_block.message().find("2048"), std::string::npos);
+  const sss::core::Result<xtf::XtfFileInfo> header = xtf::parseFileHeader(bytes.data(), bytes.size());
+  ASSERT_OK(header);
+  const xtf::XtfFileInfo& info = *header;
   ASSERT_EQ(info.channels.size(), 8u);
   EXPECT_FLOAT_EQ(info.channels[7].frequency, 400.0f);
 }
@@ -55,9 +59,10 @@ TEST(XtfFormat, EightChannelHeaderNeedsTwoBlocks) {
 TEST(XtfFormat, PairsOrderedByFrequency) {
   // High-frequency pair first in the file: pair 0 must still be the low one.
   const xtf::XtfWriterOptions options = test::makeXtfOptions({410.0f, 120.0f}, 1);
-  std::string error;
   const std::vector<uint8_t> bytes = xtf::encodeFileHeader(options);
-  const std::vector<xtf::ChannelPair> pairs = xtf::sideScanPairs(xtf::parseFileHeader(bytes.data(), bytes.size(), error));
+  const sss::core::Result<xtf::XtfFileInfo> header = xtf::parseFileHeader(bytes.data(), bytes.size());
+  ASSERT_OK(header);
+  const std::vector<xtf::ChannelPair> pairs = xtf::sideScanPairs(*header);
   ASSERT_EQ(pairs.size(), 2u);
   EXPECT_EQ(pairs[0].port, 2);
   EXPECT_EQ(pairs[0].starboard, 3);
@@ -143,8 +148,10 @@ xtf::SonarDecodeResult decodeOne(float sound_velocity, float slant_range_m, floa
   }
   const std::vector<uint8_t> header = xtf::encodeFileHeader(options);
   const std::vector<uint8_t> packet = xtf::encodeSonarPacket(options, input);
-  std::string error;
-  const xtf::XtfFileInfo info = xtf::parseFileHeader(header.data(), header.size(), error);
+  const sss::core::Result<xtf::XtfFileInfo> parsed = xtf::parseFileHeader(header.data(), header.size());
+  EXPECT_OK(parsed);
+  if (!parsed) return {};
+  const xtf::XtfFileInfo& info = *parsed;
   xtf::SonarDecodeOptions decode;
   decode.port_channel = 0;
   decode.starboard_channel = 1;

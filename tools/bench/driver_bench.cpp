@@ -104,9 +104,8 @@ int main(int argc, char** argv) {
   sss::emulators::StreamServerOptions sonar_options;
   sonar_options.port = 0;
   sss::emulators::TcpStreamServer sonar_server(sonar_options, sonar_chunks);
-  std::string error;
-  if (!sonar_server.listen(error)) {
-    std::fprintf(stderr, "%s\n", error.c_str());
+  if (const sss::core::Status listening = sonar_server.listen(); !listening) {
+    std::fprintf(stderr, "%s\n", listening.message.c_str());
     return 1;
   }
   std::mutex sent_mutex;
@@ -149,8 +148,7 @@ int main(int argc, char** argv) {
   ins_options.port = udp_port;
   sss::emulators::UdpStreamSender ins_sender(ins_options, ins_chunks);
   std::thread ins_thread([&] {
-    std::string send_error;
-    ins_sender.run(stop, send_error);
+    if (const sss::core::Status sent = ins_sender.run(stop); !sent) std::fprintf(stderr, "%s\n", sent.message.c_str());
   });
   const int64_t end = run_start + static_cast<int64_t>((seconds + 1.0) * 1e6);
   while (sss::core::monotonicUtime() < end) bus.handleTimeout(20);

@@ -36,7 +36,7 @@ void feedInChunks(const std::vector<uint8_t>& stream, bool decode, benchmark::St
       parser.feed(stream.data() + offset, std::min<size_t>(65536, stream.size() - offset), messages);
       if (decode) {
         for (const auto& m : messages) {
-          decoded += sss::edgetech::decodeSonarData(m.header, m.body.data(), m.body.size()).record ? 1 : 0;
+          decoded += sss::edgetech::decodeSonarData(m.header, m.body.data(), m.body.size()).ok() ? 1 : 0;
         }
       }
       messages.clear();

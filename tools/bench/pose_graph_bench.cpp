@@ -95,9 +95,17 @@ int main(int argc, char** argv) {
   const size_t report_every = std::max<size_t>(1, mission.nodes.size() / 8);
   for (size_t i = 0; i < mission.nodes.size(); ++i) {
     const synthetic::Node& n = mission.nodes[i];
-    graph.addNode(n.subframe_id, n.utime_us, n.dr, n.distance_m);
-    while (next_closure < mission.closures.size() && mission.closures[next_closure].newer_node == static_cast<int>(i))
-      graph.addLoopClosure(mission.closures[next_closure++].closure);
+    if (const Status added = graph.addNode(n.subframe_id, n.utime_us, n.dr, n.distance_m); !added.ok) {
+      std::fprintf(stderr, "%s\n", added.message.c_str());
+      return 1;
+    }
+    while (next_closure < mission.closures.size() && mission.closures[next_closure].newer_node == static_cast<int>(i)) {
+      const Status added = graph.addLoopClosure(mission.closures[next_closure++].closure);
+      if (!added.ok) {
+        std::fprintf(stderr, "%s\n", added.message.c_str());
+        return 1;
+      }
+    }
     const UpdateReport report = graph.optimize();
     update_s.push_back(report.update_s);
     solve_s.push_back(report.solve_s);

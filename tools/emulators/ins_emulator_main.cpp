@@ -38,24 +38,25 @@ int main(int argc, char** argv) {
   if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
-  std::string error;
-  std::vector<sss::emulators::TimedChunk> chunks = sss::emulators::loadInsChunks(file, error);
-  if (!error.empty() || chunks.empty()) {
-    std::fprintf(stderr, "sss-ins-emulator: %s\n", error.empty() ? "no NMEA bursts in the file" : error.c_str());
+  sss::core::Result<std::vector<sss::emulators::TimedChunk>> loaded = sss::emulators::loadInsChunks(file);
+  if (!loaded || loaded->empty()) {
+    std::fprintf(stderr, "sss-ins-emulator: %s\n", loaded ? "no NMEA bursts in the file" : loaded.message().c_str());
     return 1;
   }
+  std::vector<sss::emulators::TimedChunk> chunks = std::move(*loaded);
   std::printf("sss-ins-emulator: %zu bursts from %s %s %s:%d at speed %g\n", chunks.size(), file.c_str(),
               tcp ? "served on" : "sent to", options.bind_address.c_str(), options.port, options.speed);
   // Fixes: their own sender, paced from the INS stream's first epoch so both keep the mission's time.
   std::thread fixes_thread;
   std::string fixes_error;
   if (!fixes_file.empty()) {
-    std::vector<sss::emulators::TimedChunk> fix_chunks =
-        sss::emulators::loadFixChunks(fixes_file, chunks.front().time_us, error);
-    if (!error.empty()) {
-      std::fprintf(stderr, "sss-ins-emulator: %s\n", error.c_str());
+    sss::core::Result<std::vector<sss::emulators::TimedChunk>> fixes_loaded =
+        sss::emulators::loadFixChunks(fixes_file, chunks.front().time_us);
+    if (!fixes_loaded) {
+      std::fprintf(stderr, "sss-ins-emulator: %s\n", fixes_loaded.message().c_str());
       return 1;
     }
+    std::vector<sss::emulators::TimedChunk> fix_chunks = std::move(*fixes_loaded);
     sss::emulators::StreamServerOptions fix_options;
     fix_options.bind_address = options.bind_address;
     fix_options.port = fixes_port;
@@ -65,23 +66,23 @@ int main(int argc, char** argv) {
                 options.bind_address.c_str(), fixes_port);
     fixes_thread = std::thread([fix_options, fix_chunks = std::move(fix_chunks), &fixes_error]() mutable {
       sss::emulators::UdpStreamSender sender(fix_options, std::move(fix_chunks));
-      sender.run(g_stop, fixes_error);
+      if (const sss::core::Status sent = sender.run(g_stop); !sent) fixes_error = sent.message;
     });
   }
   std::fflush(stdout);
   sss::emulators::StreamStats stats;
   if (tcp) {
     sss::emulators::TcpStreamServer server(options, std::move(chunks));
-    if (!server.listen(error)) {
-      std::fprintf(stderr, "sss-ins-emulator: %s\n", error.c_str());
+    if (const sss::core::Status listening = server.listen(); !listening) {
+      std::fprintf(stderr, "sss-ins-emulator: %s\n", listening.message.c_str());
       return 1;
     }
     server.run(g_stop);
     stats = server.stats();
   } else {
     sss::emulators::UdpStreamSender sender(options, std::move(chunks));
-    if (!sender.run(g_stop, error)) {
-      std::fprintf(stderr, "sss-ins-emulator: %s\n", error.c_str());
+    if (const sss::core::Status sent = sender.run(g_stop); !sent) {
+      std::fprintf(stderr, "sss-ins-emulator: %s\n", sent.message.c_str());
       return 1;
     }
     stats = sender.stats();

@@ -11,13 +11,10 @@
 
 namespace sss::emulators {
 
-std::vector<TimedChunk> loadJsfChunks(const std::string& path, std::string& error) {
+sss::core::Result<std::vector<TimedChunk>> loadJsfChunks(const std::string& path) {
   std::vector<TimedChunk> chunks;
   sss::edgetech::JsfFileReader reader(path);
-  if (!reader.isOpen()) {
-    error = reader.error();
-    return chunks;
-  }
+  if (!reader.isOpen()) return sss::core::Status::error(reader.error());
   sss::edgetech::JsfMessage message;
   int64_t last_time_us = 0;
   while (reader.next(message)) {
@@ -27,7 +24,7 @@ std::vector<TimedChunk> loadJsfChunks(const std::string& path, std::string& erro
     chunk.bytes.insert(chunk.bytes.end(), message.body.begin(), message.body.end());
     if (message.header.message_type == sss::edgetech::kJsfSonarData) {
       const auto decoded = sss::edgetech::decodeSonarData(message.header, message.body.data(), message.body.size());
-      if (decoded.record) last_time_us = decoded.record->ping_time_us;
+      if (decoded) last_time_us = decoded->ping_time_us;
     }
     chunk.time_us = last_time_us;  // other types go out with the ping before them
     chunks.push_back(std::move(chunk));
@@ -35,13 +32,10 @@ std::vector<TimedChunk> loadJsfChunks(const std::string& path, std::string& erro
   return chunks;
 }
 
-std::vector<TimedChunk> loadInsChunks(const std::string& path, std::string& error) {
+sss::core::Result<std::vector<TimedChunk>> loadInsChunks(const std::string& path) {
   std::vector<TimedChunk> chunks;
   std::ifstream file(path);
-  if (!file) {
-    error = "cannot open INS file '" + path + "'";
-    return chunks;
-  }
+  if (!file) return sss::core::Status::error("cannot open INS file '" + path + "'");
   sss::ins::InsStateAssembler assembler;
   TimedChunk pending;
   int64_t last_time_us = 0;
@@ -71,11 +65,10 @@ std::vector<TimedChunk> loadInsChunks(const std::string& path, std::string& erro
   return chunks;
 }
 
-std::vector<TimedChunk> loadFixChunks(const std::string& path, int64_t reference_utime_us, std::string& error) {
-  std::vector<sss::ins::PositionFix> fixes;
-  sss::ins::FixReaderCounters counters;
-  std::string problem;
-  if (!sss::ins::readPositionFixFile(path, sss::ins::FixReaderOptions{}, fixes, counters, problem, error)) return {};
+sss::core::Result<std::vector<TimedChunk>> loadFixChunks(const std::string& path, int64_t reference_utime_us) {
+  sss::core::Result<sss::ins::FixFileContents> read = sss::ins::readPositionFixFile(path, sss::ins::FixReaderOptions{});
+  if (!read) return read.status();
+  std::vector<sss::ins::PositionFix>& fixes = read->fixes;
   sss::ins::resolveFixDates(fixes, reference_utime_us);
   std::vector<TimedChunk> chunks;
   for (const sss::ins::PositionFix& fix : fixes) {

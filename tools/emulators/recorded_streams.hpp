@@ -6,17 +6,18 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/core/status.hpp"
 #include "tools/emulators/stream_server.hpp"
 
 namespace sss::emulators {
 
-// Every framed message of a .jsf file, re-encoded byte for byte; error set when unreadable.
-std::vector<TimedChunk> loadJsfChunks(const std::string& path, std::string& error);
+// Every framed message of a .jsf file, re-encoded byte for byte; fails when the file is unreadable.
+sss::core::Result<std::vector<TimedChunk>> loadJsfChunks(const std::string& path);
 // The NMEA lines of an INS file grouped into bursts ending with $PIXSE,STATUS (the iXblue
 // output period), each stamped with the epoch time the INS assembler reads from it.
-std::vector<TimedChunk> loadInsChunks(const std::string& path, std::string& error);
+sss::core::Result<std::vector<TimedChunk>> loadInsChunks(const std::string& path);
 // The absolute fixes of a fixes.nmea file (sss-sim), one chunk per fix (ZDA + GGA + GST, re-encoded;
 // GNSS talker GP, USBL II), stamped with its time; fixes without a date take reference_utime_us's day.
-std::vector<TimedChunk> loadFixChunks(const std::string& path, int64_t reference_utime_us, std::string& error);
+sss::core::Result<std::vector<TimedChunk>> loadFixChunks(const std::string& path, int64_t reference_utime_us);
 
 }  // namespace sss::emulators

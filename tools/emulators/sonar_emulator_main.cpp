@@ -26,16 +26,16 @@ int main(int argc, char** argv) {
   if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
-  std::string error;
-  std::vector<sss::emulators::TimedChunk> chunks = sss::emulators::loadJsfChunks(file, error);
-  if (!error.empty() || chunks.empty()) {
-    std::fprintf(stderr, "sss-sonar-emulator: %s\n", error.empty() ? "no JSF messages in the file" : error.c_str());
+  const sss::core::Result<std::vector<sss::emulators::TimedChunk>> loaded = sss::emulators::loadJsfChunks(file);
+  if (!loaded || loaded->empty()) {
+    std::fprintf(stderr, "sss-sonar-emulator: %s\n", loaded ? "no JSF messages in the file" : loaded.message().c_str());
     return 1;
   }
+  const std::vector<sss::emulators::TimedChunk>& chunks = *loaded;
   do {
     sss::emulators::TcpStreamServer server(options, chunks);
-    if (!server.listen(error)) {
-      std::fprintf(stderr, "sss-sonar-emulator: %s\n", error.c_str());
+    if (const sss::core::Status listening = server.listen(); !listening) {
+      std::fprintf(stderr, "sss-sonar-emulator: %s\n", listening.message.c_str());
       return 1;
     }
     std::printf("sss-sonar-emulator: %zu messages from %s on %s:%d at speed %g\n", chunks.size(), file.c_str(),

@@ -105,7 +105,7 @@ TcpStreamServer::~TcpStreamServer() {
   if (listen_fd_ >= 0) ::close(listen_fd_);
 }
 
-bool TcpStreamServer::listen(std::string& error) {
+sss::core::Status TcpStreamServer::listen() {
   listen_fd_ = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
   const int one = 1;
   ::setsockopt(listen_fd_, SOL_SOCKET, SO_REUSEADDR, &one, sizeof(one));
@@ -113,17 +113,16 @@ bool TcpStreamServer::listen(std::string& error) {
   address.sin_family = AF_INET;
   address.sin_port = htons(static_cast<uint16_t>(options_.port));
   if (::inet_pton(AF_INET, options_.bind_address.c_str(), &address.sin_addr) != 1) {
-    error = "bad bind address '" + options_.bind_address + "'";
-    return false;
+    return sss::core::Status::error("bad bind address '" + options_.bind_address + "'");
   }
   if (::bind(listen_fd_, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0 || ::listen(listen_fd_, 4) != 0) {
-    error = "cannot listen on " + options_.bind_address + ":" + std::to_string(options_.port) + ": " + std::strerror(errno);
-    return false;
+    return sss::core::Status::error("cannot listen on " + options_.bind_address + ":" + std::to_string(options_.port) +
+                                    ": " + std::strerror(errno));
   }
   socklen_t length = sizeof(address);
   ::getsockname(listen_fd_, reinterpret_cast<sockaddr*>(&address), &length);
   port_ = ntohs(address.sin_port);
-  return true;
+  return sss::core::Status::success();
 }
 
 int TcpStreamServer::acceptClient(const std::atomic<bool>& stop) {
@@ -177,19 +176,18 @@ void TcpStreamServer::run(const std::atomic<bool>& stop) {
 UdpStreamSender::UdpStreamSender(StreamServerOptions options, std::vector<TimedChunk> chunks)
     : options_(std::move(options)), chunks_(std::move(chunks)) {}
 
-bool UdpStreamSender::run(const std::atomic<bool>& stop, std::string& error) {
+sss::core::Status UdpStreamSender::run(const std::atomic<bool>& stop) {
   const int fd = ::socket(AF_INET, SOCK_DGRAM | SOCK_CLOEXEC, 0);
   sockaddr_in address{};
   address.sin_family = AF_INET;
   address.sin_port = htons(static_cast<uint16_t>(options_.port));
   if (::inet_pton(AF_INET, options_.bind_address.c_str(), &address.sin_addr) != 1) {
-    error = "bad destination address '" + options_.bind_address + "'";
     ::close(fd);
-    return false;
+    return sss::core::Status::error("bad destination address '" + options_.bind_address + "'");
   }
   if (chunks_.empty()) {
     ::close(fd);
-    return true;
+    return sss::core::Status::success();
   }
   std::mt19937 rng(options_.faults.seed);
   Pacer pacer(options_.speed, options_.pacing_origin_us.value_or(chunks_.front().time_us));
@@ -211,7 +209,7 @@ bool UdpStreamSender::run(const std::atomic<bool>& stop, std::string& error) {
     if (options_.speed <= 0.0) std::this_thread::sleep_for(std::chrono::microseconds(50));
   }
   ::close(fd);
-  return true;
+  return sss::core::Status::success();
 }
 
 }  // namespace sss::emulators

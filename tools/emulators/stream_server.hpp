@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/core/status.hpp"
+
 namespace sss::emulators {
 
 struct TimedChunk {
@@ -56,8 +58,8 @@ class TcpStreamServer {
   TcpStreamServer(StreamServerOptions options, std::vector<TimedChunk> chunks);
   ~TcpStreamServer();
 
-  // Binds and listens; false with error set when the port is taken or the address is wrong.
-  bool listen(std::string& error);
+  // Binds and listens; fails when the port is taken or the address is wrong.
+  sss::core::Status listen();
   int port() const { return port_; }
   // Called after the last byte of chunk `index` was handed to the kernel (benchmarks).
   void setChunkSentCallback(std::function<void(size_t index, int64_t monotonic_us)> callback) {
@@ -83,7 +85,8 @@ class TcpStreamServer {
 class UdpStreamSender {
  public:
   UdpStreamSender(StreamServerOptions options, std::vector<TimedChunk> chunks);
-  bool run(const std::atomic<bool>& stop, std::string& error);
+  // Fails only for a bad destination address; a datagram nobody receives is not an error (UDP).
+  sss::core::Status run(const std::atomic<bool>& stop);
   const StreamStats& stats() const { return stats_; }
 
  private:

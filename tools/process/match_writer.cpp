@@ -38,16 +38,15 @@ MatchCsvWriter::~MatchCsvWriter() {
   if (file_) std::fclose(file_);
 }
 
-bool MatchCsvWriter::open(const std::string& path, int stride, int probe_step, std::string& error) {
+sss::core::Status MatchCsvWriter::open(const std::string& path, int stride, int probe_step) {
   path_ = path;
   stride_ = std::max(1, stride);
   probe_step_ = std::max(1, probe_step);
   file_ = std::fopen(path.c_str(), "w");
   if (!file_) {
-    error = "cannot write " + path + "; check the output folder is writable";
-    return false;
+    return sss::core::Status::error("cannot write " + path + "; check the output folder is writable");
   }
-  return true;
+  return sss::core::Status::success();
 }
 
 void MatchCsvWriter::writePreamble(const sss::core::SubframeGeometry& g, int decimation) {
@@ -127,8 +126,8 @@ void MatchCsvWriter::addPair(const sss::core::Subframe& a, const sss::core::Subf
   }
 }
 
-bool MatchCsvWriter::close(std::string& error) {
-  if (!file_) return true;
+sss::core::Status MatchCsvWriter::close() {
+  if (!file_) return sss::core::Status::success();
   if (!preamble_written_) {
     std::fprintf(file_, "# matches.csv (sss-process --write-matches): the matcher tried no pair.\n%s\n", kColumns);
   }
@@ -136,10 +135,9 @@ bool MatchCsvWriter::close(std::string& error) {
   const bool closed = std::fclose(file_) == 0;
   file_ = nullptr;
   if (!ok || !closed) {
-    error = "cannot write " + path_ + "; is the disk full?";
-    return false;
+    return sss::core::Status::error("cannot write " + path_ + "; is the disk full?");
   }
-  return true;
+  return sss::core::Status::success();
 }
 
 }  // namespace sss::offline

@@ -22,6 +22,7 @@
 #include <set>
 #include <string>
 
+#include "pipeline/core/status.hpp"
 #include "pipeline/matcher/pair_matcher.hpp"
 #include "pipeline/subframe/subframe_builder.hpp"
 
@@ -34,13 +35,13 @@ class MatchCsvWriter {
   MatchCsvWriter& operator=(const MatchCsvWriter&) = delete;
   ~MatchCsvWriter();
 
-  // Creates the file; false with a message.
-  bool open(const std::string& path, int stride, int probe_step, std::string& error);
+  // Creates the file; fails with a message.
+  sss::core::Status open(const std::string& path, int stride, int probe_step);
   // One pair of one association round (rows of subframes not written yet, matches, probes).
   void addPair(const sss::core::Subframe& a, const sss::core::Subframe& b, int association_round,
                const sss::matcher::PairMatch& match);
-  // Flushes and closes; false with a message when anything failed to write.
-  bool close(std::string& error);
+  // Flushes and closes; fails with a message when anything failed to write.
+  sss::core::Status close();
 
  private:
   void writePreamble(const sss::core::SubframeGeometry& geometry, int decimation);

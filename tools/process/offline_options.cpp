@@ -27,7 +27,7 @@ bool hasExtension(const std::string& path, const char* extension) {
   const size_t n = std::strlen(extension);
   return path.size() > n && strcasecmp(path.c_str() + path.size() - n, extension) == 0;
 }
-bool readOptions(const std::string& path, Options& options, std::string& error) {
+sss::core::Status readOptions(const std::string& path, Options& options) {
   if (!path.empty()) {
     using namespace sss::core;
     Config config = Config::fromFile(path);
@@ -62,14 +62,13 @@ bool readOptions(const std::string& path, Options& options, std::string& error) 
       products.optional("projected_crs", options.projected_crs);
       products.optional("geotiff", options.write_geotiff);
       products.rejectUnknownKeys();
-      std::string crs_problem;
-      if (!options.projected_crs.empty() && !sss::products::isKnownCrs(options.projected_crs, crs_problem)) {
-        products.addProblem("projected_crs", options.projected_crs, crs_problem);
+      if (!options.projected_crs.empty()) {
+        const sss::core::Status known = sss::products::isKnownCrs(options.projected_crs);
+        if (!known) products.addProblem("projected_crs", options.projected_crs, known.message);
       }
     }
     if (!config.ok()) {
-      error = "invalid configuration " + path + ": " + config.problemReport();
-      return false;
+      return sss::core::Status::error("invalid configuration " + path + ": " + config.problemReport());
     }
   }
   options.ins.origin = options.origin;
@@ -84,10 +83,9 @@ bool readOptions(const std::string& path, Options& options, std::string& error) 
     problems.push_back(problem);
   }
   if (!problems.empty()) {
-    error = "invalid configuration " + path + ": " + problems.front();
-    return false;
+    return sss::core::Status::error("invalid configuration " + path + ": " + problems.front());
   }
-  return true;
+  return sss::core::Status::success();
 }
 
 }  // namespace sss::offline

@@ -11,6 +11,7 @@
 #include "drivers/ins/position_fix.hpp"
 #include "drivers/xtf/xtf_reader.hpp"
 #include "pipeline/core/mission_origin.hpp"
+#include "pipeline/core/status.hpp"
 #include "pipeline/matcher/matcher_engine.hpp"
 #include "pipeline/optimiser/optimiser_engine.hpp"
 #include "pipeline/subframe/pictures.hpp"
@@ -45,6 +46,6 @@ struct Options {
 
 // The library keys of each process's section; keys only a live process uses (ports, channels)
 // are left alone here: each process's --check-config validates the whole file.
-bool readOptions(const std::string& path, Options& options, std::string& error);
+sss::core::Status readOptions(const std::string& path, Options& options);
 
 }  // namespace sss::offline

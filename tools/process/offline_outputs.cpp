@@ -4,18 +4,19 @@
 namespace sss::offline {
 
 namespace fs = std::filesystem;
+
 using sss::core::Pose;
 
 // With fixes: fixes.csv (every fix the optimiser saw, its decision and residual) and
 // dead_reckoning_fixed.tum, the best answer without side-scan: the same nodes, odometry and fixes in
 // a graph without closures (what an aided-INS smoother with the same fixes gives).
-bool Runner::writeFixOutputs(const std::string& dir, std::string& error) {
+Status Runner::writeFixOutputs(const std::string& dir) {
   const sss::optimiser::SlidingWindowPoseGraph& graph = optimiser_.graph();
   const std::vector<sss::optimiser::FixRecord> records = graph.fixes();
   sss::offline::FixSummary& s = summary_.fixes;
   s.accepted = graph.fixCounters().accepted;
   s.rejected_gate = graph.fixCounters().rejected_gate;
-  if (records.empty()) return true;
+  if (records.empty()) return Status::success();
   double sum_squared = 0.0;
   for (const auto& r : records)
     if (r.status == sss::optimiser::FixStatus::kAccepted) sum_squared += r.residual_ne_m.squaredNorm();
@@ -23,10 +24,7 @@ bool Runner::writeFixOutputs(const std::string& dir, std::string& error) {
 
   const std::string csv_path = dir + "/fixes.csv";
   std::FILE* f = std::fopen(csv_path.c_str(), "w");
-  if (!f) {
-    error = "cannot write " + csv_path;
-    return false;
-  }
+  if (!f) return Status::error("cannot write " + csv_path);
   std::fprintf(f, "# absolute fixes given to the optimiser (local NED of the mission origin); residual = fix - SLAM "
                   "estimate at the fix time; chi2 = innovation at the gate (2 dof)\n"
                   "utime_us,source,north_m,east_m,sigma_north_m,sigma_east_m,status,innovation_chi2,subframe_id,"
@@ -40,21 +38,26 @@ bool Runner::writeFixOutputs(const std::string& dir, std::string& error) {
                  std::sqrt(r.fix.covariance_m2(0, 0)), std::sqrt(r.fix.covariance_m2(1, 1)), status, r.innovation_chi2,
                  static_cast<long long>(r.subframe_id), r.residual_ne_m.x(), r.residual_ne_m.y());
   }
-  if (std::fclose(f) != 0) {
-    error = "cannot write " + csv_path;
-    return false;
-  }
+  if (std::fclose(f) != 0) return Status::error("cannot write " + csv_path);
 
   sss::optimiser::SlidingWindowPoseGraph fixed(options_.optimiser.graph);
   // The same anchor as the SLAM graph (the INS's accuracy at the first node), so the baseline
   // differs from SLAM by the closures alone.
   const Eigen::Vector2d& anchor_ins_sigma_ne_m = graph.firstNodeInsSigma();
-  if (anchor_ins_sigma_ne_m.x() > 0.0 || anchor_ins_sigma_ne_m.y() > 0.0)
-    fixed.setFirstNodeHorizontalSigma(anchor_ins_sigma_ne_m.x(), anchor_ins_sigma_ne_m.y());
-  for (const sss::optimiser::NodeState& n : graph.nodes()) {
-    fixed.addNode(n.subframe_id, n.utime_us, n.T_world_body_dr, n.distance_travelled_m);
+  // The SLAM graph took this anchor, nodes and fixes, so a refusal here is a bug, not bad input.
+  if (anchor_ins_sigma_ne_m.x() > 0.0 || anchor_ins_sigma_ne_m.y() > 0.0) {
+    const Status anchored =
+        fixed.setFirstNodeHorizontalSigma(anchor_ins_sigma_ne_m.x(), anchor_ins_sigma_ne_m.y());
+    if (!anchored) return anchored;
   }
-  for (const auto& r : records) fixed.addFix(r.fix);
+  for (const sss::optimiser::NodeState& n : graph.nodes()) {
+    const Status added = fixed.addNode(n.subframe_id, n.utime_us, n.T_world_body_dr, n.distance_travelled_m);
+    if (!added) return added;
+  }
+  for (const auto& r : records) {
+    const Status added = fixed.addFix(r.fix);
+    if (!added) return added;
+  }
   fixed.fullSmoothing();
   std::vector<sss::optimiser::StampedPose> poses;
   poses.reserve(dr_per_ping_.size());
@@ -62,28 +65,24 @@ bool Runner::writeFixOutputs(const std::string& dir, std::string& error) {
   return sss::optimiser::writeTum(dir + "/dead_reckoning_fixed.tum", poses,
                                   "sss-process: dead reckoning with the same fixes, no side-scan (graph without "
                                   "closures) at every ping" + frame_comment_,
-                                  error, origin_);
+                                  origin_);
 }
 
 // The corrected navigation for the survey's own tools: navigation.csv (every ping: UTC time,
 // latitude, longitude, local north/east, depth below the ellipsoid, attitude, altitude, horizontal 1-sigma,
 // DR or SLAM) and, when
 // the frame is geographic, navigation.nmea (ZDA + GGA + HDT per ping, GGA quality 6: estimated).
-bool Runner::writeNavigation(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& slam,
-                             std::string& error) const {
+Status Runner::writeNavigation(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& slam) const {
   std::vector<double> altitude_m;
   for (const PingAltitude& p : altitude_per_ping_) altitude_m.push_back(p.altitude_m);
-  return sss::products::writeNavigationFiles(dir, slam, optimiser_, origin_, altitude_m, error);
+  return sss::products::writeNavigationFiles(dir, slam, optimiser_, origin_, altitude_m);
 }
 
-// For GIS (QGIS opens them as they are; RFC 7946, WGS 84 longitude/latitude): track.geojson, the SLAM
-// and DR tracks (a vertex every 4 pings), and subframes.geojson, each subframe's footprint on the
-// seabed under the SLAM poses (its swath of canonical ground range either side, a vertex every 25
-// pings) with its id and line. Only in a geographic frame.
-bool Runner::writeCorrectedCopy(const std::vector<sss::optimiser::StampedPose>& slam, std::string& error) {
+// --write-corrected: a copy of the sonar file with the SLAM navigation in every ping it has a pose for.
+Status Runner::writeCorrectedCopy(const std::vector<sss::optimiser::StampedPose>& slam) {
   std::optional<sss::core::LocalTangentPlane> plane;
   if (origin_) plane.emplace(origin_->latitude_deg, origin_->longitude_deg);
-  if (!plane && !projected_origin_) return true;  // no frame on Earth: said in the findings
+  if (!plane && !projected_origin_) return Status::success();  // no frame on Earth: said in the findings
   std::error_code ec;
   fs::create_directories(request_.corrected_dir, ec);
   const std::string out_path = (fs::path(request_.corrected_dir) / fs::path(request_.sonar_path).filename()).string();
@@ -125,15 +124,16 @@ bool Runner::writeCorrectedCopy(const std::vector<sss::optimiser::StampedPose>& 
     return nav;
   };
   sss::products::CorrectedCopyCounters counters;
-  const bool ok = hasExtension(request_.sonar_path, ".xtf")
-                      ? sss::products::writeCorrectedXtf(request_.sonar_path, out_path, navigation, counters, error,
-                                                         options_.xtf.pair_index)
-                      : sss::products::writeCorrectedJsf(request_.sonar_path, out_path, navigation, counters, error);
-  if (!ok) return false;
+  const Status written =
+      hasExtension(request_.sonar_path, ".xtf")
+          ? sss::products::writeCorrectedXtf(request_.sonar_path, out_path, navigation, counters,
+                                             options_.xtf.pair_index)
+          : sss::products::writeCorrectedJsf(request_.sonar_path, out_path, navigation, counters);
+  if (!written) return written;
   summary_.corrected_copy = out_path;
   summary_.corrected_records = counters.records_corrected;
   summary_.corrected_records_without_pose = counters.records_without_pose;
-  return true;
+  return Status::success();
 }
 
 std::optional<sss::products::RasterFrame> Runner::rasterFrame() const {
@@ -150,31 +150,32 @@ std::optional<sss::products::RasterFrame> Runner::rasterFrame() const {
   return frame;
 }
 
-bool Runner::writeRaster(const std::string& dir, const std::string& name, const sss::products::FrameRaster& raster,
-                         std::string& error) {
-  if (!options_.write_geotiff) return true;
+Status Runner::writeRaster(const std::string& dir, const std::string& name, const sss::products::FrameRaster& raster) {
+  if (!options_.write_geotiff) return Status::success();
   const std::optional<sss::products::RasterFrame> frame = rasterFrame();
-  if (!frame) return true;  // no frame on Earth (said once in the findings)
+  if (!frame) return Status::success();  // no frame on Earth (said once in the findings)
   sss::products::GeoTiffInfo info;
-  if (!sss::products::writeGeoTiff(dir + "/" + name, raster, *frame, error, &info)) return false;
+  if (const Status written = sss::products::writeGeoTiff(dir + "/" + name, raster, *frame, &info); !written) {
+    return written;
+  }
   summary_.geotiffs.push_back(name);
   summary_.geotiff_crs = info.crs_name;
   summary_.geotiff_epsg = info.epsg;
-  return true;
+  return Status::success();
 }
 
-bool Runner::writeGeoJson(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& slam,
-                          std::string& error) const {
-  return sss::products::writeGeoJsonFiles(dir, slam, dr_per_ping_, footprints_, optimiser_, origin_, error);
+// For GIS (QGIS opens them as they are; RFC 7946, WGS 84 longitude/latitude): track.geojson, the SLAM
+// and DR tracks (a vertex every 4 pings), and subframes.geojson, each subframe's footprint on the
+// seabed under the SLAM poses (its swath of canonical ground range either side, a vertex every 25
+// pings) with its id and line. Only in a geographic frame.
+Status Runner::writeGeoJson(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& slam) const {
+  return sss::products::writeGeoJsonFiles(dir, slam, dr_per_ping_, footprints_, optimiser_, origin_);
 }
 
 // altitude.csv: the altitude every ping was processed with and where it came from.
-bool Runner::writeAltitudeCsv(const std::string& path, std::string& error) const {
+Status Runner::writeAltitudeCsv(const std::string& path) const {
   std::FILE* f = std::fopen(path.c_str(), "w");
-  if (!f) {
-    error = "cannot write " + path;
-    return false;
-  }
+  if (!f) return Status::error("cannot write " + path);
   std::fprintf(f, "# the sonar's altitude above the seabed each ping was processed with; source: nav (DVL), "
                   "ping_header (the sonar's own field) or bottom_track (its returns; quality 0..1)\n"
                   "utime_us,altitude_m,source,bottom_track_quality\n");
@@ -182,12 +183,11 @@ bool Runner::writeAltitudeCsv(const std::string& path, std::string& error) const
     std::fprintf(f, "%lld,%.3f,%s,%.2f\n", static_cast<long long>(p.utime_us), p.altitude_m,
                  sss::subframe::altitudeSourceName(p.source), p.quality);
   }
-  const bool ok = std::fclose(f) == 0;
-  if (!ok) error = "cannot write " + path;
-  return ok;
+  if (std::fclose(f) != 0) return Status::error("cannot write " + path);
+  return Status::success();
 }
 
-bool Runner::writeOutputs(std::string& error) {
+Status Runner::writeOutputs() {
   const std::string dir = request_.out_dir;
   // Per-ping trajectories: DR as fused, SLAM = the correction at the ping time applied to it.
   std::vector<sss::optimiser::StampedPose> slam;
@@ -196,29 +196,29 @@ bool Runner::writeOutputs(std::string& error) {
     slam.push_back({p.utime_us, optimiser_.correctionAt(p.utime_us).T_corrected_dr * p.T_world_body});
   }
   summary_.pings_with_pose = dr_per_ping_.size();
-  if (!sss::optimiser::writeTum(dir + "/dead_reckoning.tum", dr_per_ping_,
-                                "sss-process: dead reckoning at every ping" + frame_comment_, error, origin_)) {
-    return false;
+  Status written = sss::optimiser::writeTum(dir + "/dead_reckoning.tum", dr_per_ping_,
+                                            "sss-process: dead reckoning at every ping" + frame_comment_, origin_);
+  if (written) {
+    written = sss::optimiser::writeTum(dir + "/slam.tum", slam,
+                                       "sss-process: SLAM-corrected pose at every ping" + frame_comment_, origin_);
   }
-  if (!sss::optimiser::writeTum(dir + "/slam.tum", slam, "sss-process: SLAM-corrected pose at every ping" + frame_comment_,
-                                error, origin_)) {
-    return false;
-  }
-  if (!writeFixOutputs(dir, error)) return false;
-  if (!writeNavigation(dir, slam, error)) return false;
-  if (!writeGeoJson(dir, slam, error)) return false;
-  if (!request_.corrected_dir.empty() && !writeCorrectedCopy(slam, error)) return false;
+  if (written) written = writeFixOutputs(dir);
+  if (written) written = writeNavigation(dir, slam);
+  if (written) written = writeGeoJson(dir, slam);
+  if (written && !request_.corrected_dir.empty()) written = writeCorrectedCopy(slam);
+  if (!written) return written;
   if (!footprints_.empty()) {
     const sss::products::CoverageGrid coverage =
         sss::products::computeCoverage(sss::products::slamStrips(footprints_, optimiser_), 5.0);
     summary_.coverage_covered_m2 = coverage.covered_m2;
     summary_.coverage_seen_twice_m2 = coverage.seen_twice_m2;
-    if (!sss::products::writeCoverageFiles(dir + "/coverage.yaml", coverage, error, origin_)) return false;
-    if (!writeRaster(dir, "coverage.tif", sss::products::coverageRaster(coverage), error)) return false;
+    written = sss::products::writeCoverageFiles(dir + "/coverage.yaml", coverage, origin_);
+    if (written) written = writeRaster(dir, "coverage.tif", sss::products::coverageRaster(coverage));
   }
-  if (!sss::products::writeTieReportCsv(dir + "/loop_closures.csv", optimiser_, error)) return false;
-  if (!writeAltitudeCsv(dir + "/altitude.csv", error)) return false;
-  if (!match_writer_.close(error)) return false;
+  if (written) written = sss::products::writeTieReportCsv(dir + "/loop_closures.csv", optimiser_);
+  if (written) written = writeAltitudeCsv(dir + "/altitude.csv");
+  if (written) written = match_writer_.close();
+  if (!written) return written;
 
   const auto& counters = optimiser_.graph().counters();
   summary_.closures_accepted = counters.closures_accepted;
@@ -236,8 +236,9 @@ bool Runner::writeOutputs(std::string& error) {
   const std::vector<sss::optimiser::SeabedPoint> points = optimiser_.seabedPoints(false);
   const std::vector<sss::optimiser::SeabedPoint> points_dr = optimiser_.seabedPoints(true);
   summary_.seabed_points = points.size();
-  if (!sss::optimiser::writeSeabedPly(dir + "/bathymetry.ply", points, error, origin_)) return false;
-  if (!sss::optimiser::writeSeabedPly(dir + "/bathymetry_dr.ply", points_dr, error, origin_)) return false;
+  written = sss::optimiser::writeSeabedPly(dir + "/bathymetry.ply", points, origin_);
+  if (written) written = sss::optimiser::writeSeabedPly(dir + "/bathymetry_dr.ply", points_dr, origin_);
+  if (!written) return written;
   const struct {
     const std::vector<sss::optimiser::SeabedPoint>& points;
     const char* name;
@@ -247,13 +248,13 @@ bool Runner::writeOutputs(std::string& error) {
   for (const auto& heightmap : heightmaps) {
     if (heightmap.points.empty()) continue;
     const sss::optimiser::HeightmapGrid grid = sss::optimiser::gridSeabedPoints(heightmap.points, bathymetry);
-    if (!sss::optimiser::writeHeightmapFiles(dir + "/" + heightmap.name + ".yaml", grid, heightmap.description, error,
-                                             origin_) ||
-        !writeRaster(dir, std::string(heightmap.name) + ".tif",
-                     sss::products::heightmapRaster(grid, std::string(heightmap.description) + " (depth m, down)"),
-                     error)) {
-      return false;
+    written = sss::optimiser::writeHeightmapFiles(dir + "/" + heightmap.name + ".yaml", grid, heightmap.description,
+                                                  origin_);
+    if (written) {
+      written = writeRaster(dir, std::string(heightmap.name) + ".tif",
+                            sss::products::heightmapRaster(grid, std::string(heightmap.description) + " (depth m, down)"));
     }
+    if (!written) return written;
   }
 
   if (request_.write_mosaics) {
@@ -261,16 +262,15 @@ bool Runner::writeOutputs(std::string& error) {
         options_.write_geotiff ? rasterFrame() : std::optional<sss::products::RasterFrame>();
     sss::products::GeoTiffInfo info;
     const size_t before = summary_.geotiffs.size();
-    if (!sss::products::writeMosaicProducts(dir, mosaic_store_.subframes(), optimiser_, options_.pictures, origin_, frame,
-                                            "sss-process", summary_.geotiffs, info, error)) {
-      return false;
-    }
+    written = sss::products::writeMosaicProducts(dir, mosaic_store_.subframes(), optimiser_, options_.pictures, origin_,
+                                                 frame, "sss-process", summary_.geotiffs, info);
+    if (!written) return written;
     if (summary_.geotiffs.size() > before) {
       summary_.geotiff_crs = info.crs_name;
       summary_.geotiff_epsg = info.epsg;
     }
   }
-  return true;
+  return Status::success();
 }
 
 }  // namespace sss::offline

@@ -28,7 +28,10 @@ OfflineResult runOffline(const OfflineRequest& request) {
     return result;
   }
   Options options;
-  if (!readOptions(request.config_path, options, result.error)) return result;
+  if (const sss::core::Status read = readOptions(request.config_path, options); !read) {
+    result.error = read.message;
+    return result;
+  }
   for (const std::string& path : {request.sonar_path, request.ins_path, request.lcm_log_path}) {
     if (path.empty()) continue;
     std::error_code ec;
@@ -48,10 +51,14 @@ OfflineResult runOffline(const OfflineRequest& request) {
   std::vector<sss::ins::PositionFix> fixes;
   FixSummary fix_summary;
   for (const std::string& spec : request.fix_paths) {
-    std::vector<sss::ins::PositionFix> read;
-    sss::ins::FixReaderCounters counters;
-    std::string problem;
-    if (!sss::ins::readPositionFixFile(spec, options.fix_reader, read, counters, problem, result.error)) return result;
+    const sss::core::Result<sss::ins::FixFileContents> contents = sss::ins::readPositionFixFile(spec, options.fix_reader);
+    if (!contents) {
+      result.error = contents.message();
+      return result;
+    }
+    const std::vector<sss::ins::PositionFix>& read = contents->fixes;
+    const sss::ins::FixReaderCounters& counters = contents->counters;
+    const std::string& problem = contents->first_problem;
     ++fix_summary.files;
     fix_summary.read += read.size();
     fix_summary.sentences_skipped += counters.rejected_sentences + counters.malformed + counters.no_fix;
@@ -69,9 +76,12 @@ OfflineResult runOffline(const OfflineRequest& request) {
   Runner runner(request, options);
   runner.summary().fixes = fix_summary;
   runner.setFixes(std::move(fixes));
-  if (request.write_matches && !runner.openMatchWriter(result.error)) {
-    result.exit_code = 1;
-    return result;
+  if (request.write_matches) {
+    if (const sss::core::Status opened = runner.openMatchWriter(); !opened) {
+      result.error = opened.message;
+      result.exit_code = 1;
+      return result;
+    }
   }
   uint64_t faults = 0;
   std::optional<Eigen::Vector2d> projected_origin;  // a projected frame (XTF NavUnits 0): E0, N0
@@ -259,7 +269,10 @@ OfflineResult runOffline(const OfflineRequest& request) {
   }
   summary.input_faults = faults;
   result.exit_code = 1;
-  if (!runner.writeOutputs(result.error)) return result;
+  if (const sss::core::Status written = runner.writeOutputs(); !written) {
+    result.error = written.message;
+    return result;
+  }
   summary.wall_s = wallSeconds() - runner.startSeconds();
   summary.mission_s = runner.missionSeconds();
   summary.real_time_factor = summary.wall_s > 0.0 ? summary.mission_s / summary.wall_s : 0.0;
@@ -289,7 +302,11 @@ OfflineResult runOffline(const OfflineRequest& request) {
     }
   }
   result.summary = summary;
-  if (!writeSummaryJson(request.out_dir + "/summary.json", request, summary, result.error)) return result;
+  if (const sss::core::Status written = writeSummaryJson(request.out_dir + "/summary.json", request, summary);
+      !written) {
+    result.error = written.message;
+    return result;
+  }
   if (summary.pings_with_pose == 0 || summary.subframes == 0) {
     // Nothing could be processed: the outputs say so (summary.json), and so does the exit code.
     result.exit_code = 3;

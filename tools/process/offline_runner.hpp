@@ -81,6 +81,8 @@ struct OfflineSummary {
   uint64_t pings = 0;            // pings read
   uint64_t pings_with_pose = 0;  // pings that got a DR pose (in the trajectories)
   uint64_t subframes = 0;
+  uint64_t subframes_refused = 0;  // by the optimiser (no centre ping, distance not finite): a buffer bug
+  std::string first_subframe_refusal;
   uint64_t pairs_attempted = 0;
   uint64_t matcher_closures = 0;   // closures the matcher produced (all rounds)
   uint64_t false_closures_injected = 0;  // of those, made wrong on purpose (false_closure_fraction)

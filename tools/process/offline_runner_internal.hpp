@@ -56,6 +56,7 @@
 
 namespace sss::offline {
 
+using sss::core::Status;
 using sss::subframe::NavInput;
 using sss::subframe::PingInput;
 
@@ -132,18 +133,17 @@ class Runner {
     std::fflush(request_.progress);
   }
 
-  bool writeOutputs(std::string& error);
-  bool writeFixOutputs(const std::string& dir, std::string& error);
-  bool writeNavigation(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& slam, std::string& error) const;
-  bool writeGeoJson(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& slam, std::string& error) const;
+  Status writeOutputs();
+  Status writeFixOutputs(const std::string& dir);
+  Status writeNavigation(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& slam) const;
+  Status writeGeoJson(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& slam) const;
   // --write-corrected: the sonar file with the SLAM navigation in every ping.
-  bool writeCorrectedCopy(const std::vector<sss::optimiser::StampedPose>& slam, std::string& error);
+  Status writeCorrectedCopy(const std::vector<sss::optimiser::StampedPose>& slam);
   // The GeoTIFFs' frame: the origin's tangent plane, or the file's projected grid; nullopt: neither.
   std::optional<sss::products::RasterFrame> rasterFrame() const;
   // Writes dir/name as a GeoTIFF when the run has a frame on Earth and GeoTIFFs are on.
-  bool writeRaster(const std::string& dir, const std::string& name, const sss::products::FrameRaster& raster,
-                   std::string& error);
-  bool writeAltitudeCsv(const std::string& path, std::string& error) const;
+  Status writeRaster(const std::string& dir, const std::string& name, const sss::products::FrameRaster& raster);
+  Status writeAltitudeCsv(const std::string& path) const;
   OfflineSummary& summary() { return summary_; }
   const std::optional<sss::core::MissionOrigin>& origin() const { return origin_; }
   // The frame is a projected grid's (XTF NavUnits 0): said in every trajectory file.
@@ -183,13 +183,14 @@ class Runner {
   }
 
   // matches.csv: the matcher engine shows every matched pair to the writer.
-  bool openMatchWriter(std::string& error) {
-    if (!match_writer_.open(request_.out_dir + "/matches.csv", options_.matcher.pair.dense.stride, 4, error)) return false;
+  Status openMatchWriter() {
+    const Status opened = match_writer_.open(request_.out_dir + "/matches.csv", options_.matcher.pair.dense.stride, 4);
+    if (!opened) return opened;
     matcher_.setPairMatchObserver([this](const sss::core::Subframe& a, const sss::core::Subframe& b, int round,
                                          const sss::matcher::PairMatch& match) {
       match_writer_.addPair(a, b, round, match);
     });
-    return true;
+    return Status::success();
   }
   double startSeconds() const { return start_s_; }
   double missionSeconds() const {
@@ -271,9 +272,13 @@ class Runner {
   void handleSubframes() {
     for (sss::core::Subframe& subframe : subframes_) {
       ++summary_.subframes;
+      if (const sss::core::Status added = optimiser_.addSubframe(subframe); !added) {
+        // Without a node its closures would be refused too: the subframe is left out of SLAM.
+        if (summary_.subframes_refused++ == 0) summary_.first_subframe_refusal = added.message;
+        continue;
+      }
       centres_.push_back({subframe.line_id, subframe.centre().T_world_body});
       footprints_.push_back(sss::products::footprintOf(subframe));
-      optimiser_.addSubframe(subframe);
       if (request_.write_mosaics) mosaic_store_.add(subframe);
       addOutcomes(timedMatch([&] { return matcher_.addSubframe(std::move(subframe)); }));
       update();

@@ -69,6 +69,11 @@ std::vector<std::string> explainRun(const OfflineSummary& s, const Options& opti
     findings.push_back("no subframe: " + why);
     return findings;
   }
+  if (s.subframes_refused > 0) {
+    findings.push_back(count(s.subframes_refused) + " of " + count(s.subframes) + " subframes refused by the optimiser " +
+                       "and left out (first: " + s.first_subframe_refusal + "); this is a bug in the subframe buffer, " +
+                       "please report it with the input file");
+  }
   const double swath_m = s.canonical_swath_m;
   if (s.pairs_attempted == 0) {
     if (s.survey_lines < 2) {
@@ -189,8 +194,7 @@ std::vector<std::string> explainFixes(const FixSummary& f, const Options& option
 
 // ---- outputs -----------------------------------------------------------------------------------
 
-bool writeSummaryJson(const std::string& path, const OfflineRequest& request, const OfflineSummary& s,
-                      std::string& error) {
+sss::core::Status writeSummaryJson(const std::string& path, const OfflineRequest& request, const OfflineSummary& s) {
   using sss::eval::Json;
   using sss::eval::jsonValue;
   Json json = Json::object();
@@ -215,6 +219,7 @@ bool writeSummaryJson(const std::string& path, const OfflineRequest& request, co
   const std::pair<const char*, uint64_t> counts[] = {
       {"nav_samples", s.nav_samples},         {"pings", s.pings},
       {"pings_with_pose", s.pings_with_pose}, {"subframes", s.subframes},
+      {"subframes_refused", s.subframes_refused},
       {"pairs_attempted", s.pairs_attempted}, {"matcher_closures", s.matcher_closures},
       {"false_closures_injected", s.false_closures_injected},
       {"closures_accepted", s.closures_accepted}, {"closures_rejected", s.closures_rejected},
@@ -329,10 +334,9 @@ bool writeSummaryJson(const std::string& path, const OfflineRequest& request, co
   std::ofstream out(path);
   out << json.dump(2) << "\n";
   if (!out) {
-    error = "cannot write " + path;
-    return false;
+    return sss::core::Status::error("cannot write " + path);
   }
-  return true;
+  return sss::core::Status::success();
 }
 
 

@@ -15,7 +15,6 @@ namespace sss::offline {
 std::vector<std::string> explainRun(const OfflineSummary& s, const Options& options);
 // The same for the fixes of --fixes files.
 std::vector<std::string> explainFixes(const FixSummary& f, const Options& options);
-bool writeSummaryJson(const std::string& path, const OfflineRequest& request, const OfflineSummary& s,
-                      std::string& error);
+sss::core::Status writeSummaryJson(const std::string& path, const OfflineRequest& request, const OfflineSummary& s);
 
 }  // namespace sss::offline

@@ -22,6 +22,8 @@
 #include <sstream>
 
 namespace sss::sim {
+
+using sss::core::Status;
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -211,18 +213,17 @@ std::string insNmeaStream(const Mission& mission) {
 
 namespace {
 
-bool writeBinary(const std::string& path, const void* data, size_t bytes, std::string& error) {
+Status writeBinary(const std::string& path, const void* data, size_t bytes) {
   std::ofstream out(path, std::ios::binary);
   out.write(static_cast<const char*>(data), static_cast<std::streamsize>(bytes));
   if (!out) {
-    error = "cannot write " + path + "; check the output directory is writable and has space";
-    return false;
+    return Status::error("cannot write " + path + "; check the output directory is writable and has space");
   }
-  return true;
+  return Status::success();
 }
 
-bool writeText(const std::string& path, const std::string& text, std::string& error) {
-  return writeBinary(path, text.data(), text.size(), error);
+Status writeText(const std::string& path, const std::string& text) {
+  return writeBinary(path, text.data(), text.size());
 }
 
 std::string tumLine(int64_t utime_us, const sss::core::Pose& pose) {
@@ -254,25 +255,31 @@ cv::Mat toImage8(const std::vector<float>& values, int rows, int cols, float whi
   return image;
 }
 
-bool writePng(const std::string& path, const cv::Mat& image, std::string& error) {
+Status writePng(const std::string& path, const cv::Mat& image) {
   try {
-    if (cv::imwrite(path, image)) return true;
+    if (cv::imwrite(path, image)) return Status::success();
   } catch (const cv::Exception& e) {
-    error = "cannot write " + path + ": " + e.what();
-    return false;
+    return Status::error("cannot write " + path + ": " + e.what());
   }
-  error = "cannot write " + path;
-  return false;
+  return Status::error("cannot write " + path);
 }
 
-bool writeSeabed(const Mission& mission, const std::string& dir, MissionReport& report, std::string& error) {
+Status writeSeabed(const Mission& mission, const std::string& dir, MissionReport& report) {
   const Seabed& seabed = mission.seabed();
   const SeabedOptions& o = seabed.options();
   const auto& depth = seabed.depthGrid();
   const auto& reflect = seabed.reflectivityGrid();
   // Raw float32 in the host byte order; every supported target (x86-64, aarch64) is little-endian.
-  if (!writeBinary(dir + "/seabed_depth.f32", depth.data(), depth.size() * sizeof(float), error)) return false;
-  if (!writeBinary(dir + "/seabed_reflectivity.f32", reflect.data(), reflect.size() * sizeof(float), error)) return false;
+  if (const Status written =
+          writeBinary(dir + "/seabed_depth.f32", depth.data(), depth.size() * sizeof(float));
+      !written) {
+    return written;
+  }
+  if (const Status written =
+          writeBinary(dir + "/seabed_reflectivity.f32", reflect.data(), reflect.size() * sizeof(float));
+      !written) {
+    return written;
+  }
   std::ostringstream yaml;
   yaml.precision(12);
   yaml << "# True seabed of the simulated mission: two raw little-endian float32 rasters, row-major.\n"
@@ -284,7 +291,7 @@ bool writeSeabed(const Mission& mission, const std::string& dir, MissionReport& 
        << "\norigin_longitude_deg: " << mission.options().origin_longitude_deg
        << "\ndepth_file: seabed_depth.f32\ndepth_units: metres below the origin (NED z, positive down)"
        << "\nreflectivity_file: seabed_reflectivity.f32\nreflectivity_units: backscatter coefficient (dimensionless)\n";
-  if (!writeText(dir + "/seabed.yaml", yaml.str(), error)) return false;
+  if (const Status written = writeText(dir + "/seabed.yaml", yaml.str()); !written) return written;
 
   // Previews at 4 cells per pixel, north up: hill-shaded depth and reflectivity.
   const int step = 4;
@@ -310,24 +317,23 @@ bool writeSeabed(const Mission& mission, const std::string& dir, MissionReport& 
           static_cast<uint8_t>(std::clamp(seabed.reflectivity(north, east) / 1.2 * 255.0, 0.0, 255.0));
     }
   }
-  if (!writePng(dir + "/seabed_depth.png", shade, error)) return false;
-  if (!writePng(dir + "/seabed_reflectivity.png", refl, error)) return false;
+  if (const Status written = writePng(dir + "/seabed_depth.png", shade); !written) return written;
+  if (const Status written = writePng(dir + "/seabed_reflectivity.png", refl); !written) return written;
   for (const char* name : {"seabed_depth.f32", "seabed_reflectivity.f32", "seabed.yaml", "seabed_depth.png",
                            "seabed_reflectivity.png"}) {
     report.files.push_back(name);
   }
-  return true;
+  return Status::success();
 }
 
 }  // namespace
 
-bool writeMission(const Mission& mission, const std::string& out_dir, MissionReport& report, std::string& error) {
+Status writeMission(const Mission& mission, const std::string& out_dir, MissionReport& report) {
   const auto start = std::chrono::steady_clock::now();
   std::error_code ec;
   std::filesystem::create_directories(out_dir, ec);
   if (ec) {
-    error = "cannot create " + out_dir + ": " + ec.message();
-    return false;
+    return Status::error("cannot create " + out_dir + ": " + ec.message());
   }
   const std::string dir = out_dir;
   const SimOptions& options = mission.options();
@@ -338,7 +344,7 @@ bool writeMission(const Mission& mission, const std::string& out_dir, MissionRep
   report.duration_s = mission.durationS();
   report.distance_m = mission.deadReckoning().distanceTravelledM();
 
-  if (!writeSeabed(mission, dir, report, error)) return false;
+  if (const Status written = writeSeabed(mission, dir, report); !written) return written;
 
   // Trajectories, one line per ping.
   // The frame's origin heads both files, so that a run with another origin is compared right.
@@ -355,16 +361,16 @@ bool writeMission(const Mission& mission, const std::string& out_dir, MissionRep
     report.max_dr_error_m = std::max(report.max_dr_error_m, err);
     if (i + 1 == pings) report.final_dr_error_m = err;
   }
-  if (!writeText(dir + "/ground_truth.tum", truth_text, error)) return false;
-  if (!writeText(dir + "/dead_reckoning.tum", dr_text, error)) return false;
+  if (const Status written = writeText(dir + "/ground_truth.tum", truth_text); !written) return written;
+  if (const Status written = writeText(dir + "/dead_reckoning.tum", dr_text); !written) return written;
   report.files.push_back("ground_truth.tum");
   report.files.push_back("dead_reckoning.tum");
 
   // INS stream: iXblue NMEA ($PIXSE family) at the DR rate.
-  if (!writeText(dir + "/ins.nmea", insNmeaStream(mission), error)) return false;
+  if (const Status written = writeText(dir + "/ins.nmea", insNmeaStream(mission)); !written) return written;
   report.files.push_back("ins.nmea");
   if (options.fixes.gnss != "none" || options.fixes.usbl_period_s > 0.0) {
-    if (!writeText(dir + "/fixes.nmea", fixesNmea(mission), error)) return false;
+    if (const Status written = writeText(dir + "/fixes.nmea", fixesNmea(mission)); !written) return written;
     report.files.push_back("fixes.nmea");
   }
 
@@ -385,8 +391,7 @@ bool writeMission(const Mission& mission, const std::string& out_dir, MissionRep
 
   std::ofstream jsf_out(dir + "/sonar.jsf", std::ios::binary);
   if (!jsf_out) {
-    error = "cannot write " + dir + "/sonar.jsf";
-    return false;
+    return Status::error("cannot write " + dir + "/sonar.jsf");
   }
   const auto render_start = std::chrono::steady_clock::now();
   uint8_t sequence = 0;
@@ -437,8 +442,7 @@ bool writeMission(const Mission& mission, const std::string& out_dir, MissionRep
   }
   jsf_out.close();
   if (!jsf_out) {
-    error = "cannot write " + dir + "/sonar.jsf (disk full?)";
-    return false;
+    return Status::error("cannot write " + dir + "/sonar.jsf (disk full?)");
   }
   report.render_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - render_start).count();
   report.files.push_back("sonar.jsf");
@@ -455,7 +459,11 @@ bool writeMission(const Mission& mission, const std::string& out_dir, MissionRep
     if (rows == 0) continue;
     char name[64];
     std::snprintf(name, sizeof name, "waterfall_line_%02d.png", line);
-    if (!writePng(dir + "/" + name, toImage8(image, rows, 2 * bins, percentile(image, 0.99)), error)) return false;
+    if (const Status written =
+            writePng(dir + "/" + name, toImage8(image, rows, 2 * bins, percentile(image, 0.99)));
+        !written) {
+      return written;
+    }
     report.files.push_back(name);
   }
   // Mosaic, north up, on the seabed raster's extent.
@@ -463,8 +471,10 @@ bool writeMission(const Mission& mission, const std::string& out_dir, MissionRep
   for (size_t i = 0; i < mosaic.size(); ++i) {
     if (mosaic_count[i] > 0) mosaic[i] = mosaic_sum[i] / mosaic_count[i];
   }
-  if (!writePng(dir + "/mosaic.png", toImage8(mosaic, mosaic_rows, mosaic_cols, percentile(mosaic, 0.99)), error)) {
-    return false;
+  if (const Status written =
+          writePng(dir + "/mosaic.png", toImage8(mosaic, mosaic_rows, mosaic_cols, percentile(mosaic, 0.99)));
+      !written) {
+    return written;
   }
   std::ostringstream mosaic_yaml;
   mosaic_yaml.precision(12);
@@ -472,7 +482,7 @@ bool writeMission(const Mission& mission, const std::string& out_dir, MissionRep
               << "# Pixel (row, col): north = north_max_m - (row + 0.5) * resolution_m, east = east_min_m + (col + 0.5)"
               << " * resolution_m.\nresolution_m: " << mres << "\nnorth_max_m: " << bed.north_min_m + mosaic_rows * mres
               << "\neast_min_m: " << bed.east_min_m << "\nrows: " << mosaic_rows << "\ncols: " << mosaic_cols << "\n";
-  if (!writeText(dir + "/mosaic.yaml", mosaic_yaml.str(), error)) return false;
+  if (const Status written = writeText(dir + "/mosaic.yaml", mosaic_yaml.str()); !written) return written;
   report.files.push_back("mosaic.png");
   report.files.push_back("mosaic.yaml");
 
@@ -494,9 +504,9 @@ bool writeMission(const Mission& mission, const std::string& out_dir, MissionRep
        << "\n  frames: local NED at the origin (x north, y east, z down), body FRD, TUM t x y z qx qy qz qw"
        << "\n  ins_protocol: iXblue NMEA 0183 ($HEHDT, $PIXSE ATITUD/POSITI/SPEED_/TIME__/STD*, $SDDPT, $INZDA)"
        << "\n  jsf: type 80 envelope, port (channel 0) then starboard (1) per ping, DR navigation in the headers\n";
-  if (!writeText(dir + "/mission.yaml", yaml.str(), error)) return false;
+  if (const Status written = writeText(dir + "/mission.yaml", yaml.str()); !written) return written;
   report.files.push_back("mission.yaml");
-  return true;
+  return Status::success();
 }
 
 }  // namespace sss::sim

@@ -8,6 +8,7 @@
 #include "tools/sim/seabed.hpp"
 #include "tools/sim/sonar_model.hpp"
 #include "tools/sim/trajectory.hpp"
+#include "pipeline/core/status.hpp"
 
 #include <cstdint>
 #include <memory>
@@ -106,9 +107,9 @@ struct MissionReport {
   std::vector<std::string> files;
 };
 
-// Writes every output of sss-sim into out_dir (created if missing). Returns false with a message
-// in error when a file cannot be written.
-bool writeMission(const Mission& mission, const std::string& out_dir, MissionReport& report, std::string& error);
+// Writes every output of sss-sim into out_dir (created if missing). Fails with a message when a
+// file cannot be written.
+sss::core::Status writeMission(const Mission& mission, const std::string& out_dir, MissionReport& report);
 
 // The INS stream: iXblue $PIXSE NMEA bursts of the DR navigation at the DR rate.
 std::string insNmeaStream(const Mission& mission);

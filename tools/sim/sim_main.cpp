@@ -131,9 +131,8 @@ int main(int argc, char** argv) {
     std::cout << "sss-sim: " << mission.pingCount() << " pings, " << mission.durationS() << " s, seabed "
               << mission.seabed().rows() << " x " << mission.seabed().cols() << " cells\n";
     sss::sim::MissionReport report;
-    std::string error;
-    if (!sss::sim::writeMission(mission, out_dir, report, error)) {
-      std::cerr << "sss-sim: " << error << "\n";
+    if (const sss::core::Status written = sss::sim::writeMission(mission, out_dir, report); !written) {
+      std::cerr << "sss-sim: " << written.message << "\n";
       return 1;
     }
     std::printf("sss-sim: wrote %s: %zu pings, %.0f m, DR error final %.2f m (%.3f %% of distance), max %.2f m; "

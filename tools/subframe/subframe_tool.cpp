@@ -132,11 +132,12 @@ int main(int argc, char** argv) {
   collect();
 
   const sss::subframe::SubframeBufferCounters c = buffer.counters();
-  std::string error;
   sss::subframe::PictureOptions picture_options;
-  const auto files = sss::subframe::writeWaterfalls(all, out_dir, picture_options, error);
-  const bool mosaic_ok = sss::subframe::writeMosaic(all, {}, out_dir + "/mosaic.png", picture_options, error);
-  if (!error.empty()) std::fprintf(stderr, "%s\n", error.c_str());
+  const auto waterfalls = sss::subframe::writeWaterfalls(all, out_dir, picture_options);
+  const sss::core::Status mosaic_ok = sss::subframe::writeMosaic(all, {}, out_dir + "/mosaic.png", picture_options);
+  if (!waterfalls) std::fprintf(stderr, "%s\n", waterfalls.message().c_str());
+  if (!mosaic_ok) std::fprintf(stderr, "%s\n", mosaic_ok.message.c_str());
+  const std::vector<std::string> files = waterfalls ? waterfalls.value() : std::vector<std::string>{};
 
   std::printf("pings in %llu, fused %llu, dropped without nav %llu, out of order %llu, duplicates %llu, "
               "altitude from ping %llu, dropped no altitude %llu, turn rows %llu\n",
