@@ -4,6 +4,7 @@
 #include "tools/eval/closure_metrics.hpp"
 
 #include "tests/eval/eval_test_paths.hpp"
+#include "tests/support/status_assertions.hpp"
 
 #include <gtest/gtest.h>
 
@@ -81,7 +82,7 @@ TEST_F(ClosureMetrics, KnownPerturbationsComeBackPerStatus) {
   write(text);
   std::vector<ClosureRecord> closures;
   std::string error;
-  ASSERT_TRUE(readClosureCsv(path_, closures, error)) << error;
+  ASSERT_OK(readClosureCsv(path_, closures));
   ASSERT_EQ(closures.size(), 4u);
   EXPECT_EQ(closures[2].status, "rejected");
   EXPECT_EQ(closures[2].rejection, "chi_square_gate");
@@ -156,7 +157,7 @@ TEST_F(ClosureMetrics, CentreTimesBetweenTruthSamplesAreInterpolated) {
   write(text.str());
   std::vector<ClosureRecord> closures;
   std::string error;
-  ASSERT_TRUE(readClosureCsv(path_, closures, error)) << error;
+  ASSERT_OK(readClosureCsv(path_, closures));
   const ClosureEvaluation ev = evaluateClosures(closures, line, nullptr, 1.0);
   ASSERT_TRUE(ev.closures[0].has_truth);
   EXPECT_NEAR(ev.closures[0].truth.translation_m.x(), 40.5, 1e-9);
@@ -167,23 +168,23 @@ TEST_F(ClosureMetrics, ReaderNamesFileAndLineOfAProblem) {
   std::vector<ClosureRecord> closures;
   std::string error;
   write("subframe_id_a,subframe_id_b,utime_a_us,utime_b_us,status,dx_m,dy_m,dz_m\n");
-  EXPECT_FALSE(readClosureCsv(path_, closures, error));
+  error = sss::testing::failureMessage(readClosureCsv(path_, closures));
   EXPECT_NE(error.find(path_ + ":1: the header has no column 'dheading_rad'"), std::string::npos) << error;
 
   write(std::string(kHeader) + "1,2,100,200,0,accepted,none,x,0,0,0,0,0,10,0.5,0,0,0,0\n");
-  EXPECT_FALSE(readClosureCsv(path_, closures, error));
+  error = sss::testing::failureMessage(readClosureCsv(path_, closures));
   EXPECT_NE(error.find(path_ + ":4: dx_m 'x'"), std::string::npos) << error;
 
   write(std::string(kHeader) + "1,2,100,200,0,accepted\n");
-  EXPECT_FALSE(readClosureCsv(path_, closures, error));
+  error = sss::testing::failureMessage(readClosureCsv(path_, closures));
   EXPECT_NE(error.find(":4: 6 fields"), std::string::npos) << error;
 
-  EXPECT_FALSE(readClosureCsv(path_ + ".missing", closures, error));
+  error = sss::testing::failureMessage(readClosureCsv(path_ + ".missing", closures));
   EXPECT_NE(error.find("cannot open"), std::string::npos) << error;
 
   // Only the needed columns, no status: one "unknown" group.
   write("subframe_id_a,subframe_id_b,utime_a_us,utime_b_us,dx_m,dy_m,dz_m,dheading_rad\n1,2,100,200,1,2,3,0.1\n");
-  ASSERT_TRUE(readClosureCsv(path_, closures, error)) << error;
+  ASSERT_OK(readClosureCsv(path_, closures));
   ASSERT_EQ(closures.size(), 1u);
   EXPECT_EQ(closures[0].status, "unknown");
   EXPECT_EQ(closures[0].round, -1);
@@ -207,7 +208,7 @@ TEST_F(ClosureMetrics, HorizontalNeesUsesTheClosuresOwnCovariance) {
   write(text);
   std::vector<ClosureRecord> closures;
   std::string error;
-  ASSERT_TRUE(readClosureCsv(path_, closures, error)) << error;
+  ASSERT_OK(readClosureCsv(path_, closures));
   ASSERT_EQ(closures.size(), 3u);
   EXPECT_TRUE(closures[0].has_covariance);
   EXPECT_DOUBLE_EQ(closures[1].horizontal_covariance_m2(0, 1), 0.02);
@@ -226,7 +227,7 @@ TEST_F(ClosureMetrics, HorizontalNeesUsesTheClosuresOwnCovariance) {
 
   // A covariance column that is not a number: refused with the line.
   write(text.substr(0, text.rfind(",0,0,0,0")) + ",x,0,0,0\n");
-  EXPECT_FALSE(readClosureCsv(path_, closures, error));
+  error = sss::testing::failureMessage(readClosureCsv(path_, closures));
   EXPECT_NE(error.find("cov_xx_m2"), std::string::npos) << error;
 }
 

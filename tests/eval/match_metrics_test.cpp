@@ -102,7 +102,7 @@ TEST(MatchFile, EvaluationFromTheFileEqualsTheInProcessOne) {
   std::string error;
 
   MatchFileEvaluation file;
-  ASSERT_TRUE(evaluateMatchFile((dir / "matches.csv").string(), dir.string(), file, error)) << error;
+  ASSERT_OK(evaluateMatchFile((dir / "matches.csv").string(), dir.string(), file));
   ASSERT_EQ(file.pairs.size(), 2u);
   EXPECT_EQ(file.pairs[0].type, PairType::kAntiParallel);
   EXPECT_EQ(file.pairs[1].type, PairType::kCrossing);
@@ -128,7 +128,7 @@ TEST(MatchFile, EvaluationFromTheFileEqualsTheInProcessOne) {
     std::ofstream append(dir / "matches.csv", std::ios::app);
     append << "match,1,2,0,abc,1,1,1,0,0,port,port,0,0,0,0,0,0,0,1,\n";
   }
-  EXPECT_FALSE(evaluateMatchFile((dir / "matches.csv").string(), dir.string(), file, error));
+  error = sss::testing::failureMessage(evaluateMatchFile((dir / "matches.csv").string(), dir.string(), file));
   EXPECT_NE(error.find("matches.csv:"), std::string::npos) << error;
   EXPECT_NE(error.find("row_a is not a number"), std::string::npos) << error;
   fs::remove_all(dir);

@@ -3,6 +3,7 @@
 // bit-for-bit repeatable and its recorded LCM log replays to the same trajectory, the sonar
 // file's embedded navigation works without an INS file, and bad input is refused cleanly.
 #include "tests/process/offline_runner_fixture.hpp"
+#include "tests/support/status_assertions.hpp"
 
 namespace {
 
@@ -214,7 +215,7 @@ TEST_F(OfflineRunnerTest, WrittenMatchesAreEvaluatedAgainstTheTruth) {
   ASSERT_TRUE(result.ok) << result.error;
   sss::eval::MatchFileEvaluation evaluation;
   std::string error;
-  ASSERT_TRUE(sss::eval::evaluateMatchFile(r.out_dir + "/matches.csv", root_ + "/mission", evaluation, error)) << error;
+  ASSERT_OK(sss::eval::evaluateMatchFile(r.out_dir + "/matches.csv", root_ + "/mission", evaluation));
   std::printf("matches.csv: %zu pair rounds, %ld matches, within 2 px %.3f, recall %.3f, EPE %.2f px\n",
               evaluation.pairs.size(), evaluation.overall.matches, evaluation.overall.withinFraction(),
               evaluation.overall.recall(), evaluation.overall.meanErrorPx());
@@ -228,7 +229,7 @@ TEST_F(OfflineRunnerTest, WrittenMatchesAreEvaluatedAgainstTheTruth) {
   EXPECT_GT(evaluation.overall.recall(), 0.05);
 
   // A matches file against a folder without the mission is refused with a reason.
-  EXPECT_FALSE(sss::eval::evaluateMatchFile(r.out_dir + "/matches.csv", r.out_dir, evaluation, error));
+  error = sss::testing::failureMessage(sss::eval::evaluateMatchFile(r.out_dir + "/matches.csv", r.out_dir, evaluation));
   EXPECT_NE(error.find("mission.yaml"), std::string::npos) << error;
 }
 
@@ -247,7 +248,7 @@ TEST_F(OfflineRunnerTest, InjectedFalseClosuresAreAllRejectedAndSlamStillBeatsDr
 
   std::vector<sss::eval::ClosureRecord> closures;
   std::string error;
-  ASSERT_TRUE(sss::eval::readClosureCsv(r.out_dir + "/loop_closures.csv", closures, error)) << error;
+  ASSERT_OK(sss::eval::readClosureCsv(r.out_dir + "/loop_closures.csv", closures));
   const auto truth = sss::eval::readTum(root_ + "/mission/ground_truth.tum");
   ASSERT_TRUE(truth.ok);
   const auto evaluation = sss::eval::evaluateClosures(closures, truth.poses, nullptr, 1.0);

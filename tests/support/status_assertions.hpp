@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
+
 #include "pipeline/core/status.hpp"
 
 namespace sss::testing {
@@ -17,6 +19,12 @@ template <typename T>
 ::testing::AssertionResult isOk(const sss::core::Result<T>& result) {
   if (result.ok()) return ::testing::AssertionSuccess();
   return ::testing::AssertionFailure() << "error: " << result.message();
+}
+
+// The message of a call that must fail (a test failure when it succeeds), for the checks on it.
+inline std::string failureMessage(const sss::core::Status& status) {
+  EXPECT_FALSE(status.ok) << "expected a failure";
+  return status.message;
 }
 
 }  // namespace sss::testing

@@ -15,6 +15,8 @@
 #include "tools/eval/csv_fields.hpp"
 
 namespace sss::eval {
+
+using sss::core::Status;
 namespace {
 
 SignedErrorStatistics signedStatistics(const std::vector<double>& values) {
@@ -32,18 +34,20 @@ SignedErrorStatistics signedStatistics(const std::vector<double>& values) {
 
 }  // namespace
 
-bool readClosureCsv(const std::string& path, std::vector<ClosureRecord>& closures, std::string& error) {
+sss::core::Status readClosureCsv(const std::string& path, std::vector<ClosureRecord>& closures) {
   const std::vector<const char*> kIntegers = {"subframe_id_a", "subframe_id_b", "utime_a_us", "utime_b_us"};
   const std::vector<const char*> kNumbers = {"dx_m", "dy_m", "dz_m", "dheading_rad"};
   const std::vector<const char*> kCovariance = {"cov_xx_m2", "cov_xy_m2", "cov_yy_m2"};
   std::vector<std::string> required(kIntegers.begin(), kIntegers.end());
   required.insert(required.end(), kNumbers.begin(), kNumbers.end());
   CsvTable table;
-  if (!readCsvTable(path, required,
-                    "the loop_closures.csv of sss-process: subframe_id_a,subframe_id_b,utime_a_us,utime_b_us,round,"
-                    "status,rejection,dx_m,dy_m,dz_m,droll_rad,dpitch_rad,dheading_rad,...",
-                    table, error)) {
-    return false;
+  if (const Status read = readCsvTable(
+          path, required,
+          "the loop_closures.csv of sss-process: subframe_id_a,subframe_id_b,utime_a_us,utime_b_us,round,"
+          "status,rejection,dx_m,dy_m,dz_m,droll_rad,dpitch_rad,dheading_rad,...",
+          table);
+      !read) {
+    return read;
   }
   const bool has_covariance = table.has("cov_xx_m2") && table.has("cov_xy_m2") && table.has("cov_yy_m2");
   closures.clear();
@@ -52,9 +56,8 @@ bool readClosureCsv(const std::string& path, std::vector<ClosureRecord>& closure
     record.line = row.line;
     int64_t integers[4];
     double numbers[4];
-    if (!parseIntegerColumns(table, row, kIntegers, integers, error) ||
-        !parseNumberColumns(table, row, kNumbers, numbers, error))
-      return false;
+    if (const Status parsed = parseIntegerColumns(table, row, kIntegers, integers); !parsed) return parsed;
+    if (const Status parsed = parseNumberColumns(table, row, kNumbers, numbers); !parsed) return parsed;
     record.subframe_id_a = integers[0];
     record.subframe_id_b = integers[1];
     record.utime_a_us = integers[2];
@@ -63,7 +66,7 @@ bool readClosureCsv(const std::string& path, std::vector<ClosureRecord>& closure
     record.heading_rad = numbers[3];
     if (table.has("round")) {
       int64_t round = 0;
-      if (!parseIntegerColumns(table, row, {"round"}, &round, error)) return false;
+      if (const Status parsed = parseIntegerColumns(table, row, {"round"}, &round); !parsed) return parsed;
       record.round = static_cast<int>(round);
     }
     record.status = table.has("status") ? table.field(row, "status") : "unknown";
@@ -71,13 +74,13 @@ bool readClosureCsv(const std::string& path, std::vector<ClosureRecord>& closure
     if (table.has("rejection")) record.rejection = table.field(row, "rejection");
     if (has_covariance) {
       double c[3];
-      if (!parseNumberColumns(table, row, kCovariance, c, error)) return false;
+      if (const Status parsed = parseNumberColumns(table, row, kCovariance, c); !parsed) return parsed;
       record.horizontal_covariance_m2 << c[0], c[1], c[1], c[2];
       record.has_covariance = true;
     }
     closures.push_back(std::move(record));
   }
-  return true;
+  return Status::success();
 }
 
 RelativePoseXyzHeading relativePose(const sss::core::Pose& T_world_a, const sss::core::Pose& T_world_b) {

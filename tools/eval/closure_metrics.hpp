@@ -34,9 +34,9 @@ struct ClosureRecord {
 
 // Header line first (columns found by name in any order, extra columns ignored; needed:
 // subframe_id_a, subframe_id_b, utime_a_us, utime_b_us, dx_m, dy_m, dz_m, dheading_rad; optional:
-// round, status, rejection, cov_xx_m2 + cov_xy_m2 + cov_yy_m2), then one closure per line; '#' and blank lines are skipped. False
-// with "FILE:LINE: ..." on the first problem.
-bool readClosureCsv(const std::string& path, std::vector<ClosureRecord>& closures, std::string& error);
+// round, status, rejection, cov_xx_m2 + cov_xy_m2 + cov_yy_m2), then one closure per line; '#' and
+// blank lines are skipped. Fails with "FILE:LINE: ..." on the first problem.
+sss::core::Status readClosureCsv(const std::string& path, std::vector<ClosureRecord>& closures);
 
 // The relative pose of B in A as a closure states it: translation in A's body frame (FRD) and the
 // heading (yaw) of R_a^T R_b.

@@ -9,6 +9,8 @@
 
 namespace sss::eval {
 
+using sss::core::Status;
+
 std::string trimField(const std::string& text) {
   const size_t first = text.find_first_not_of(" \t\r");
   if (first == std::string::npos) return "";
@@ -39,12 +41,11 @@ bool parseInteger64(const std::string& text, int64_t& value) {
   return !text.empty() && end == text.c_str() + text.size() && errno != ERANGE;
 }
 
-bool forEachCsvRow(const std::string& path, const std::vector<std::string>& required, const std::string& expected,
-                   CsvTable& table, const CsvRowHandler& on_row, std::string& error) {
+Status forEachCsvRow(const std::string& path, const std::vector<std::string>& required, const std::string& expected,
+                     CsvTable& table, const CsvRowHandler& on_row) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
-    error = path + ": cannot open; check the path";
-    return false;
+    return Status::error(path + ": cannot open; check the path");
   }
   table = CsvTable{};
   table.path = path;
@@ -60,60 +61,56 @@ bool forEachCsvRow(const std::string& path, const std::vector<std::string>& requ
       for (size_t k = 0; k < row.fields.size(); ++k) table.column[row.fields[k]] = k;
       for (const std::string& name : required) {
         if (!table.has(name)) {
-          error = table.where(row) + "the header has no column '" + name + "' (expected " + expected + ")";
-          return false;
+          return Status::error(table.where(row) + "the header has no column '" + name + "' (expected " + expected +
+                               ")");
         }
       }
       have_header = true;
       continue;
     }
     if (row.fields.size() != table.column.size()) {
-      error = table.where(row) + std::to_string(row.fields.size()) + " fields, the header has " +
-              std::to_string(table.column.size());
-      return false;
+      return Status::error(table.where(row) + std::to_string(row.fields.size()) + " fields, the header has " +
+                           std::to_string(table.column.size()));
     }
-    if (!on_row(table, row, error)) return false;
+    if (const Status taken = on_row(table, row); !taken) return taken;
   }
   if (!have_header) {
-    error = path + ": no header line (expected " + expected + ")";
-    return false;
+    return Status::error(path + ": no header line (expected " + expected + ")");
   }
-  return true;
+  return Status::success();
 }
 
-bool parseNumberColumns(const CsvTable& table, const CsvRow& row, const std::vector<const char*>& names,
-                        double* values, std::string& error) {
+Status parseNumberColumns(const CsvTable& table, const CsvRow& row, const std::vector<const char*>& names,
+                          double* values) {
   for (size_t k = 0; k < names.size(); ++k) {
     const std::string& field = table.field(row, names[k]);
     if (!parseFiniteDouble(field, values[k])) {
-      error = table.where(row) + names[k] + " '" + field + "' is not a finite number";
-      return false;
+      return Status::error(table.where(row) + names[k] + " '" + field + "' is not a finite number");
     }
   }
-  return true;
+  return Status::success();
 }
 
-bool parseIntegerColumns(const CsvTable& table, const CsvRow& row, const std::vector<const char*>& names,
-                         int64_t* values, std::string& error) {
+Status parseIntegerColumns(const CsvTable& table, const CsvRow& row, const std::vector<const char*>& names,
+                           int64_t* values) {
   for (size_t k = 0; k < names.size(); ++k) {
     const std::string& field = table.field(row, names[k]);
     if (!parseInteger64(field, values[k])) {
-      error = table.where(row) + names[k] + " '" + field + "' is not an integer";
-      return false;
+      return Status::error(table.where(row) + names[k] + " '" + field + "' is not an integer");
     }
   }
-  return true;
+  return Status::success();
 }
 
-bool readCsvTable(const std::string& path, const std::vector<std::string>& required, const std::string& expected,
-                  CsvTable& table, std::string& error) {
+Status readCsvTable(const std::string& path, const std::vector<std::string>& required, const std::string& expected,
+                    CsvTable& table) {
   std::vector<CsvRow> rows;
-  const bool ok = forEachCsvRow(path, required, expected, table, [&](const CsvTable&, CsvRow& row, std::string&) {
+  const Status read = forEachCsvRow(path, required, expected, table, [&](const CsvTable&, CsvRow& row) {
     rows.push_back(std::move(row));
-    return true;
-  }, error);
+    return Status::success();
+  });
   table.rows = std::move(rows);
-  return ok;
+  return read;
 }
 
 }  // namespace sss::eval

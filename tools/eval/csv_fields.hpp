@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/core/status.hpp"
+
 namespace sss::eval {
 
 // Without leading and trailing spaces, tabs and CRs.
@@ -35,25 +37,24 @@ struct CsvTable {
   std::string where(const CsvRow& row) const { return path + ":" + std::to_string(row.line) + ": "; }
 };
 
-// The named fields of a row as numbers / integers, in the order of `names`; false with
+// The named fields of a row as numbers / integers, in the order of `names`; fails with
 // "PATH:LINE: NAME 'TEXT' is not a finite number" (or "an integer") for the first that is not.
-bool parseNumberColumns(const CsvTable& table, const CsvRow& row, const std::vector<const char*>& names,
-                        double* values, std::string& error);
-bool parseIntegerColumns(const CsvTable& table, const CsvRow& row, const std::vector<const char*>& names,
-                         int64_t* values, std::string& error);
+sss::core::Status parseNumberColumns(const CsvTable& table, const CsvRow& row, const std::vector<const char*>& names,
+                                     double* values);
+sss::core::Status parseIntegerColumns(const CsvTable& table, const CsvRow& row, const std::vector<const char*>& names,
+                                      int64_t* values);
 
 // Reads path: '#' and blank lines skipped, the first other line is the header, every row must have
 // as many fields as the header. False with "PATH[:LINE]: ..." on a missing file, a missing
 // required column or header, or a row of another length; `expected` (e.g. "a,b,...") is quoted
 // in the header messages.
-bool readCsvTable(const std::string& path, const std::vector<std::string>& required, const std::string& expected,
-                  CsvTable& table, std::string& error);
+sss::core::Status readCsvTable(const std::string& path, const std::vector<std::string>& required,
+                               const std::string& expected, CsvTable& table);
 
 // The same reading, row by row, for files too large to hold as text (matches.csv): `table` has the
-// header and no rows; each row goes to on_row (which may move it away), which returns false with an
-// error to stop.
-using CsvRowHandler = std::function<bool(const CsvTable& table, CsvRow& row, std::string& error)>;
-bool forEachCsvRow(const std::string& path, const std::vector<std::string>& required, const std::string& expected,
-                   CsvTable& table, const CsvRowHandler& on_row, std::string& error);
+// header and no rows; each row goes to on_row (which may move it away), which fails to stop.
+using CsvRowHandler = std::function<sss::core::Status(const CsvTable& table, CsvRow& row)>;
+sss::core::Status forEachCsvRow(const std::string& path, const std::vector<std::string>& required,
+                                const std::string& expected, CsvTable& table, const CsvRowHandler& on_row);
 
 }  // namespace sss::eval

@@ -168,8 +168,10 @@ int main(int argc, char** argv) {
     }
     if (!request.matches_path.empty()) {
       // Apart from runEvaluation: it needs the simulator to rebuild the truth.
-      if (!sss::eval::evaluateMatchFile(request.matches_path, request.mission_dir, report.matches, error)) {
-        std::cerr << "sss-eval: " << error << "\n";
+      if (const sss::core::Status evaluated =
+              sss::eval::evaluateMatchFile(request.matches_path, request.mission_dir, report.matches);
+          !evaluated) {
+        std::cerr << "sss-eval: " << evaluated.message << "\n";
         return 2;
       }
       report.has_matches = true;

@@ -162,7 +162,10 @@ struct PairRows {
 
 }  // namespace
 
-bool evaluateMatchFile(const std::string& matches_path, const std::string& mission_dir, MatchFileEvaluation& result,
+namespace {
+
+// evaluateMatchFile's work; its row callback and checks say what went wrong in `error`.
+bool evaluateMatchRows(const std::string& matches_path, const std::string& mission_dir, MatchFileEvaluation& result,
                        std::string& error) {
   result = MatchFileEvaluation{};
   result.path = matches_path;
@@ -178,7 +181,7 @@ bool evaluateMatchFile(const std::string& matches_path, const std::string& missi
                                              "col_b", "utime_a_us", "altitude_a_m", "zncc", "heading_a_rad",
                                              "heading_b_rad", "valid_columns"};
   CsvTable table;
-  const auto onRow = [&](const CsvTable& t, const CsvRow& row, std::string& message) {
+  const auto parseRow = [&](const CsvTable& t, const CsvRow& row, std::string& message) {
     const auto number = [&](const char* name, double& value) {
       if (parseFiniteDouble(t.field(row, name), value)) return true;
       message = t.where(row) + "column " + name + " is not a number: '" + t.field(row, name) + "'";
@@ -250,7 +253,14 @@ bool evaluateMatchFile(const std::string& matches_path, const std::string& missi
     pair.matches.push_back(m);
     return true;
   };
-  if (!forEachCsvRow(matches_path, required, kExpectedHeader, table, onRow, error)) return false;
+  const auto onRow = [&](const CsvTable& t, CsvRow& row) {
+    std::string message;
+    return parseRow(t, row, message) ? sss::core::Status::success() : sss::core::Status::error(message);
+  };
+  if (const sss::core::Status read = forEachCsvRow(matches_path, required, kExpectedHeader, table, onRow); !read) {
+    error = read.message;
+    return false;
+  }
   if (pairs.empty()) return true;  // the matcher tried no pair: nothing to evaluate
 
   // Parameters of the matching image.
@@ -378,6 +388,15 @@ bool evaluateMatchFile(const std::string& matches_path, const std::string& missi
     result.pairs.push_back(std::move(report));
   }
   return true;
+}
+
+}  // namespace
+
+sss::core::Status evaluateMatchFile(const std::string& matches_path, const std::string& mission_dir,
+                                    MatchFileEvaluation& result) {
+  std::string error;
+  if (!evaluateMatchRows(matches_path, mission_dir, result, error)) return sss::core::Status::error(error);
+  return sss::core::Status::success();
 }
 
 }  // namespace sss::eval

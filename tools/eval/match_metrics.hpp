@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include "pipeline/core/status.hpp"
+
 // Only references here, so the report code can include this without the simulator and the matcher.
 namespace sss::sim {
 class Mission;
@@ -112,8 +114,8 @@ struct MatchFileEvaluation {
 };
 
 // Reads matches.csv and evaluates every match and probe against the truth rebuilt from
-// MISSION_DIR/mission.yaml. False with "FILE[:LINE]: ..." for unusable input.
-bool evaluateMatchFile(const std::string& matches_path, const std::string& mission_dir, MatchFileEvaluation& result,
-                       std::string& error);
+// MISSION_DIR/mission.yaml. Fails with "FILE[:LINE]: ..." for unusable input.
+sss::core::Status evaluateMatchFile(const std::string& matches_path, const std::string& mission_dir,
+                                    MatchFileEvaluation& result);
 
 }  // namespace sss::eval

@@ -215,7 +215,10 @@ bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalR
 
   if (!request.closures_path.empty()) {
     std::vector<ClosureRecord> closures;
-    if (!readClosureCsv(request.closures_path, closures, error)) return false;
+    if (const sss::core::Status read = readClosureCsv(request.closures_path, closures); !read) {
+      error = read.message;
+      return false;
+    }
     report.has_closures = true;
     report.closures.path = request.closures_path;
     Trajectory dr;

@@ -5,6 +5,8 @@
 
 namespace sss::eval {
 
+using sss::core::Status;
+
 using namespace report_internal;
 
 namespace {
@@ -83,12 +85,14 @@ void readHeightmaps(RunReport& report, const RunReportRequest& request) {
 
 // ---- loop closures and summary -----------------------------------------------------------
 
-bool readLoopClosures(const std::string& path, std::vector<LoopClosureRecord>& closures, std::string& error) {
+sss::core::Status readLoopClosures(const std::string& path, std::vector<LoopClosureRecord>& closures) {
   const std::vector<const char*> kCentres = {"north_a_m", "east_a_m", "north_b_m", "east_b_m"};
   CsvTable table;
-  if (!readCsvTable(path, {"status", kCentres[0], kCentres[1], kCentres[2], kCentres[3]},
-                    "subframe_id_a,subframe_id_b,...,status,...,north_a_m,east_a_m,north_b_m,east_b_m", table, error)) {
-    return false;
+  if (const Status read =
+          readCsvTable(path, {"status", kCentres[0], kCentres[1], kCentres[2], kCentres[3]},
+                       "subframe_id_a,subframe_id_b,...,status,...,north_a_m,east_a_m,north_b_m,east_b_m", table);
+      !read) {
+    return read;
   }
   closures.clear();
   for (const CsvRow& row : table.rows) {
@@ -97,12 +101,12 @@ bool readLoopClosures(const std::string& path, std::vector<LoopClosureRecord>& c
     record.status = table.field(row, "status");
     if (record.status != "accepted" && record.status != "rejected" && record.status != "pending" &&
         record.status != "superseded") {
-      error = table.where(row) + "status '" + record.status + "' is not accepted, rejected, pending or superseded";
-      return false;
+      return Status::error(table.where(row) + "status '" + record.status +
+                           "' is not accepted, rejected, pending or superseded");
     }
     if (table.has("rejection")) record.rejection = table.field(row, "rejection");
     double values[4];
-    if (!parseNumberColumns(table, row, kCentres, values, error)) return false;
+    if (const Status parsed = parseNumberColumns(table, row, kCentres, values); !parsed) return parsed;
     record.centre_a_north_east_m = Eigen::Vector2d(values[0], values[1]);
     record.centre_b_north_east_m = Eigen::Vector2d(values[2], values[3]);
     if (table.has("subframe_id_a") && table.has("subframe_id_b")) {
@@ -114,12 +118,12 @@ bool readLoopClosures(const std::string& path, std::vector<LoopClosureRecord>& c
       if (!table.has(names[0])) continue;
       const std::vector<const char*> columns = {names[0].c_str(), names[1].c_str(), names[2].c_str(), names[3].c_str()};
       double offset[4];
-      if (!parseNumberColumns(table, row, columns, offset, error)) return false;
+      if (const Status parsed = parseNumberColumns(table, row, columns, offset); !parsed) return parsed;
       *target = Eigen::Vector4d(offset[0], offset[1], offset[2], offset[3]);
     }
     closures.push_back(std::move(record));
   }
-  return true;
+  return Status::success();
 }
 
 LoopClosureCounts countClosures(const std::vector<LoopClosureRecord>& closures) {
@@ -271,15 +275,15 @@ RunReport writeRunReport(const RunReportRequest& request, const RunReportOptions
     report.closures_path = joinPath(request.run_dir, "loop_closures.csv");
     if (!fileExists(report.closures_path)) {
       report.notes.push_back("no loop_closures.csv in the run folder (" + report.closures_path + "): no closure graph");
-    } else if (!readLoopClosures(report.closures_path, report.closures, error)) {
-      report.notes.push_back("loop closures unusable, no closure graph: " + error);
+    } else if (const Status read = readLoopClosures(report.closures_path, report.closures); !read) {
+      report.notes.push_back("loop closures unusable, no closure graph: " + read.message);
     } else {
       report.has_closures = true;
       report.closure_counts = countClosures(report.closures);
       // The same file as sss-eval --closures reads: relative pose errors of the accepted closures.
       std::vector<ClosureRecord> records;
-      if (!readClosureCsv(report.closures_path, records, error)) {
-        report.notes.push_back("loop closures without relative poses, no closure errors: " + error);
+      if (const Status read = readClosureCsv(report.closures_path, records); !read) {
+        report.notes.push_back("loop closures without relative poses, no closure errors: " + read.message);
       } else {
         const ClosureEvaluation closures =
             evaluateClosures(records, truth, &dr, options.trajectory.association.max_interpolation_gap_s);

@@ -98,8 +98,8 @@ struct LoopClosureCounts {
 
 // Header line first (columns are found by name, in any order; extra columns are ignored; needed:
 // status, north_a_m, east_a_m, north_b_m, east_b_m), then one closure per line; '#' lines and
-// blank lines are skipped. False with "FILE:LINE: ..." on the first problem.
-bool readLoopClosures(const std::string& path, std::vector<LoopClosureRecord>& closures, std::string& error);
+// blank lines are skipped. Fails with "FILE:LINE: ..." on the first problem.
+sss::core::Status readLoopClosures(const std::string& path, std::vector<LoopClosureRecord>& closures);
 LoopClosureCounts countClosures(const std::vector<LoopClosureRecord>& closures);
 
 // ---- summary.json --------------------------------------------------------------------------
