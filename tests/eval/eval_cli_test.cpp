@@ -4,6 +4,7 @@
 #include "tools/eval/trajectory_io.hpp"
 
 #include "tests/eval/eval_test_paths.hpp"
+#include "tests/support/status_assertions.hpp"
 
 #include <gtest/gtest.h>
 #include <yaml-cpp/yaml.h>
@@ -47,9 +48,9 @@ class EvalCli : public ::testing::Test {
     fs::create_directories(dir_);
     truth_ = test::lawnmower(3, 200.0, 60.0);
     std::string error;
-    ASSERT_TRUE(writeTum(path("truth.tum"), truth_, error)) << error;
-    ASSERT_TRUE(writeTum(path("dr.tum"), shifted(2.0), error)) << error;
-    ASSERT_TRUE(writeTum(path("slam.tum"), shifted(0.5), error)) << error;
+    ASSERT_OK(writeTum(path("truth.tum"), truth_));
+    ASSERT_OK(writeTum(path("dr.tum"), shifted(2.0)));
+    ASSERT_OK(writeTum(path("slam.tum"), shifted(0.5)));
   }
   void TearDown() override { fs::remove_all(dir_); }
 
@@ -158,7 +159,7 @@ TEST_F(EvalCli, NoLceTurnsTheDefaultLceOffAndATruthWithoutLinesSkipsIt) {
 
   // A 40 m straight line has no survey line: the default LCE is skipped with a reason, --lce fails.
   std::string error;
-  ASSERT_TRUE(writeTum(path("short.tum"), test::straightLine(40.0), error)) << error;
+  ASSERT_OK(writeTum(path("short.tum"), test::straightLine(40.0)));
   ProgramRun result = run("--gt " + path("short.tum") + " --est " + path("short.tum") + " --json " + path("short.json"));
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_NE(result.out.find("LCE) skipped"), std::string::npos) << result.out;
@@ -181,8 +182,8 @@ TEST_F(EvalCli, ComparesHeightmapsAndWritesErrorMaps) {
   HeightmapRaster estimate = seabed;
   for (size_t i = 0; i < estimate.depth_m.size(); ++i) estimate.depth_m[i] = i % 4 == 0 ? NAN : 50.3f;
   std::string error;
-  ASSERT_TRUE(writeHeightmap(path("seabed"), seabed, error)) << error;
-  ASSERT_TRUE(writeHeightmap(path("recon.yaml"), estimate, error)) << error;
+  ASSERT_OK(writeHeightmap(path("seabed"), seabed));
+  ASSERT_OK(writeHeightmap(path("recon.yaml"), estimate));
   const ProgramRun result = run("--seabed " + path("seabed.yaml") + " --heightmap " + path("recon.yaml") + " --json " +
                          path("hm.json") + " --plot " + path("hm.png") + " --error-map " + path("err"));
   ASSERT_EQ(result.exit_code, 0) << result.err;
@@ -276,7 +277,7 @@ TEST_F(EvalCli, BadInputsExitWithCodeTwoAndAClearMessage) {
   Trajectory later = truth_;
   for (StampedPose& p : later) p.utime_us += 86400LL * 1000000;
   std::string error;
-  ASSERT_TRUE(writeTum(path("later.tum"), later, error));
+  ASSERT_OK(writeTum(path("later.tum"), later));
   result = run("--gt " + path("truth.tum") + " --est " + path("later.tum"));
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_NE(result.err.find("same clock"), std::string::npos) << result.err;

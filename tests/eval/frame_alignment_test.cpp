@@ -9,6 +9,7 @@
 
 #include "pipeline/core/geodesy.hpp"
 #include "tools/eval/heightmap_metrics.hpp"
+#include "tests/support/status_assertions.hpp"
 
 namespace sss::eval {
 namespace {
@@ -52,7 +53,7 @@ TEST(FrameAlignment, ReadersReexpressFilesWhoseHeaderNamesAnotherOrigin) {
   poses[0].utime_us = 1'000'000;
   poses[0].T_world_body.translation = Eigen::Vector3d(10.0, 20.0, 30.0);
   std::string error;
-  ASSERT_TRUE(writeTum(dir + "/a.tum", poses, error, "in A", kA)) << error;
+  ASSERT_OK(writeTum(dir + "/a.tum", poses, "in A", kA));
   const TumReadResult same = readTum(dir + "/a.tum");
   ASSERT_TRUE(same.ok && same.origin);
   EXPECT_DOUBLE_EQ(same.origin->latitude_deg, kA.latitude_deg);
@@ -64,7 +65,7 @@ TEST(FrameAlignment, ReadersReexpressFilesWhoseHeaderNamesAnotherOrigin) {
   EXPECT_TRUE(in_b.reexpressed);
   EXPECT_NEAR(in_b.poses[0].T_world_body.translation.x(), -5560.0 + 10.0, 20.0);
   // A file that names no origin is taken as it is.
-  ASSERT_TRUE(writeTum(dir + "/plain.tum", poses, error)) << error;
+  ASSERT_OK(writeTum(dir + "/plain.tum", poses));
   const TumReadResult plain = readTum(dir + "/plain.tum", to_b);
   EXPECT_FALSE(plain.origin);
   EXPECT_FALSE(plain.reexpressed);
@@ -77,11 +78,11 @@ TEST(FrameAlignment, ReadersReexpressFilesWhoseHeaderNamesAnotherOrigin) {
   raster.resolution_m = 2.0;
   raster.depth_m.assign(12, 30.0f);
   raster.origin = kA;
-  ASSERT_TRUE(writeHeightmap(dir + "/map.yaml", raster, error)) << error;
+  ASSERT_OK(writeHeightmap(dir + "/map.yaml", raster));
   HeightmapRaster read;
   HeightmapReadOptions heightmap_to_b;
   heightmap_to_b.target_origin = kB;
-  ASSERT_TRUE(readHeightmap(dir + "/map.yaml", read, error, heightmap_to_b)) << error;
+  ASSERT_OK(readHeightmap(dir + "/map.yaml", read, heightmap_to_b));
   ASSERT_TRUE(read.origin);
   EXPECT_DOUBLE_EQ(read.origin->latitude_deg, kB.latitude_deg);
   const sss::core::LocalTangentPlane a(kA.latitude_deg, kA.longitude_deg), b(kB.latitude_deg, kB.longitude_deg);

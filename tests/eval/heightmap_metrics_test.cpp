@@ -2,6 +2,7 @@
 // the writer/reader round trip and its file:line errors, and the error-map PNG.
 #include "tools/eval/heightmap_metrics.hpp"
 #include "tools/eval/plots.hpp"
+#include "tests/support/status_assertions.hpp"
 
 #include <gtest/gtest.h>
 
@@ -117,15 +118,15 @@ TEST(HeightmapIo, WritesAndReadsTheSimulatorFormat) {
   HeightmapRaster estimate = offsetEstimate(nan_cells, outside_cells);
   estimate.description = "test reconstruction\nsecond comment line";
   std::string error;
-  ASSERT_TRUE(writeHeightmap((dir / "recon.yaml").string(), estimate, error)) << error;
+  ASSERT_OK(writeHeightmap((dir / "recon.yaml").string(), estimate));
   EXPECT_TRUE(fs::exists(dir / "recon_depth.f32"));
   EXPECT_EQ(fs::file_size(dir / "recon_depth.f32"), estimate.depth_m.size() * 4);
-  ASSERT_TRUE(writeHeightmap((dir / "prefix").string(), estimate, error)) << error;
+  ASSERT_OK(writeHeightmap((dir / "prefix").string(), estimate));
   EXPECT_TRUE(fs::exists(dir / "prefix.yaml"));
   EXPECT_TRUE(fs::exists(dir / "prefix_depth.f32"));
 
   HeightmapRaster read;
-  ASSERT_TRUE(readHeightmap((dir / "recon.yaml").string(), read, error)) << error;
+  ASSERT_OK(readHeightmap((dir / "recon.yaml").string(), read));
   EXPECT_EQ(read.rows, estimate.rows);
   EXPECT_EQ(read.cols, estimate.cols);
   EXPECT_DOUBLE_EQ(read.resolution_m, estimate.resolution_m);
@@ -139,11 +140,11 @@ TEST(HeightmapIo, WritesAndReadsTheSimulatorFormat) {
       EXPECT_EQ(read.depth_m[i], estimate.depth_m[i]);
     }
   }
-  EXPECT_FALSE(writeHeightmap("/nonexistent/dir/map", estimate, error));
+  error = sss::testing::failureMessage(writeHeightmap("/nonexistent/dir/map", estimate));
   EXPECT_NE(error.find("/nonexistent/dir/map_depth.f32"), std::string::npos);
   HeightmapRaster bad = estimate;
   bad.depth_m.pop_back();
-  EXPECT_FALSE(writeHeightmap((dir / "bad").string(), bad, error));
+  error = sss::testing::failureMessage(writeHeightmap((dir / "bad").string(), bad));
   fs::remove_all(dir);
 }
 
@@ -163,35 +164,39 @@ TEST(HeightmapIo, ReportsBadFilesWithFileAndLine) {
   HeightmapRaster raster;
   std::string error;
   const std::string header = "rows: 2\ncols: 3\nresolution_m: 1\nnorth_min_m: 0\neast_min_m: 0\n";
-  ASSERT_TRUE(readHeightmap(write("ok.yaml", header + "depth_file: d.f32\n"), raster, error)) << error;
+  ASSERT_OK(readHeightmap(write("ok.yaml", header + "depth_file: d.f32\n"), raster));
   EXPECT_EQ(raster.at(1, 2), 6.0f);
 
-  EXPECT_FALSE(readHeightmap(write("type.yaml", "rows: 2\ncols: three\nresolution_m: 1\nnorth_min_m: 0\neast_min_m: 0\n"
-                                                "depth_file: d.f32\n"), raster, error));
+  error = sss::testing::failureMessage(
+      readHeightmap(write("type.yaml", "rows: 2\ncols: three\nresolution_m: 1\nnorth_min_m: 0\neast_min_m: 0\n"
+                                       "depth_file: d.f32\n"), raster));
   EXPECT_NE(error.find("type.yaml:2: cols: 'three' is not an integer"), std::string::npos) << error;
 
-  EXPECT_FALSE(readHeightmap(write("missing.yaml", "rows: 2\ncols: 3\n"), raster, error));
+  error = sss::testing::failureMessage(readHeightmap(write("missing.yaml", "rows: 2\ncols: 3\n"), raster));
   EXPECT_NE(error.find("missing key 'resolution_m'"), std::string::npos) << error;
 
-  EXPECT_FALSE(readHeightmap(write("size.yaml", "rows: 3\ncols: 3\nresolution_m: 1\nnorth_min_m: 0\neast_min_m: 0\n"
-                                                "depth_file: d.f32\n"), raster, error));
+  error = sss::testing::failureMessage(
+      readHeightmap(write("size.yaml", "rows: 3\ncols: 3\nresolution_m: 1\nnorth_min_m: 0\neast_min_m: 0\n"
+                                       "depth_file: d.f32\n"), raster));
   EXPECT_NE(error.find("24 bytes, but rows x cols x 4 = 36"), std::string::npos) << error;
 
-  EXPECT_FALSE(readHeightmap(write("nofile.yaml", header + "depth_file: none.f32\n"), raster, error));
+  error = sss::testing::failureMessage(readHeightmap(write("nofile.yaml", header + "depth_file: none.f32\n"), raster));
   EXPECT_NE(error.find("nofile.yaml:6: depth_file"), std::string::npos) << error;
 
-  EXPECT_FALSE(readHeightmap(write("syntax.yaml", "rows: 2\ncols: [3\n"), raster, error));
+  error = sss::testing::failureMessage(readHeightmap(write("syntax.yaml", "rows: 2\ncols: [3\n"), raster));
   EXPECT_NE(error.find("syntax.yaml:"), std::string::npos) << error;
 
-  EXPECT_FALSE(readHeightmap(write("res.yaml", "rows: 2\ncols: 3\nresolution_m: -1\nnorth_min_m: 0\neast_min_m: 0\n"
-                                               "depth_file: d.f32\n"), raster, error));
+  error = sss::testing::failureMessage(
+      readHeightmap(write("res.yaml", "rows: 2\ncols: 3\nresolution_m: -1\nnorth_min_m: 0\neast_min_m: 0\n"
+                                      "depth_file: d.f32\n"), raster));
   EXPECT_NE(error.find("res.yaml:3: resolution_m"), std::string::npos) << error;
 
-  EXPECT_FALSE(readHeightmap(write("huge.yaml", "rows: 2000000000\ncols: 2000000000\nresolution_m: 1\n"
-                                                "north_min_m: 0\neast_min_m: 0\ndepth_file: d.f32\n"), raster, error));
+  error = sss::testing::failureMessage(
+      readHeightmap(write("huge.yaml", "rows: 2000000000\ncols: 2000000000\nresolution_m: 1\n"
+                                       "north_min_m: 0\neast_min_m: 0\ndepth_file: d.f32\n"), raster));
   EXPECT_NE(error.find("huge.yaml:1:"), std::string::npos) << error;
 
-  EXPECT_FALSE(readHeightmap((dir / "absent.yaml").string(), raster, error));
+  error = sss::testing::failureMessage(readHeightmap((dir / "absent.yaml").string(), raster));
   EXPECT_NE(error.find("absent.yaml: cannot open"), std::string::npos) << error;
   fs::remove_all(dir);
 }
@@ -203,14 +208,14 @@ TEST(HeightmapPng, WritesAReadableErrorMap) {
   const fs::path path = fs::temp_directory_path() / "sss_eval_error_map.png";
   std::string error;
   double limit = 0.0;
-  ASSERT_TRUE(writeErrorMapPng(path.string(), result.error_map, "test", error, {}, &limit)) << error;
+  ASSERT_OK(writeErrorMapPng(path.string(), result.error_map, "test", {}, &limit));
   EXPECT_DOUBLE_EQ(limit, 0.5);  // 99th percentile 0.25 m rounded up to 1-2-5
   std::ifstream in(path, std::ios::binary);
   char signature[8] = {};
   in.read(signature, 8);
   EXPECT_EQ(std::string(signature + 1, 3), "PNG");
   fs::remove(path);
-  EXPECT_FALSE(writeErrorMapPng("/nonexistent/dir/e.png", result.error_map, "test", error));
+  error = sss::testing::failureMessage(writeErrorMapPng("/nonexistent/dir/e.png", result.error_map, "test"));
 }
 
 TEST(Plots, NiceCeilRoundsUpToOneTwoFive) {

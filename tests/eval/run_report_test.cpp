@@ -89,11 +89,11 @@ class RunReport : public ::testing::Test {
     ASSERT_TRUE(truth.ok) << truth.error;
     Trajectory slam = truth.poses;
     for (StampedPose& p : slam) p.T_world_body.translation.x() += slam_north_offset_m;
-    ASSERT_TRUE(writeTum((run_dir() / "slam.tum").string(), slam, error)) << error;
+    ASSERT_OK(writeTum((run_dir() / "slam.tum").string(), slam));
 
     // Heightmaps on every other seabed cell (cell centres coincide, so bilinear sampling is exact).
     HeightmapRaster seabed;
-    ASSERT_TRUE(readHeightmap((mission_dir_ / "seabed.yaml").string(), seabed, error)) << error;
+    ASSERT_OK(readHeightmap((mission_dir_ / "seabed.yaml").string(), seabed));
     HeightmapRaster coarse;
     coarse.rows = seabed.rows / 2;
     coarse.cols = seabed.cols / 2;
@@ -106,7 +106,7 @@ class RunReport : public ::testing::Test {
     for (const auto& [name, offset_m] : {std::pair{"heightmap", 0.05f}, std::pair{"heightmap_dr", 0.3f}}) {
       HeightmapRaster estimate = coarse;
       for (float& depth : estimate.depth_m) depth += offset_m;
-      ASSERT_TRUE(writeHeightmap((run_dir() / name).string(), estimate, error)) << error;
+      ASSERT_OK(writeHeightmap((run_dir() / name).string(), estimate));
     }
     for (const char* name : {"mosaic_dr", "mosaic_slam"}) {
       fs::copy_file(mission_dir_ / "mosaic.png", run_dir() / (std::string(name) + ".png"), fs::copy_options::overwrite_existing);

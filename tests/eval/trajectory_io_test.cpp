@@ -3,6 +3,7 @@
 #include "tools/eval/trajectory_io.hpp"
 
 #include "tests/eval/eval_test_paths.hpp"
+#include "tests/support/status_assertions.hpp"
 
 #include <gtest/gtest.h>
 
@@ -117,7 +118,7 @@ TEST(TumWriter, RoundTripsThroughAFile) {
   const Trajectory poses = test::lawnmower(2, 50.0, 30.0);
   const std::string path = (std::filesystem::temp_directory_path() / "sss_eval_roundtrip.tum").string();
   std::string error;
-  ASSERT_TRUE(writeTum(path, poses, error, "written by the test\nsecond line")) << error;
+  ASSERT_OK(writeTum(path, poses, "written by the test\nsecond line"));
   const TumReadResult result = readTum(path);
   ASSERT_TRUE(result.ok) << result.error;
   ASSERT_EQ(result.poses.size(), poses.size());
@@ -129,7 +130,7 @@ TEST(TumWriter, RoundTripsThroughAFile) {
     EXPECT_LT(result.poses[i].T_world_body.rotation.angularDistance(poses[i].T_world_body.rotation), 1e-8);
   }
   std::filesystem::remove(path);
-  EXPECT_FALSE(writeTum("/nonexistent/dir/out.tum", poses, error));
+  error = sss::testing::failureMessage(writeTum("/nonexistent/dir/out.tum", poses));
   EXPECT_NE(error.find("/nonexistent/dir/out.tum"), std::string::npos);
 }
 

@@ -50,10 +50,10 @@ TEST_F(OfflineRunnerTest, SonarAndInsFilesGiveEveryOutputAndBeatDeadReckoning) {
   auto heightmapMae = [&](const std::string& name, size_t& compared) {
     sss::eval::HeightmapRaster truth, estimate;
     std::string error;
-    EXPECT_TRUE(sss::eval::readHeightmap(root_ + "/mission/seabed.yaml", truth, error)) << error;
+    EXPECT_OK(sss::eval::readHeightmap(root_ + "/mission/seabed.yaml", truth));
     sss::eval::HeightmapReadOptions in_truth_frame;
     in_truth_frame.target_origin = truth.origin;
-    EXPECT_TRUE(sss::eval::readHeightmap(r.out_dir + "/" + name, estimate, error, in_truth_frame)) << error;
+    EXPECT_OK(sss::eval::readHeightmap(r.out_dir + "/" + name, estimate, in_truth_frame));
     const auto result = sss::eval::compareHeightmaps(truth, estimate);
     EXPECT_TRUE(result.ok) << result.error;
     compared = result.compared_cells;
@@ -346,7 +346,7 @@ TEST_F(OfflineRunnerTest, OriginComesFromTheDataWhereverTheMissionIs) {
       }
       sss::eval::HeightmapRaster heightmap;
       std::string error;
-      ASSERT_TRUE(sss::eval::readHeightmap(r.out_dir + "/heightmap.yaml", heightmap, error)) << error;
+      ASSERT_OK(sss::eval::readHeightmap(r.out_dir + "/heightmap.yaml", heightmap));
       ASSERT_TRUE(heightmap.origin);
       EXPECT_DOUBLE_EQ(heightmap.origin->longitude_deg, s.origin->longitude_deg);
       const std::string ply = readFile(r.out_dir + "/bathymetry.ply");
@@ -398,7 +398,7 @@ TEST_F(OfflineRunnerTest, WithoutAnyAltitudeTheBottomTrackKeepsTheAccuracy) {
   // altitude.csv against the true altitude: the true seabed under the true position.
   sss::eval::HeightmapRaster seabed;
   std::string error;
-  ASSERT_TRUE(sss::eval::readHeightmap(mission + "/seabed.yaml", seabed, error)) << error;
+  ASSERT_OK(sss::eval::readHeightmap(mission + "/seabed.yaml", seabed));
   const auto truth = sss::eval::readTum(mission + "/ground_truth.tum");
   ASSERT_TRUE(truth.ok);
   std::map<int64_t, Eigen::Vector3d> true_position;

@@ -161,9 +161,8 @@ int main(int argc, char** argv) {
 
   try {
     sss::eval::EvalReport report;
-    std::string error;
-    if (!sss::eval::runEvaluation(request, options, report, error)) {
-      std::cerr << "sss-eval: " << error << "\n";
+    if (const sss::core::Status evaluated = sss::eval::runEvaluation(request, options, report); !evaluated) {
+      std::cerr << "sss-eval: " << evaluated.message << "\n";
       return 2;
     }
     if (!request.matches_path.empty()) {
@@ -179,7 +178,7 @@ int main(int argc, char** argv) {
     std::cout << sss::eval::formatTable(report);
     // Without figures (e.g. no python3-matplotlib) the JSON is still written; the exit code says 1.
     std::string figures_error;
-    if (!sss::eval::writeFigures(request, report, error)) figures_error = error;
+    if (const sss::core::Status drawn = sss::eval::writeFigures(request, report); !drawn) figures_error = drawn.message;
     if (!request.json_path.empty()) {
       report.json_path = request.json_path;
       std::ofstream out(request.json_path, std::ios::binary);

@@ -20,8 +20,8 @@ namespace fs = std::filesystem;
 
 // NumPy's .npy format 1.0 (what np.load reads without extra packages): magic, header length,
 // a Python dict literal padded to a multiple of 64 bytes, then the little-endian data (x86/ARM).
-bool writeNpy(const std::string& path, const char* descr, const void* data, size_t bytes, int rows, int cols,
-              std::string& error) {
+sss::core::Status writeNpy(const std::string& path, const char* descr, const void* data, size_t bytes, int rows,
+                           int cols) {
   std::string header = "{'descr': '" + std::string(descr) + "', 'fortran_order': False, 'shape': (" +
                        std::to_string(rows) + ", " + std::to_string(cols) + "), }";
   const size_t preamble = 10;  // magic (6) + version (2) + header length (2)
@@ -37,10 +37,9 @@ bool writeNpy(const std::string& path, const char* descr, const void* data, size
   out.write(static_cast<const char*>(data), static_cast<std::streamsize>(bytes));
   out.close();
   if (!out) {
-    error = "cannot write " + path + "; check the folder is writable and the disk not full";
-    return false;
+    return sss::core::Status::error("cannot write " + path + "; check the folder is writable and the disk not full");
   }
-  return true;
+  return sss::core::Status::success();
 }
 
 std::string lastLine(const std::string& path) {
@@ -52,10 +51,10 @@ std::string lastLine(const std::string& path) {
   return last;
 }
 
-// Runs python script data_dir out_dir with stdout and stderr into log_path; the exit status, or
-// -1 with a message when it could not be started or did not exit normally.
-int runScript(const FigureScriptOptions& options, const std::string& data_dir, const std::string& out_dir,
-              const std::string& log_path, std::string& error) {
+// Runs python script data_dir out_dir with stdout and stderr into log_path; its exit status, or a
+// failure when it could not be started or did not exit normally.
+sss::core::Result<int> runScript(const FigureScriptOptions& options, const std::string& data_dir,
+                                 const std::string& out_dir, const std::string& log_path) {
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
@@ -68,19 +67,17 @@ int runScript(const FigureScriptOptions& options, const std::string& data_dir, c
   const int spawned = posix_spawn(&pid, options.python.c_str(), &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   if (spawned != 0) {
-    error = "cannot start " + options.python + ": " + std::strerror(spawned);
-    return -1;
+    return sss::core::Status::error("cannot start " + options.python + ": " + std::strerror(spawned));
   }
   int status = 0;
   while (waitpid(pid, &status, 0) < 0) {
     if (errno != EINTR) {
-      error = "waiting for " + options.script + ": " + std::strerror(errno);
-      return -1;
+      return sss::core::Status::error("waiting for " + options.script + ": " + std::strerror(errno));
     }
   }
   if (!WIFEXITED(status)) {
-    error = options.script + " was killed by signal " + std::to_string(WTERMSIG(status));
-    return -1;
+    return sss::core::Status::error(options.script + " was killed by signal " +
+                                    std::to_string(WTERMSIG(status)));
   }
   return WEXITSTATUS(status);
 }
@@ -92,11 +89,9 @@ Json writeRaster(FigureBatch& batch, const std::string& name, const char* dtype,
   std::error_code ec;
   fs::create_directories(batch.data_dir, ec);
   const std::string file = name + ".npy";
-  std::string error;
-  if (!writeNpy((fs::path(batch.data_dir) / file).string(), dtype, data, bytes, rows, cols, error) &&
-      batch.error.empty()) {
-    batch.error = error;
-  }
+  const sss::core::Status written =
+      writeNpy((fs::path(batch.data_dir) / file).string(), dtype, data, bytes, rows, cols);
+  if (!written && batch.error.empty()) batch.error = written.message;
   Json raster = Json::object();
   raster["npy"] = file;
   raster["resolution_m"] = resolution_m;
@@ -205,14 +200,13 @@ FigureRun drawFigures(const FigureBatch& batch, const std::string& out_dir, cons
   } else if (problem.empty() && !fs::is_regular_file(options.script, ec)) {
     problem = "the figure script " + options.script + " is missing; run from the build tree or reinstall (cmake --install)";
   } else if (problem.empty()) {
-    std::string error;
-    const int code = runScript(options, batch.data_dir, out_dir, log_path, error);
-    if (code == 3) {
+    const sss::core::Result<int> code = runScript(options, batch.data_dir, out_dir, log_path);
+    if (!code) {
+      problem = code.message();
+    } else if (*code == 3) {
       problem = "matplotlib is not installed for " + options.python + "; run tools/setup-deps.sh (python3-matplotlib)";
-    } else if (code < 0) {
-      problem = error;
-    } else if (code != 0) {
-      problem = options.script + " failed (exit " + std::to_string(code) + "): " + lastLine(log_path) +
+    } else if (*code != 0) {
+      problem = options.script + " failed (exit " + std::to_string(*code) + "): " + lastLine(log_path) +
                 "; whole log in " + log_path;
     }
   }

@@ -12,6 +12,8 @@
 #include <sstream>
 
 namespace sss::eval {
+
+using sss::core::Status;
 namespace {
 
 namespace fs = std::filesystem;
@@ -23,23 +25,21 @@ std::string located(const std::string& path, const YAML::Node& node) {
 }
 
 template <typename T>
-bool readKey(const std::string& path, const YAML::Node& root, const char* key, const char* type_name, T& value,
-             std::string& error) {
+Status readKey(const std::string& path, const YAML::Node& root, const char* key, const char* type_name, T& value) {
   const YAML::Node node = root[key];
   if (!node) {
-    error = path + ": missing key '" + key +
-            "' (a heightmap YAML has rows, cols, resolution_m, north_min_m, east_min_m, depth_file)";
-    return false;
+    return Status::error(path + ": missing key '" + key +
+                         "' (a heightmap YAML has rows, cols, resolution_m, north_min_m, east_min_m, depth_file)");
   }
   try {
     if (!node.IsScalar()) throw YAML::Exception(node.Mark(), "not a scalar");
     value = node.as<T>();
-    return true;
+    return Status::success();
   } catch (const YAML::Exception&) {
     std::ostringstream shown;
     shown << node;
-    error = located(path, node) + ": " + key + ": '" + shown.str().substr(0, 60) + "' is not " + type_name;
-    return false;
+    return Status::error(located(path, node) + ": " + key + ": '" + shown.str().substr(0, 60) + "' is not " +
+                         type_name);
   }
 }
 
@@ -80,83 +80,72 @@ std::optional<double> HeightmapRaster::sampleBilinear(double north_m, double eas
   return depth;
 }
 
-bool readHeightmap(const std::string& yaml_path, HeightmapRaster& raster, std::string& error,
-                   const HeightmapReadOptions& options) {
+Status readHeightmap(const std::string& yaml_path, HeightmapRaster& raster, const HeightmapReadOptions& options) {
   YAML::Node root;
   try {
     root = YAML::LoadFile(yaml_path);
   } catch (const YAML::BadFile&) {
-    error = yaml_path + ": cannot open; check the path";
-    return false;
+    return Status::error(yaml_path + ": cannot open; check the path");
   } catch (const YAML::Exception& e) {
-    error = yaml_path + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg;
-    return false;
+    return Status::error(yaml_path + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
   }
   if (!root.IsMap()) {
-    error = yaml_path + ":1: expected a YAML map with rows, cols, resolution_m, north_min_m, east_min_m, depth_file";
-    return false;
+    return Status::error(yaml_path +
+                         ":1: expected a YAML map with rows, cols, resolution_m, north_min_m, east_min_m, depth_file");
   }
   HeightmapRaster result;
   std::string depth_file;
-  if (!readKey(yaml_path, root, "rows", "an integer", result.rows, error) ||
-      !readKey(yaml_path, root, "cols", "an integer", result.cols, error) ||
-      !readKey(yaml_path, root, "resolution_m", "a number", result.resolution_m, error) ||
-      !readKey(yaml_path, root, "north_min_m", "a number", result.north_min_m, error) ||
-      !readKey(yaml_path, root, "east_min_m", "a number", result.east_min_m, error) ||
-      !readKey(yaml_path, root, "depth_file", "a file name", depth_file, error)) {
-    return false;
-  }
+  Status read = readKey(yaml_path, root, "rows", "an integer", result.rows);
+  if (read) read = readKey(yaml_path, root, "cols", "an integer", result.cols);
+  if (read) read = readKey(yaml_path, root, "resolution_m", "a number", result.resolution_m);
+  if (read) read = readKey(yaml_path, root, "north_min_m", "a number", result.north_min_m);
+  if (read) read = readKey(yaml_path, root, "east_min_m", "a number", result.east_min_m);
+  if (read) read = readKey(yaml_path, root, "depth_file", "a file name", depth_file);
+  if (!read) return read;
   if (root["origin_latitude_deg"] || root["origin_longitude_deg"]) {
     sss::core::MissionOrigin origin;
-    if (!readKey(yaml_path, root, "origin_latitude_deg", "a number", origin.latitude_deg, error) ||
-        !readKey(yaml_path, root, "origin_longitude_deg", "a number", origin.longitude_deg, error)) {
-      return false;
-    }
+    read = readKey(yaml_path, root, "origin_latitude_deg", "a number", origin.latitude_deg);
+    if (read) read = readKey(yaml_path, root, "origin_longitude_deg", "a number", origin.longitude_deg);
+    if (!read) return read;
     if (!sss::core::isValidOrigin(origin.latitude_deg, origin.longitude_deg)) {
-      error = located(yaml_path, root["origin_latitude_deg"]) + ": the origin must be a latitude in (-90, 90) and a "
-              "longitude in [-180, 180] (degrees)";
-      return false;
+      return Status::error(located(yaml_path, root["origin_latitude_deg"]) +
+                           ": the origin must be a latitude in (-90, 90) and a longitude in [-180, 180] (degrees)");
     }
     result.origin = origin;
   }
   if (result.rows < 1 || result.cols < 1) {
-    error = located(yaml_path, root[result.rows < 1 ? "rows" : "cols"]) + ": rows and cols must be >= 1";
-    return false;
+    return Status::error(located(yaml_path, root[result.rows < 1 ? "rows" : "cols"]) + ": rows and cols must be >= 1");
   }
   if (!std::isfinite(result.resolution_m) || result.resolution_m <= 0.0) {
-    error = located(yaml_path, root["resolution_m"]) + ": resolution_m must be a positive number";
-    return false;
+    return Status::error(located(yaml_path, root["resolution_m"]) + ": resolution_m must be a positive number");
   }
   if (!std::isfinite(result.north_min_m) || !std::isfinite(result.east_min_m)) {
-    error = located(yaml_path, root["north_min_m"]) + ": north_min_m and east_min_m must be finite";
-    return false;
+    return Status::error(located(yaml_path, root["north_min_m"]) + ": north_min_m and east_min_m must be finite");
   }
   const int64_t cells = static_cast<int64_t>(result.rows) * result.cols;
   if (cells > options.max_cells) {
-    error = located(yaml_path, root["rows"]) + ": " + std::to_string(result.rows) + " x " +
-            std::to_string(result.cols) + " cells exceeds the limit of " + std::to_string(options.max_cells);
-    return false;
+    return Status::error(located(yaml_path, root["rows"]) + ": " + std::to_string(result.rows) + " x " +
+                         std::to_string(result.cols) + " cells exceeds the limit of " +
+                         std::to_string(options.max_cells));
   }
   fs::path depth_path(depth_file);
   if (depth_path.is_relative()) depth_path = fs::path(yaml_path).parent_path() / depth_path;
   std::error_code ec;
   const uintmax_t size = fs::file_size(depth_path, ec);
   if (ec) {
-    error = located(yaml_path, root["depth_file"]) + ": depth_file " + depth_path.string() + ": " + ec.message();
-    return false;
+    return Status::error(located(yaml_path, root["depth_file"]) + ": depth_file " + depth_path.string() + ": " +
+                         ec.message());
   }
   const uintmax_t expected = static_cast<uintmax_t>(cells) * sizeof(float);
   if (size != expected) {
-    error = depth_path.string() + ": " + std::to_string(size) + " bytes, but rows x cols x 4 = " +
-            std::to_string(expected) + " (" + yaml_path + "); the header and the raster do not match";
-    return false;
+    return Status::error(depth_path.string() + ": " + std::to_string(size) + " bytes, but rows x cols x 4 = " +
+                         std::to_string(expected) + " (" + yaml_path + "); the header and the raster do not match");
   }
   result.depth_m.resize(static_cast<size_t>(cells));
   std::ifstream in(depth_path, std::ios::binary);
   in.read(reinterpret_cast<char*>(result.depth_m.data()), static_cast<std::streamsize>(expected));
   if (!in) {
-    error = depth_path.string() + ": read error";
-    return false;
+    return Status::error(depth_path.string() + ": read error");
   }
   if (const YAML::Node units = root["depth_units"]; units && units.IsScalar()) result.units = units.Scalar();
   if (options.target_origin && result.origin && !sameOrigin(*result.origin, *options.target_origin)) {
@@ -164,18 +153,16 @@ bool readHeightmap(const std::string& yaml_path, HeightmapRaster& raster, std::s
     result.origin = options.target_origin;
   }
   raster = std::move(result);
-  return true;
+  return Status::success();
 }
 
-bool writeHeightmap(const std::string& path, const HeightmapRaster& raster, std::string& error) {
+Status writeHeightmap(const std::string& path, const HeightmapRaster& raster) {
   if (raster.rows < 1 || raster.cols < 1 || raster.depth_m.size() != static_cast<size_t>(raster.rows) * raster.cols) {
-    error = "writeHeightmap " + path + ": raster has " + std::to_string(raster.depth_m.size()) + " values for " +
-            std::to_string(raster.rows) + " x " + std::to_string(raster.cols) + " cells";
-    return false;
+    return Status::error("writeHeightmap " + path + ": raster has " + std::to_string(raster.depth_m.size()) +
+                         " values for " + std::to_string(raster.rows) + " x " + std::to_string(raster.cols) + " cells");
   }
   if (!(raster.resolution_m > 0.0)) {
-    error = "writeHeightmap " + path + ": resolution_m must be positive";
-    return false;
+    return Status::error("writeHeightmap " + path + ": resolution_m must be positive");
   }
   std::string prefix = path;
   for (const char* extension : {".yaml", ".yml"}) {
@@ -192,8 +179,7 @@ bool writeHeightmap(const std::string& path, const HeightmapRaster& raster, std:
     out.write(reinterpret_cast<const char*>(raster.depth_m.data()),
               static_cast<std::streamsize>(raster.depth_m.size() * sizeof(float)));
     if (!out) {
-      error = "cannot write " + depth_path + "; check the directory exists, is writable and has space";
-      return false;
+      return Status::error("cannot write " + depth_path + "; check the directory exists, is writable and has space");
     }
   }
   std::ostringstream yaml;
@@ -210,10 +196,9 @@ bool writeHeightmap(const std::string& path, const HeightmapRaster& raster, std:
   out << yaml.str();
   out.close();
   if (!out) {
-    error = "cannot write " + yaml_path + "; check the directory exists and is writable";
-    return false;
+    return Status::error("cannot write " + yaml_path + "; check the directory exists and is writable");
   }
-  return true;
+  return Status::success();
 }
 
 HeightmapErrorResult compareHeightmaps(const HeightmapRaster& truth, const HeightmapRaster& estimate) {

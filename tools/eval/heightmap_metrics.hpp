@@ -12,6 +12,7 @@
 
 #include "pipeline/core/mission_origin.hpp"
 #include "tools/eval/trajectory_metrics.hpp"
+#include "pipeline/core/status.hpp"
 
 namespace sss::eval {
 
@@ -47,13 +48,14 @@ struct HeightmapReadOptions {
 };
 
 // Reads YAML keys rows, cols, resolution_m, north_min_m, east_min_m, depth_file (relative to the
-// YAML's folder unless absolute), and origin_latitude_deg + origin_longitude_deg when present. False with "FILE:LINE: ..." in error on any problem.
-bool readHeightmap(const std::string& yaml_path, HeightmapRaster& raster, std::string& error,
-                   const HeightmapReadOptions& options = {});
+// YAML's folder unless absolute), and origin_latitude_deg + origin_longitude_deg when present.
+// Fails with "FILE:LINE: ..." on any problem.
+sss::core::Status readHeightmap(const std::string& yaml_path, HeightmapRaster& raster,
+                                const HeightmapReadOptions& options = {});
 
 // Writes PREFIX.yaml and PREFIX_depth.f32 (the simulator's layout). path may be the prefix or
-// the YAML path itself ("out/map" or "out/map.yaml"). False with a message in error on failure.
-bool writeHeightmap(const std::string& path, const HeightmapRaster& raster, std::string& error);
+// the YAML path itself ("out/map" or "out/map.yaml"). Fails with a message.
+sss::core::Status writeHeightmap(const std::string& path, const HeightmapRaster& raster);
 
 struct HeightmapErrorResult {
   bool ok = false;

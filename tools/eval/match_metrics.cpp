@@ -15,6 +15,8 @@
 #include "tools/sim/simulated_survey.hpp"
 
 namespace sss::eval {
+
+using sss::core::Status;
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
@@ -111,11 +113,10 @@ struct FileParameters {
 };
 
 // The "# parameters: key=value ..." comment line.
-bool readParameters(const std::string& path, FileParameters& parameters, std::string& error) {
+sss::core::Status readParameters(const std::string& path, FileParameters& parameters) {
   std::ifstream in(path, std::ios::binary);
   if (!in) {
-    error = path + ": cannot open; check the path";
-    return false;
+    return sss::core::Status::error(path + ": cannot open; check the path");
   }
   const std::string prefix = "# parameters:";
   std::string line;
@@ -127,9 +128,9 @@ bool readParameters(const std::string& path, FileParameters& parameters, std::st
       if (equals != std::string::npos) parameters.values[token.substr(0, equals)] = token.substr(equals + 1);
     }
     parameters.found = true;
-    return true;
+    return sss::core::Status::success();
   }
-  return true;
+  return sss::core::Status::success();
 }
 
 bool numbersOf(const std::string& text, size_t count, std::vector<double>& values) {
@@ -162,16 +163,13 @@ struct PairRows {
 
 }  // namespace
 
-namespace {
-
-// evaluateMatchFile's work; its row callback and checks say what went wrong in `error`.
-bool evaluateMatchRows(const std::string& matches_path, const std::string& mission_dir, MatchFileEvaluation& result,
-                       std::string& error) {
+Status evaluateMatchFile(const std::string& matches_path, const std::string& mission_dir,
+                         MatchFileEvaluation& result) {
   result = MatchFileEvaluation{};
   result.path = matches_path;
   result.mission_dir = mission_dir;
   FileParameters parameters;
-  if (!readParameters(matches_path, parameters, error)) return false;
+  if (const Status read = readParameters(matches_path, parameters); !read) return read;
 
   // Rows, streamed (a survey's file holds millions of matches).
   std::map<int64_t, std::vector<PingRow>> pings;
@@ -181,69 +179,70 @@ bool evaluateMatchRows(const std::string& matches_path, const std::string& missi
                                              "col_b", "utime_a_us", "altitude_a_m", "zncc", "heading_a_rad",
                                              "heading_b_rad", "valid_columns"};
   CsvTable table;
-  const auto parseRow = [&](const CsvTable& t, const CsvRow& row, std::string& message) {
+  const auto onRow = [&](const CsvTable& t, CsvRow& row) -> Status {
+    std::string bad_column;  // the first field that did not parse, with what it should be
     const auto number = [&](const char* name, double& value) {
       if (parseFiniteDouble(t.field(row, name), value)) return true;
-      message = t.where(row) + "column " + name + " is not a number: '" + t.field(row, name) + "'";
+      bad_column = "column " + std::string(name) + " is not a number: '" + t.field(row, name) + "'";
       return false;
     };
     const auto integer = [&](const char* name, int64_t& value) {
       if (parseInteger64(t.field(row, name), value)) return true;
-      message = t.where(row) + "column " + name + " is not an integer: '" + t.field(row, name) + "'";
+      bad_column = "column " + std::string(name) + " is not an integer: '" + t.field(row, name) + "'";
       return false;
     };
+    const auto bad = [&] { return Status::error(t.where(row) + bad_column); };
     const std::string& kind = t.field(row, "kind");
     int64_t id_a = 0, id_b = 0, round = 0, utime = 0;
     double row_a = 0.0, col_a = 0.0;
-    if (!integer("subframe_a", id_a) || !number("row_a", row_a)) return false;
+    if (!integer("subframe_a", id_a) || !number("row_a", row_a)) return bad();
     if (kind == "ping") {
       PingRow ping;
       ping.line = row.line;
       ping.present = true;
-      if (!integer("utime_a_us", ping.utime_us) || !number("altitude_a_m", ping.altitude_m)) return false;
+      if (!integer("utime_a_us", ping.utime_us) || !number("altitude_a_m", ping.altitude_m)) return bad();
       std::istringstream runs(t.field(row, "valid_columns"));
       for (std::string run; std::getline(runs, run, ';');) {
         const size_t dash = run.find('-');
         int64_t first = 0, last = 0;
         if (dash == std::string::npos || !parseInteger64(run.substr(0, dash), first) ||
             !parseInteger64(run.substr(dash + 1), last) || first > last) {
-          message = t.where(row) + "valid_columns expects runs FIRST-LAST;..., got '" + t.field(row, "valid_columns") + "'";
-          return false;
+          return Status::error(t.where(row) + "valid_columns expects runs FIRST-LAST;..., got '" +
+                               t.field(row, "valid_columns") + "'");
         }
         ping.valid_runs.emplace_back(static_cast<int>(first), static_cast<int>(last));
       }
       if (row_a < 0 || row_a > 100000 || row_a != std::floor(row_a)) {
-        message = t.where(row) + "row_a of a ping row must be a row number, got '" + t.field(row, "row_a") + "'";
-        return false;
+        return Status::error(t.where(row) + "row_a of a ping row must be a row number, got '" + t.field(row, "row_a") +
+                             "'");
       }
       std::vector<PingRow>& rows = pings[id_a];
       const size_t r = static_cast<size_t>(row_a);
       if (rows.size() <= r) rows.resize(r + 1);
       if (rows[r].present) {
-        message = t.where(row) + "subframe " + std::to_string(id_a) + " row " + std::to_string(r) + " is listed twice";
-        return false;
+        return Status::error(t.where(row) + "subframe " + std::to_string(id_a) + " row " + std::to_string(r) +
+                             " is listed twice");
       }
       rows[r] = std::move(ping);
-      return true;
+      return Status::success();
     }
     if (kind != "match" && kind != "probe") {
-      message = t.where(row) + "kind '" + kind + "' is not ping, match or probe";
-      return false;
+      return Status::error(t.where(row) + "kind '" + kind + "' is not ping, match or probe");
     }
     double heading_a = 0.0, heading_b = 0.0;
     if (!integer("subframe_b", id_b) || !integer("round", round) || !number("col_a", col_a) ||
         !integer("utime_a_us", utime) || !number("heading_a_rad", heading_a) || !number("heading_b_rad", heading_b))
-      return false;
+      return bad();
     const auto key = std::make_tuple(id_a, id_b, static_cast<int>(round));
     auto [it, inserted] = pair_index.emplace(key, pairs.size());
     if (inserted) pairs.push_back({id_a, id_b, static_cast<int>(round), heading_a, heading_b, {}, {}});
     PairRows& pair = pairs[it->second];
     if (kind == "probe") {
       pair.probes.emplace_back(static_cast<int>(std::lround(row_a)), static_cast<int>(std::lround(col_a)));
-      return true;
+      return Status::success();
     }
     double row_b = 0.0, col_b = 0.0, zncc = 0.0;
-    if (!number("row_b", row_b) || !number("col_b", col_b) || !number("zncc", zncc)) return false;
+    if (!number("row_b", row_b) || !number("col_b", col_b) || !number("zncc", zncc)) return bad();
     sss::matcher::Correspondence m;
     m.row_a = static_cast<float>(row_a);
     m.col_a = static_cast<float>(col_a);
@@ -251,43 +250,36 @@ bool evaluateMatchRows(const std::string& matches_path, const std::string& missi
     m.col_b = static_cast<float>(col_b);
     m.zncc = static_cast<float>(zncc);
     pair.matches.push_back(m);
-    return true;
+    return Status::success();
   };
-  const auto onRow = [&](const CsvTable& t, CsvRow& row) {
-    std::string message;
-    return parseRow(t, row, message) ? sss::core::Status::success() : sss::core::Status::error(message);
-  };
-  if (const sss::core::Status read = forEachCsvRow(matches_path, required, kExpectedHeader, table, onRow); !read) {
-    error = read.message;
-    return false;
-  }
-  if (pairs.empty()) return true;  // the matcher tried no pair: nothing to evaluate
+  if (const Status read = forEachCsvRow(matches_path, required, kExpectedHeader, table, onRow); !read) return read;
+  if (pairs.empty()) return Status::success();  // the matcher tried no pair: nothing to evaluate
 
   // Parameters of the matching image.
   if (!parameters.found) {
-    error = matches_path + ": no '# parameters:' line; was it written by sss-process --write-matches?";
-    return false;
+    return Status::error(matches_path + ": no '# parameters:' line; was it written by sss-process --write-matches?");
   }
+  std::string missing_parameter;
   const auto parameter = [&](const std::string& name, double& value) {
     const auto it = parameters.values.find(name);
     if (it != parameters.values.end() && parseFiniteDouble(it->second, value)) return true;
-    error = matches_path + ": the parameters line has no number " + name;
+    missing_parameter = name;
     return false;
   };
   double bins = 0, bin_size = 0, first_bin = 0, decimation = 0, stride = 0, probe_step = 0;
   if (!parameter("bins_per_side", bins) || !parameter("bin_size_m", bin_size) ||
       !parameter("first_bin_range_m", first_bin) || !parameter("decimation", decimation) ||
       !parameter("stride", stride) || !parameter("probe_step", probe_step))
-    return false;
+    return Status::error(matches_path + ": the parameters line has no number " + missing_parameter);
   std::vector<double> position, orientation;
   if (!numbersOf(parameters.values["sonar_position_body_m"], 3, position) ||
       !numbersOf(parameters.values["sonar_orientation_body_wxyz"], 4, orientation)) {
-    error = matches_path + ": the parameters line needs sonar_position_body_m=x;y;z and sonar_orientation_body_wxyz=w;x;y;z";
-    return false;
+    return Status::error(matches_path + ": the parameters line needs sonar_position_body_m=x;y;z and "
+                                        "sonar_orientation_body_wxyz=w;x;y;z");
   }
   if (bins < 1 || bins > 1e6 || !(bin_size > 0) || decimation < 1 || stride < 1 || probe_step < 1) {
-    error = matches_path + ": parameters out of range (bins_per_side, bin_size_m, decimation, stride, probe_step)";
-    return false;
+    return Status::error(matches_path +
+                         ": parameters out of range (bins_per_side, bin_size_m, decimation, stride, probe_step)");
   }
   sss::core::SubframeGeometry geometry;
   geometry.bins_per_side = static_cast<int>(bins);
@@ -304,25 +296,23 @@ bool evaluateMatchRows(const std::string& matches_path, const std::string& missi
   // The mission's truth.
   const std::string mission_yaml = mission_dir + "/mission.yaml";
   if (!std::ifstream(mission_yaml)) {
-    error = mission_yaml + ": cannot open; --mission expects the sss-sim output folder the matches come from";
-    return false;
+    return Status::error(mission_yaml +
+                         ": cannot open; --mission expects the sss-sim output folder the matches come from");
   }
   sss::core::Config config = sss::core::Config::fromFile(mission_yaml);
   if (config.ok() && !config.root().has("sim")) {
-    error = mission_yaml + ": no `sim` section; --mission expects an sss-sim output folder";
-    return false;
+    return Status::error(mission_yaml + ": no `sim` section; --mission expects an sss-sim output folder");
   }
   sss::sim::SimOptions sim;
   if (config.ok()) sss::sim::readSimOptions(config.section("sim"), sim);
   if (!config.ok()) {
-    error = mission_yaml + ": " + config.problemReport();
-    while (!error.empty() && error.back() == '\n') error.pop_back();
-    return false;
+    std::string report_text = config.problemReport();
+    while (!report_text.empty() && report_text.back() == '\n') report_text.pop_back();
+    return Status::error(mission_yaml + ": " + report_text);
   }
   const std::vector<std::string> problems = sss::sim::validateSimOptions(sim);
   if (!problems.empty()) {
-    error = mission_yaml + ": " + problems.front();
-    return false;
+    return Status::error(mission_yaml + ": " + problems.front());
   }
   const sss::sim::Mission mission(sim);
 
@@ -336,16 +326,16 @@ bool evaluateMatchRows(const std::string& matches_path, const std::string& missi
     s.mask.assign(rows.size() * static_cast<size_t>(geometry.columns()), sss::core::kMaskNadir);
     for (size_t r = 0; r < rows.size(); ++r) {
       if (!rows[r].present) {
-        error = matches_path + ": subframe " + std::to_string(id) + " has no ping row " + std::to_string(r);
-        return false;
+        return Status::error(matches_path + ": subframe " + std::to_string(id) + " has no ping row " +
+                             std::to_string(r));
       }
       const double t_s = 1e-6 * static_cast<double>(rows[r].utime_us - sim.start_utime_us);
       const long long ping = std::llround(t_s * rate_hz);
       if (ping < 0 || ping >= static_cast<long long>(mission.pingCount()) ||
           std::llabs(mission.pingUtimeUs(static_cast<size_t>(ping)) - rows[r].utime_us) > 1000) {
-        error = matches_path + ":" + std::to_string(rows[r].line) + ": utime " + std::to_string(rows[r].utime_us) +
-                " is not a ping time of the mission in " + mission_dir + "; is it the right mission?";
-        return false;
+        return Status::error(matches_path + ":" + std::to_string(rows[r].line) + ": utime " +
+                             std::to_string(rows[r].utime_us) + " is not a ping time of the mission in " + mission_dir +
+                             "; is it the right mission?");
       }
       sss::core::SubframePing p;
       p.utime_us = rows[r].utime_us;
@@ -354,9 +344,9 @@ bool evaluateMatchRows(const std::string& matches_path, const std::string& missi
       s.pings.push_back(p);
       for (const auto& [first, last] : rows[r].valid_runs) {
         if (first < 0 || last >= geometry.columns()) {
-          error = matches_path + ":" + std::to_string(rows[r].line) + ": valid columns " + std::to_string(first) + "-" +
-                  std::to_string(last) + " outside the " + std::to_string(geometry.columns()) + " columns";
-          return false;
+          return Status::error(matches_path + ":" + std::to_string(rows[r].line) + ": valid columns " +
+                               std::to_string(first) + "-" + std::to_string(last) + " outside the " +
+                               std::to_string(geometry.columns()) + " columns");
         }
         std::fill(s.mask.begin() + static_cast<long>(r * geometry.columns() + first),
                   s.mask.begin() + static_cast<long>(r * geometry.columns() + last + 1), sss::core::kMaskValid);
@@ -368,9 +358,8 @@ bool evaluateMatchRows(const std::string& matches_path, const std::string& missi
   for (const PairRows& pair : pairs) {
     const auto a = subframes.find(pair.a), b = subframes.find(pair.b);
     if (a == subframes.end() || b == subframes.end() || a->second.rows() < 2 || b->second.rows() < 2) {
-      error = matches_path + ": pair " + std::to_string(pair.a) + "-" + std::to_string(pair.b) +
-              " has matches but no ping rows for its subframes";
-      return false;
+      return Status::error(matches_path + ": pair " + std::to_string(pair.a) + "-" + std::to_string(pair.b) +
+                           " has matches but no ping rows for its subframes");
     }
     PairMatchReport report;
     report.subframe_a = pair.a;
@@ -387,16 +376,8 @@ bool evaluateMatchRows(const std::string& matches_path, const std::string& missi
     result.overall += report.evaluation;
     result.pairs.push_back(std::move(report));
   }
-  return true;
+  return Status::success();
 }
 
-}  // namespace
-
-sss::core::Status evaluateMatchFile(const std::string& matches_path, const std::string& mission_dir,
-                                    MatchFileEvaluation& result) {
-  std::string error;
-  if (!evaluateMatchRows(matches_path, mission_dir, result, error)) return sss::core::Status::error(error);
-  return sss::core::Status::success();
-}
 
 }  // namespace sss::eval

@@ -16,6 +16,8 @@
 #include <limits>
 
 namespace sss::eval {
+
+using sss::core::Status;
 namespace {
 
 const cv::Scalar kBlack(0, 0, 0);
@@ -71,14 +73,13 @@ cv::Size textSize(const std::string& text, double scale = kFontScale, int thickn
   return cv::getTextSize(text, kFont, scale, thickness, &baseline);
 }
 
-bool savePng(const std::string& path, const cv::Mat& image, std::string& error) {
+Status savePng(const std::string& path, const cv::Mat& image) {
   try {
-    if (cv::imwrite(path, image)) return true;
-    error = "cannot write " + path + "; check the directory exists and the name ends in .png";
+    if (cv::imwrite(path, image)) return Status::success();
+    return Status::error("cannot write " + path + "; check the directory exists and the name ends in .png");
   } catch (const cv::Exception& e) {
-    error = "cannot write " + path + ": " + e.what();
+    return Status::error("cannot write " + path + ": " + e.what());
   }
-  return false;
 }
 
 }  // namespace
@@ -92,11 +93,10 @@ double niceCeil(double value) {
   return 10.0 * magnitude;
 }
 
-bool writeErrorMapPng(const std::string& path, const HeightmapRaster& map, const std::string& title, std::string& error,
-                      const ErrorMapPngOptions& options, double* used_limit_m) {
+Status writeErrorMapPng(const std::string& path, const HeightmapRaster& map, const std::string& title,
+                        const ErrorMapPngOptions& options, double* used_limit_m) {
   if (map.rows < 1 || map.cols < 1 || map.depth_m.size() != static_cast<size_t>(map.rows) * map.cols) {
-    error = "error map " + path + ": empty raster";
-    return false;
+    return Status::error("error map " + path + ": empty raster");
   }
   // Scale: symmetric, from the 99th percentile of |error| unless given.
   double limit = options.limit_m;
@@ -196,27 +196,25 @@ bool writeErrorMapPng(const std::string& path, const HeightmapRaster& map, const
   }
   const std::string legend = "estimate - true depth: red = estimate deeper, blue = shallower, grey = no data";
   putText(image, legend, cv::Point(width / 2 - textSize(legend).width / 2, bar_y + bar_height + 46), kFontScale, kAxis);
-  return savePng(path, image, error);
+  return savePng(path, image);
 }
 
-bool readMosaic(const std::string& yaml_path, GreyMosaic& mosaic, std::string& error) {
+Status readMosaic(const std::string& yaml_path, GreyMosaic& mosaic) {
   YAML::Node root;
   try {
     root = YAML::LoadFile(yaml_path);
   } catch (const YAML::BadFile&) {
-    error = yaml_path + ": cannot open; check the path";
-    return false;
+    return Status::error(yaml_path + ": cannot open; check the path");
   } catch (const YAML::Exception& e) {
-    error = yaml_path + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg;
-    return false;
+    return Status::error(yaml_path + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
   }
   GreyMosaic result;
   try {
     if (!root.IsMap()) throw YAML::Exception(root.Mark(), "not a map");
     for (const char* key : {"resolution_m", "north_max_m", "east_min_m", "rows", "cols"}) {
       if (!root[key]) {
-        error = yaml_path + ": missing key '" + key + "' (a mosaic YAML has resolution_m, north_max_m, east_min_m, rows, cols)";
-        return false;
+        return Status::error(yaml_path + ": missing key '" + key +
+                             "' (a mosaic YAML has resolution_m, north_max_m, east_min_m, rows, cols)");
       }
     }
     result.resolution_m = root["resolution_m"].as<double>();
@@ -225,14 +223,12 @@ bool readMosaic(const std::string& yaml_path, GreyMosaic& mosaic, std::string& e
     result.rows = root["rows"].as<int>();
     result.cols = root["cols"].as<int>();
   } catch (const YAML::Exception& e) {
-    error = yaml_path + ":" + std::to_string(e.mark.line + 1) + ": expected numbers for resolution_m, north_max_m, "
-            "east_min_m and integers for rows, cols";
-    return false;
+    return Status::error(yaml_path + ":" + std::to_string(e.mark.line + 1) +
+                         ": expected numbers for resolution_m, north_max_m, east_min_m and integers for rows, cols");
   }
   if (!(result.resolution_m > 0.0) || !std::isfinite(result.resolution_m) || !std::isfinite(result.north_max_m) ||
       !std::isfinite(result.east_min_m) || result.rows < 1 || result.cols < 1) {
-    error = yaml_path + ": resolution_m must be positive, the corners finite and rows, cols >= 1";
-    return false;
+    return Status::error(yaml_path + ": resolution_m must be positive, the corners finite and rows, cols >= 1");
   }
   std::filesystem::path png(yaml_path);
   png.replace_extension(".png");
@@ -240,22 +236,20 @@ bool readMosaic(const std::string& yaml_path, GreyMosaic& mosaic, std::string& e
   try {
     image = cv::imread(png.string(), cv::IMREAD_GRAYSCALE);
   } catch (const cv::Exception& e) {
-    error = png.string() + ": cannot decode: " + e.what();
-    return false;
+    return Status::error(png.string() + ": cannot decode: " + e.what());
   }
   if (image.empty()) {
-    error = png.string() + ": missing or not a PNG (the image of " + yaml_path + ")";
-    return false;
+    return Status::error(png.string() + ": missing or not a PNG (the image of " + yaml_path + ")");
   }
   if (image.rows != result.rows || image.cols != result.cols) {
-    error = png.string() + ": " + std::to_string(image.cols) + " x " + std::to_string(image.rows) + " pixels, but " +
-            yaml_path + " says cols " + std::to_string(result.cols) + ", rows " + std::to_string(result.rows);
-    return false;
+    return Status::error(png.string() + ": " + std::to_string(image.cols) + " x " + std::to_string(image.rows) +
+                         " pixels, but " + yaml_path + " says cols " + std::to_string(result.cols) + ", rows " +
+                         std::to_string(result.rows));
   }
   if (!image.isContinuous()) image = image.clone();
   result.pixels.assign(image.ptr<uint8_t>(0), image.ptr<uint8_t>(0) + static_cast<size_t>(image.rows) * image.cols);
   mosaic = std::move(result);
-  return true;
+  return Status::success();
 }
 
 }  // namespace sss::eval

@@ -18,8 +18,8 @@ struct ErrorMapPngOptions {
 
 // North up; blue = estimate shallower, white = 0, red = estimate deeper, grey = no data; a colour
 // bar with its scale in metres below. used_limit_m (optional) receives the scale used.
-bool writeErrorMapPng(const std::string& path, const HeightmapRaster& error_map, const std::string& title,
-                      std::string& error, const ErrorMapPngOptions& options = {}, double* used_limit_m = nullptr);
+sss::core::Status writeErrorMapPng(const std::string& path, const HeightmapRaster& error_map, const std::string& title,
+                                   const ErrorMapPngOptions& options = {}, double* used_limit_m = nullptr);
 
 // Round up to 1, 2 or 5 x 10^k.
 double niceCeil(double value);
@@ -36,7 +36,7 @@ struct GreyMosaic {
 };
 
 // Reads X.yaml (keys resolution_m, north_max_m, east_min_m, rows, cols) and the 8-bit grey X.png
-// beside it. False with a message naming the file on any problem (missing key, size mismatch).
-bool readMosaic(const std::string& yaml_path, GreyMosaic& mosaic, std::string& error);
+// beside it. Fails with a message naming the file on any problem (missing key, size mismatch).
+sss::core::Status readMosaic(const std::string& yaml_path, GreyMosaic& mosaic);
 
 }  // namespace sss::eval

@@ -12,6 +12,8 @@
 #include <sstream>
 
 namespace sss::eval {
+
+using sss::core::Status;
 namespace {
 
 std::string defaultLabel(const EvalInput& input) {
@@ -137,7 +139,7 @@ std::string fileSafeLabel(const std::string& label) {
   return safe.empty() ? "unnamed" : safe;
 }
 
-bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalReport& report, std::string& error) {
+Status runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalReport& report) {
   report = EvalReport();
   report.options = options;
   report.truth_path = request.truth_path;
@@ -146,13 +148,11 @@ bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalR
   std::optional<sss::core::MissionOrigin> truth_origin;
   if (!request.estimates.empty() || !request.closures_path.empty() || request.lce) {
     if (request.truth_path.empty()) {
-      error = "estimates, closures and LCE need the truth trajectory (--gt TRUTH.tum)";
-      return false;
+      return Status::error("estimates, closures and LCE need the truth trajectory (--gt TRUTH.tum)");
     }
     TumReadResult truth = readTum(request.truth_path);
     if (!truth.ok) {
-      error = truth.error;
-      return false;
+      return Status::error(truth.error);
     }
     report.truth = std::move(truth.poses);
     truth_origin = truth.origin;
@@ -166,15 +166,13 @@ bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalR
     in_truth_frame.target_origin = truth_origin;
     TumReadResult estimate = readTum(input.path, in_truth_frame);
     if (!estimate.ok) {
-      error = estimate.error;
-      return false;
+      return Status::error(estimate.error);
     }
     EstimateReport entry;
     entry.input = {defaultLabel(input), input.path};
     entry.evaluation = evaluateTrajectory(report.truth, estimate.poses, report.lines, options.trajectory);
     if (!entry.evaluation.ok) {
-      error = input.path + ": " + entry.evaluation.error;
-      return false;
+      return Status::error(input.path + ": " + entry.evaluation.error);
     }
     report.estimates.push_back(std::move(entry));
     estimates.push_back(std::move(estimate.poses));
@@ -191,23 +189,25 @@ bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalR
   const bool lce_needs_seabed = request.lce && !std::isfinite(options.lce_seabed_depth_m) && !request.seabed_path.empty();
   if (!request.heightmaps.empty() || lce_needs_seabed) {
     if (request.seabed_path.empty()) {
-      error = "heightmaps need the true seabed (--seabed seabed.yaml)";
-      return false;
+      return Status::error("heightmaps need the true seabed (--seabed seabed.yaml)");
     }
-    if (!readHeightmap(request.seabed_path, seabed, error)) return false;
+    if (const Status read = readHeightmap(request.seabed_path, seabed); !read) {
+      return read;
+    }
   }
   HeightmapReadOptions in_seabed_frame;
   in_seabed_frame.target_origin = seabed.origin ? seabed.origin : truth_origin;
   if (!request.heightmaps.empty()) {
     for (const EvalInput& input : request.heightmaps) {
       HeightmapRaster estimate;
-      if (!readHeightmap(input.path, estimate, error, in_seabed_frame)) return false;
+      if (const Status read = readHeightmap(input.path, estimate, in_seabed_frame); !read) {
+        return read;
+      }
       HeightmapReport entry;
       entry.input = {defaultLabel(input), input.path};
       entry.result = compareHeightmaps(seabed, estimate);
       if (!entry.result.ok) {
-        error = input.path + ": " + entry.result.error;
-        return false;
+        return Status::error(input.path + ": " + entry.result.error);
       }
       report.heightmaps.push_back(std::move(entry));
     }
@@ -215,9 +215,8 @@ bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalR
 
   if (!request.closures_path.empty()) {
     std::vector<ClosureRecord> closures;
-    if (const sss::core::Status read = readClosureCsv(request.closures_path, closures); !read) {
-      error = read.message;
-      return false;
+    if (const Status read = readClosureCsv(request.closures_path, closures); !read) {
+      return read;
     }
     report.has_closures = true;
     report.closures.path = request.closures_path;
@@ -227,8 +226,7 @@ bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalR
       in_truth_frame.target_origin = truth_origin;
       TumReadResult read = readTum(request.closures_dr_path, in_truth_frame);
       if (!read.ok) {
-        error = read.error;
-        return false;
+        return Status::error(read.error);
       }
       dr = std::move(read.poses);
       report.closures.dr = {defaultLabel({"", request.closures_dr_path}), request.closures_dr_path};
@@ -244,8 +242,8 @@ bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalR
     report.lce_skipped = "no survey lines found in the truth (LCE needs straight lines seen from both sides)";
   } else if (request.lce) {
     if (report.lines.empty()) {
-      error = request.truth_path + ": no survey lines found in the truth; --lce needs straight lines seen from both sides";
-      return false;
+      return Status::error(request.truth_path +
+                           ": no survey lines found in the truth; --lce needs straight lines seen from both sides");
     }
     LceReport& lce = report.lce;
     if (std::isfinite(options.lce_seabed_depth_m)) {
@@ -267,10 +265,10 @@ bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalR
     }
     report.has_lce = true;
   }
-  return true;
+  return Status::success();
 }
 
-bool writeFigures(const EvalRequest& request, EvalReport& report, std::string& error) {
+Status writeFigures(const EvalRequest& request, EvalReport& report) {
   // The PNGs are drawn by report_figures.py from X_figure_data/ beside X.png (figure_script.hpp).
   const std::filesystem::path plot(request.plot_path);
   const std::string out_dir = plot.parent_path().empty() ? "." : plot.parent_path().string();
@@ -315,7 +313,9 @@ bool writeFigures(const EvalRequest& request, EvalReport& report, std::string& e
     const std::string safe = fileSafeLabel(h.input.label);
     if (!request.error_map_prefix.empty()) {
       const std::string prefix = request.error_map_prefix + "_" + safe;
-      if (!writeHeightmap(prefix, h.result.error_map, error)) return false;
+      if (const Status written = writeHeightmap(prefix, h.result.error_map); !written) {
+        return written;
+      }
       h.error_map_yaml = prefix + ".yaml";
     }
     if (!request.plot_path.empty()) {
@@ -340,10 +340,9 @@ bool writeFigures(const EvalRequest& request, EvalReport& report, std::string& e
     if (!h.error_map_png.empty() && !drawn(h.error_map_png)) h.error_map_png.clear();
   }
   if (!run.problem.empty()) {
-    error = run.problem;
-    return false;
+    return Status::error(run.problem);
   }
-  return true;
+  return Status::success();
 }
 
 namespace {

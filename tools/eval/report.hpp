@@ -161,16 +161,16 @@ struct EvalReport {
   std::string json_path;
 };
 
-// Reads every input and computes every metric. False with a message naming the file (and line)
+// Reads every input and computes every metric. Fails with a message naming the file (and line)
 // for bad or unusable input: unreadable or malformed files, an estimate with no pose in the
 // truth's time span, a heightmap that does not overlap the seabed, --lce without survey lines.
-bool runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalReport& report, std::string& error);
+sss::core::Status runEvaluation(const EvalRequest& request, const EvalOptions& options, EvalReport& report);
 
 // Figures and error-map rasters of the request (plot_path, error_map_prefix); the figures drawn
-// by report_figures.py (figure_script.hpp). False with a one-line message when a file cannot be
+// by report_figures.py (figure_script.hpp). Fails with a one-line message when a file cannot be
 // written or figures were not drawn (no python3-matplotlib: the message says to run
 // tools/setup-deps.sh); report.plots then lists only the PNGs drawn.
-bool writeFigures(const EvalRequest& request, EvalReport& report, std::string& error);
+sss::core::Status writeFigures(const EvalRequest& request, EvalReport& report);
 
 // The aligned terminal table: one row per estimate (ATE RMSE raw and aligned, horizontal ATE RMSE
 // and max, horizontal aligned and gauge-free RMSE, RPE, improvement vs the first estimate), the

@@ -15,23 +15,17 @@ namespace {
 
 // A file whose header names another origin than target_origin is re-expressed in its frame; the
 // file's own origin goes to *origin when given.
-bool readTrajectoryInput(const std::string& path, const std::string& what, Trajectory& poses, std::string& error,
-                         const std::optional<sss::core::MissionOrigin>& target_origin = std::nullopt,
-                         std::optional<sss::core::MissionOrigin>* origin = nullptr) {
-  if (!fileExists(path)) {
-    error = path + ": missing (" + what + ")";
-    return false;
-  }
+Status readTrajectoryInput(const std::string& path, const std::string& what, Trajectory& poses,
+                           const std::optional<sss::core::MissionOrigin>& target_origin = std::nullopt,
+                           std::optional<sss::core::MissionOrigin>* origin = nullptr) {
+  if (!fileExists(path)) return Status::error(path + ": missing (" + what + ")");
   TumReadOptions options;
   options.target_origin = target_origin;
   TumReadResult result = readTum(path, options);
-  if (!result.ok) {
-    error = result.error;
-    return false;
-  }
+  if (!result.ok) return Status::error(result.error);
   poses = std::move(result.poses);
   if (origin) *origin = result.origin;
-  return true;
+  return Status::success();
 }
 
 // Heightmaps are compared in the truth's frame (a run with its own origin is re-expressed).
@@ -50,11 +44,10 @@ void readHeightmaps(RunReport& report, const RunReportRequest& request) {
   if (!have_dr) report.notes.push_back("no DR heightmap (" + dr_path + "): heightmap section without it");
   if (!have_slam && !have_dr) return;
   HeightmapRaster seabed;
-  std::string error;
   if (!fileExists(seabed_path)) {
     report.notes.push_back("no true seabed (" + seabed_path + "): heightmap errors not computed");
-  } else if (!readHeightmap(seabed_path, seabed, error, truthFrame(report))) {
-    report.notes.push_back("true seabed unusable, heightmap errors not computed: " + error);
+  } else if (const Status read = readHeightmap(seabed_path, seabed, truthFrame(report)); !read) {
+    report.notes.push_back("true seabed unusable, heightmap errors not computed: " + read.message);
     seabed = HeightmapRaster();
   } else {
     report.seabed_path = seabed_path;
@@ -63,8 +56,8 @@ void readHeightmaps(RunReport& report, const RunReportRequest& request) {
                                       std::tuple{dr_path, &report.heightmap_dr, have_dr}}) {
     if (!present || report.seabed_path.empty()) continue;
     HeightmapRaster estimate;
-    if (!readHeightmap(path, estimate, error, truthFrame(report))) {
-      report.notes.push_back("heightmap unusable: " + error);
+    if (const Status read = readHeightmap(path, estimate, truthFrame(report)); !read) {
+      report.notes.push_back("heightmap unusable: " + read.message);
       continue;
     }
     entry->path = path;
@@ -139,20 +132,17 @@ LoopClosureCounts countClosures(const std::vector<LoopClosureRecord>& closures) 
   return counts;
 }
 
-bool readRunSummary(const std::string& path, RunSummary& summary, std::string& error) {
+Status readRunSummary(const std::string& path, RunSummary& summary) {
   YAML::Node root;
   try {
     root = YAML::LoadFile(path);
   } catch (const YAML::BadFile&) {
-    error = path + ": cannot open; check the path";
-    return false;
+    return Status::error(path + ": cannot open; check the path");
   } catch (const YAML::Exception& e) {
-    error = path + ":" + std::to_string(e.mark.line + 1) + ": not valid JSON: " + e.msg;
-    return false;
+    return Status::error(path + ":" + std::to_string(e.mark.line + 1) + ": not valid JSON: " + e.msg);
   }
   if (!root.IsMap()) {
-    error = path + ": expected a JSON object with pings, subframes, closures_accepted, wall_s, ...";
-    return false;
+    return Status::error(path + ": expected a JSON object with pings, subframes, closures_accepted, wall_s, ...");
   }
   RunSummary result;
   const std::pair<const char*, double*> keys[] = {
@@ -202,7 +192,7 @@ bool readRunSummary(const std::string& path, RunSummary& summary, std::string& e
     }
   }
   summary = std::move(result);
-  return true;
+  return Status::success();
 }
 
 // ---- the report ----------------------------------------------------------------------------
@@ -222,7 +212,6 @@ RunReport writeRunReport(const RunReportRequest& request, const RunReportOptions
   };
   try {
     // Required: the truth, the SLAM estimate, some DR.
-    std::string error;
     if (!fs::is_directory(request.mission_dir)) {
       return fail(RunReportStatus::bad_input, request.mission_dir + ": not a folder (--mission: the sss-sim --out folder)");
     }
@@ -233,12 +222,14 @@ RunReport writeRunReport(const RunReportRequest& request, const RunReportOptions
     report.slam_path = joinPath(request.run_dir, "slam.tum");
     report.dr_path = joinPath(request.run_dir, "dead_reckoning.tum");
     Trajectory truth, dr, slam;
-    if (!readTrajectoryInput(report.truth_path, "the simulator's ground truth; is --mission the sss-sim --out folder?",
-                             truth, error, std::nullopt, &report.truth_origin) ||
-        !readTrajectoryInput(report.slam_path, "the SLAM trajectory; is --run the sss-process output folder?", slam,
-                             error, report.truth_origin)) {
-      return fail(RunReportStatus::bad_input, error);
+    Status read = readTrajectoryInput(report.truth_path,
+                                      "the simulator's ground truth; is --mission the sss-sim --out folder?", truth,
+                                      std::nullopt, &report.truth_origin);
+    if (read) {
+      read = readTrajectoryInput(report.slam_path, "the SLAM trajectory; is --run the sss-process output folder?", slam,
+                                 report.truth_origin);
     }
+    if (!read) return fail(RunReportStatus::bad_input, read.message);
     if (!fileExists(report.dr_path)) {
       const std::string fallback = joinPath(request.mission_dir, "dead_reckoning.tum");
       if (!fileExists(fallback)) {
@@ -248,8 +239,9 @@ RunReport writeRunReport(const RunReportRequest& request, const RunReportOptions
       report.notes.push_back("no dead_reckoning.tum in the run folder; the mission's " + fallback + " stands in for DR");
       report.dr_path = fallback;
     }
-    if (!readTrajectoryInput(report.dr_path, "dead reckoning", dr, error, report.truth_origin)) {
-      return fail(RunReportStatus::bad_input, error);
+    if (const Status read_dr = readTrajectoryInput(report.dr_path, "dead reckoning", dr, report.truth_origin);
+        !read_dr) {
+      return fail(RunReportStatus::bad_input, read_dr.message);
     }
 
     report.truth_poses = truth.size();
@@ -300,7 +292,7 @@ RunReport writeRunReport(const RunReportRequest& request, const RunReportOptions
       // Landmark consistency on correspondences made from the truth (sss-eval --lce).
       HeightmapRaster seabed;
       const std::string seabed_path = joinPath(request.mission_dir, "seabed.yaml");
-      const bool have_seabed = fileExists(seabed_path) && readHeightmap(seabed_path, seabed, error, truthFrame(report));
+      const bool have_seabed = fileExists(seabed_path) && readHeightmap(seabed_path, seabed, truthFrame(report)).ok;
       LandmarkConsistencyOptions model;
       model.seabed_depth_m = flatSeabedDepthM(truth, have_seabed ? &seabed : nullptr, options.lce_altitude_m,
                                               report.lce_seabed_depth_source);
@@ -318,8 +310,8 @@ RunReport writeRunReport(const RunReportRequest& request, const RunReportOptions
     const std::string summary_path = joinPath(request.run_dir, "summary.json");
     if (!fileExists(summary_path)) {
       report.notes.push_back("no summary.json in the run folder (" + summary_path + "): no run figures (time, memory)");
-    } else if (!readRunSummary(summary_path, report.summary, error)) {
-      report.notes.push_back("run summary unusable: " + error);
+    } else if (const Status read_summary = readRunSummary(summary_path, report.summary); !read_summary) {
+      report.notes.push_back("run summary unusable: " + read_summary.message);
     } else {
       report.has_summary = true;
       if (!report.summary.missing_keys.empty()) {
@@ -333,8 +325,8 @@ RunReport writeRunReport(const RunReportRequest& request, const RunReportOptions
     const std::string mosaic_path = joinPath(request.mission_dir, "mosaic.yaml");
     if (!fileExists(mosaic_path)) {
       report.notes.push_back("no true-pose mosaic (" + mosaic_path + "): trajectories drawn on a blank background");
-    } else if (!readMosaic(mosaic_path, truth_mosaic, error)) {
-      report.notes.push_back("true-pose mosaic unusable, trajectories drawn on a blank background: " + error);
+    } else if (const Status read = readMosaic(mosaic_path, truth_mosaic); !read) {
+      report.notes.push_back("true-pose mosaic unusable, trajectories drawn on a blank background: " + read.message);
     } else {
       background = &truth_mosaic;
     }
@@ -376,11 +368,10 @@ RunReport writeRunReport(const RunReportRequest& request, const RunReportOptions
     // Files listed before they are written, so metrics.json lists itself and both pages.
     for (const std::string& path : {html_path, md_path, json_path}) report.files.push_back(path);
     report.index_html = html_path;
-    if (!writeText(html_path, renderHtml(report, request, key, sections, tables, inputs), error) ||
-        !writeText(md_path, renderMarkdown(report, request, key, sections, tables, inputs), error) ||
-        !writeText(json_path, runReportJson(report, request), error)) {
-      return fail(RunReportStatus::write_failed, error);
-    }
+    Status written = writeText(html_path, renderHtml(report, request, key, sections, tables, inputs));
+    if (written) written = writeText(md_path, renderMarkdown(report, request, key, sections, tables, inputs));
+    if (written) written = writeText(json_path, runReportJson(report, request));
+    if (!written) return fail(RunReportStatus::write_failed, written.message);
   } catch (const std::bad_alloc&) {
     return fail(RunReportStatus::bad_input, "out of memory; are the inputs the right files?");
   } catch (const std::exception& e) {

@@ -126,9 +126,9 @@ struct RunSummary {
   std::vector<std::string> missing_keys;  // expected keys absent or not numbers
 };
 
-// Reads the JSON object (JSON is YAML flow, so yaml-cpp reads it). False with a message naming
+// Reads the JSON object (JSON is YAML flow, so yaml-cpp reads it). Fails with a message naming
 // the file when it cannot be read or is not an object; absent keys only land in missing_keys.
-bool readRunSummary(const std::string& path, RunSummary& summary, std::string& error);
+sss::core::Status readRunSummary(const std::string& path, RunSummary& summary);
 
 // ---- the report ----------------------------------------------------------------------------
 

@@ -188,12 +188,11 @@ void mosaicFigure(FigureContext& context) {
   for (auto [name, label] : {std::pair{"mosaic_dr", "dead reckoning (DR)"}, std::pair{"mosaic_slam", "SLAM"}}) {
     const std::string path = joinPath(context.request.run_dir, std::string(name) + ".yaml");
     GreyMosaic mosaic;
-    std::string error;
     if (!fileExists(path)) {
       context.report.notes.push_back("no " + std::string(name) + ".yaml in the run folder (" + path +
                                      "): no mosaic comparison");
-    } else if (!readMosaic(path, mosaic, error)) {
-      context.report.notes.push_back("mosaic unusable, no mosaic comparison: " + error);
+    } else if (const sss::core::Status read = readMosaic(path, mosaic); !read) {
+      context.report.notes.push_back("mosaic unusable, no mosaic comparison: " + read.message);
     } else {
       Json panel = mosaicRaster(context.figures, mosaic, name);
       panel["label"] = label;
@@ -217,8 +216,7 @@ void heightmapFigures(FigureContext& context) {
   Section section{"5. Heightmaps", "", {}, {}};
   const std::string slam_path = joinPath(context.request.run_dir, "heightmap.yaml");
   HeightmapRaster slam;
-  std::string error;
-  if (fileExists(slam_path) && readHeightmap(slam_path, slam, error)) {
+  if (fileExists(slam_path) && readHeightmap(slam_path, slam).ok) {
     char title[256];
     std::snprintf(title, sizeof title, "SLAM heightmap: %.2g m cells, grid %zu x %zu", slam.resolution_m,
                   static_cast<size_t>(slam.cols), static_cast<size_t>(slam.rows));

@@ -303,6 +303,6 @@ std::string renderHtml(const RunReport& report, const RunReportRequest& request,
 std::string renderMarkdown(const RunReport& report, const RunReportRequest& request, const Table& key,
                            const std::vector<Section>& sections, const std::vector<Table>& tables,
                            const std::vector<std::string>& inputs);
-bool writeText(const std::string& path, const std::string& text, std::string& error);
+sss::core::Status writeText(const std::string& path, const std::string& text);
 
 }  // namespace sss::eval::report_internal

@@ -135,15 +135,14 @@ std::string renderMarkdown(const RunReport& report, const RunReportRequest& requ
   return out.str();
 }
 
-bool writeText(const std::string& path, const std::string& text, std::string& error) {
+sss::core::Status writeText(const std::string& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);
   out << text;
   out.close();
   if (!out) {
-    error = "cannot write " + path + "; check the directory exists, is writable and has space";
-    return false;
+    return sss::core::Status::error("cannot write " + path + "; check the directory exists, is writable and has space");
   }
-  return true;
+  return sss::core::Status::success();
 }
 
 }  // namespace sss::eval::report_internal

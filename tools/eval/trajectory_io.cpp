@@ -190,13 +190,10 @@ std::string tumLine(const StampedPose& pose) {
   return line;
 }
 
-bool writeTum(const std::string& path, const Trajectory& poses, std::string& error, const std::string& comment,
-              const std::optional<sss::core::MissionOrigin>& origin) {
+sss::core::Status writeTum(const std::string& path, const Trajectory& poses, const std::string& comment,
+                           const std::optional<sss::core::MissionOrigin>& origin) {
   std::ofstream out(path, std::ios::binary);
-  if (!out) {
-    error = "cannot write " + path + "; check the directory exists and is writable";
-    return false;
-  }
+  if (!out) return sss::core::Status::error("cannot write " + path + "; check the directory exists and is writable");
   if (!comment.empty()) {
     std::istringstream lines(comment);
     for (std::string line; std::getline(lines, line);) out << "# " << line << "\n";
@@ -204,11 +201,8 @@ bool writeTum(const std::string& path, const Trajectory& poses, std::string& err
   if (origin) out << sss::core::originCommentLine(*origin) << "\n";
   for (const StampedPose& pose : poses) out << tumLine(pose);
   out.close();
-  if (!out) {
-    error = "cannot write " + path + " (disk full?)";
-    return false;
-  }
-  return true;
+  if (!out) return sss::core::Status::error("cannot write " + path + " (disk full?)");
+  return sss::core::Status::success();
 }
 
 }  // namespace sss::eval

@@ -4,6 +4,7 @@
 
 #include "pipeline/core/mission_origin.hpp"
 #include "pipeline/core/pose.hpp"
+#include "pipeline/core/status.hpp"
 
 #include <cstdint>
 #include <optional>
@@ -57,9 +58,9 @@ bool parseTumTimestamp(const std::string& text, int64_t& utime_us);
 // One TUM line (with '\n') as the simulator writes it: microsecond timestamp, 6 decimals for
 // metres, 9 for the quaternion.
 std::string tumLine(const StampedPose& pose);
-// Writes the poses (with an optional '#' comment first). False with a message in error when the
-// file cannot be written.
-bool writeTum(const std::string& path, const Trajectory& poses, std::string& error, const std::string& comment = "",
-              const std::optional<sss::core::MissionOrigin>& origin = std::nullopt);
+// Writes the poses (with an optional '#' comment first). Fails with a message when the file cannot
+// be written.
+sss::core::Status writeTum(const std::string& path, const Trajectory& poses, const std::string& comment = "",
+                           const std::optional<sss::core::MissionOrigin>& origin = std::nullopt);
 
 }  // namespace sss::eval
