@@ -1,6 +1,7 @@
 // The one error style of the library code: a call that can fail returns a Status (ok, or a message
 // that names the cause and, where there is one, the fix), or a Result<T> (a value, or that
-// message). No exceptions cross a library boundary and no `bool` + `std::string& error` pairs.
+// message) for anything bad input can cause. Exceptions only for programming errors (options a
+// constructor gets without validating them first); no `bool` + `std::string& error` pairs.
 // Both are [[nodiscard]]: an ignored failure is a compile warning.
 #pragma once
 
