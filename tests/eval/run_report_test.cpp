@@ -1,6 +1,8 @@
 // sss-report end to end: a short simulated mission and a run folder fabricated from it with known
 // errors (SLAM 0.1 m north of the truth, heightmaps 0.05 m and 0.3 m too deep, 3 + 1 closures) ->
 // exit code, files, metrics.json numbers, the verdict; missing required and optional inputs.
+#include "pipeline/core/geodesy.hpp"
+#include "tools/eval/frame_alignment.hpp"
 #include "tools/eval/heightmap_metrics.hpp"
 #include "tools/eval/run_report.hpp"
 #include "tools/eval/trajectory_io.hpp"
@@ -375,6 +377,44 @@ TEST_F(RunReport, SaysPlainlyWhenSlamIsWorseThanDeadReckoning) {
   EXPECT_EQ(verdict.rfind("SLAM is worse than dead reckoning", 0), 0u) << verdict;
   EXPECT_LT(json["trajectory"]["ate_horizontal_rmse_improvement_percent"].as<double>(), 0.0);
   EXPECT_NE(slurp(out_dir() / "index.html").find("class=\"verdict worse\""), std::string::npos);
+}
+
+// A run processed with its own origin (sss-process takes its first fix): loop_closures.csv is in
+// the run's frame, the figures in the truth's; the closure centres must land where they were.
+TEST_F(RunReport, ClosureCentresOfARunWithItsOwnOriginAreMovedIntoTheTruthsFrame) {
+  const TumReadResult truth = readTum((mission_dir_ / "ground_truth.tum").string());
+  ASSERT_TRUE(truth.ok) << truth.error;
+  ASSERT_TRUE(truth.origin.has_value());
+  // The run's origin 100 m north and 30 m east of the truth's.
+  const sss::core::LocalTangentPlane truth_plane(truth.origin->latitude_deg, truth.origin->longitude_deg);
+  const sss::core::GeodeticPosition moved = truth_plane.toGeodetic(Eigen::Vector3d(100.0, 30.0, 0.0));
+  const sss::core::MissionOrigin run_origin{moved.latitude_deg, moved.longitude_deg};
+  Trajectory slam = truth.poses;
+  reexpressTrajectory(slam, *truth.origin, run_origin);
+  ASSERT_OK(writeTum((run_dir() / "slam.tum").string(), slam, "", run_origin));
+  // Closure 0-3 from (25, 0) to (95, 40) in the truth's frame, written in the run's (-75, -30) ...
+  const Eigen::Vector3d a = reexpressPosition({25.0, 0.0, 0.0}, *truth.origin, run_origin);
+  const Eigen::Vector3d b = reexpressPosition({95.0, 40.0, 0.0}, *truth.origin, run_origin);
+  ASSERT_NEAR(a.x(), -75.0, 0.1);
+  {
+    std::ofstream csv(run_dir() / "loop_closures.csv");
+    csv.precision(12);
+    csv << "subframe_id_a,subframe_id_b,status,rejection,north_a_m,east_a_m,north_b_m,east_b_m\n"
+        << "0,3,accepted,none," << a.x() << "," << a.y() << "," << b.x() << "," << b.y() << "\n";
+  }
+  RunReportRequest request;
+  request.mission_dir = mission_dir_.string();
+  request.run_dir = run_dir().string();
+  request.out_dir = out_dir().string();
+  request.figures.python = (dir_ / "no-python3").string();  // the numbers only
+  const sss::eval::RunReport report = writeRunReport(request);
+  ASSERT_EQ(report.status, RunReportStatus::ok) << report.error;
+  ASSERT_EQ(report.closures.size(), 1u);
+  // ... and back to 1 cm (the transform is exact through WGS-84; the CSV keeps 12 digits).
+  EXPECT_NEAR(report.closures[0].centre_a_north_east_m.x(), 25.0, 0.01);
+  EXPECT_NEAR(report.closures[0].centre_a_north_east_m.y(), 0.0, 0.01);
+  EXPECT_NEAR(report.closures[0].centre_b_north_east_m.x(), 95.0, 0.01);
+  EXPECT_NEAR(report.closures[0].centre_b_north_east_m.y(), 40.0, 0.01);
 }
 
 }  // namespace

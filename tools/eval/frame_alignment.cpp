@@ -31,6 +31,12 @@ bool sameOrigin(const sss::core::MissionOrigin& a, const sss::core::MissionOrigi
   return std::abs(a.latitude_deg - b.latitude_deg) < 1e-9 && std::abs(a.longitude_deg - b.longitude_deg) < 1e-9;
 }
 
+Eigen::Vector3d reexpressPosition(const Eigen::Vector3d& ned_m, const sss::core::MissionOrigin& from,
+                                  const sss::core::MissionOrigin& to) {
+  const FramePair frames{{from.latitude_deg, from.longitude_deg}, {to.latitude_deg, to.longitude_deg}};
+  return frames.convert(ned_m);
+}
+
 void reexpressTrajectory(Trajectory& poses, const sss::core::MissionOrigin& from, const sss::core::MissionOrigin& to) {
   const FramePair frames{{from.latitude_deg, from.longitude_deg}, {to.latitude_deg, to.longitude_deg}};
   for (StampedPose& pose : poses) {

@@ -15,6 +15,10 @@ struct HeightmapRaster;
 // Within 1e-9 deg (0.1 mm): the same frame.
 bool sameOrigin(const sss::core::MissionOrigin& a, const sss::core::MissionOrigin& b);
 
+// One position (north, east, down in m), exactly.
+Eigen::Vector3d reexpressPosition(const Eigen::Vector3d& ned_m, const sss::core::MissionOrigin& from,
+                                  const sss::core::MissionOrigin& to);
+
 // Every pose's position exactly, its attitude rotated by the rotation between the two frames'
 // axes at that position.
 void reexpressTrajectory(Trajectory& poses, const sss::core::MissionOrigin& from, const sss::core::MissionOrigin& to);

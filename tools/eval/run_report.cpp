@@ -1,6 +1,7 @@
 // The per-run report: inputs -> metrics -> verdict, figures, index.html, report.md, metrics.json.
 // See run_report.hpp.
 #include "tools/eval/run_report.hpp"
+#include "tools/eval/frame_alignment.hpp"
 #include "tools/eval/run_report_internal.hpp"
 
 namespace sss::eval {
@@ -222,12 +223,13 @@ RunReport writeRunReport(const RunReportRequest& request, const RunReportOptions
     report.slam_path = joinPath(request.run_dir, "slam.tum");
     report.dr_path = joinPath(request.run_dir, "dead_reckoning.tum");
     Trajectory truth, dr, slam;
+    std::optional<sss::core::MissionOrigin> run_origin;  // the frame the run's files were written in
     Status read = readTrajectoryInput(report.truth_path,
                                       "the simulator's ground truth; is --mission the sss-sim --out folder?", truth,
                                       std::nullopt, &report.truth_origin);
     if (read) {
       read = readTrajectoryInput(report.slam_path, "the SLAM trajectory; is --run the sss-process output folder?", slam,
-                                 report.truth_origin);
+                                 report.truth_origin, &run_origin);
     }
     if (!read) return fail(RunReportStatus::bad_input, read.message);
     if (!fileExists(report.dr_path)) {
@@ -272,6 +274,15 @@ RunReport writeRunReport(const RunReportRequest& request, const RunReportOptions
     } else {
       report.has_closures = true;
       report.closure_counts = countClosures(report.closures);
+      // The centres are in the run's frame (its own origin, e.g. its first fix); the figures draw
+      // in the truth's, as the trajectories and heightmaps are.
+      if (run_origin && report.truth_origin && !sameOrigin(*run_origin, *report.truth_origin)) {
+        for (LoopClosureRecord& closure : report.closures) {
+          for (Eigen::Vector2d* centre : {&closure.centre_a_north_east_m, &closure.centre_b_north_east_m}) {
+            *centre = reexpressPosition({centre->x(), centre->y(), 0.0}, *run_origin, *report.truth_origin).head<2>();
+          }
+        }
+      }
       // The same file as sss-eval --closures reads: relative pose errors of the accepted closures.
       std::vector<ClosureRecord> records;
       if (const Status read = readClosureCsv(report.closures_path, records); !read) {
