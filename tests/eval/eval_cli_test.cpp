@@ -4,6 +4,7 @@
 #include "tools/eval/trajectory_io.hpp"
 
 #include "tests/eval/eval_test_paths.hpp"
+#include "tests/support/run_program.hpp"
 #include "tests/support/status_assertions.hpp"
 
 #include <gtest/gtest.h>
@@ -26,18 +27,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct ProgramRun {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+using sss::testing::ProgramRun;
+using sss::testing::slurp;
 
 class EvalCli : public ::testing::Test {
  protected:
@@ -63,14 +54,7 @@ class EvalCli : public ::testing::Test {
   }
 
   ProgramRun run(const std::string& arguments) const {
-    const std::string command = std::string(SSS_EVAL_PATH) + " " + arguments + " >" + path("stdout.txt") + " 2>" +
-                                path("stderr.txt");
-    const int status = std::system(command.c_str());
-    ProgramRun result;
-    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    result.out = slurp(path("stdout.txt"));
-    result.err = slurp(path("stderr.txt"));
-    return result;
+    return sss::testing::runProgram(std::string(SSS_EVAL_PATH) + " " + arguments, dir_);
   }
 
   fs::path dir_;

@@ -7,6 +7,7 @@
 #include "tools/eval/run_report.hpp"
 #include "tools/eval/trajectory_io.hpp"
 #include "tools/sim/mission.hpp"
+#include "tests/support/run_program.hpp"
 #include "tests/support/status_assertions.hpp"
 
 #include <gtest/gtest.h>
@@ -32,18 +33,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct ProgramRun {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-std::string slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+using sss::testing::ProgramRun;
+using sss::testing::slurp;
 
 const std::vector<std::string> kFigures = {"trajectories.png",    "error_over_time.png",   "loop_closures.png",
                                            "mosaics_dr_slam.png", "heightmap_slam.png",    "heightmap_error_dr.png",
@@ -132,14 +123,7 @@ class RunReport : public ::testing::Test {
   }
 
   ProgramRun run(const std::string& arguments) const {
-    const std::string command = std::string(SSS_REPORT_PATH) + " " + arguments + " >" + (dir_ / "stdout.txt").string() +
-                                " 2>" + (dir_ / "stderr.txt").string();
-    const int status = std::system(command.c_str());
-    ProgramRun result;
-    result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    result.out = slurp(dir_ / "stdout.txt");
-    result.err = slurp(dir_ / "stderr.txt");
-    return result;
+    return sss::testing::runProgram(std::string(SSS_REPORT_PATH) + " " + arguments, dir_);
   }
   ProgramRun report() const {
     return run("--mission " + mission_dir_.string() + " --run " + run_dir().string() + " --out " + out_dir().string());
