@@ -42,42 +42,31 @@ std::string readNodeOptions(const std::string& config_path, NodeOptions& options
   return config.problemReport();
 }
 
-// The command line over the configuration file: an exit code when the process ends here (--help, a
-// bad flag or configuration, --check-config), else -1.
-int parseOptions(int argc, char** argv, NodeOptions& options) {
+}  // namespace
+
+int main(int argc, char** argv) {
   sss::transport::NodeArguments arguments;
-  sss::cli::CommandLine command_line("sss-sonar-driver",
-                                     "EdgeTech 2205 JSF from the sonar processor's TCP data port, or a .jsf/.xtf file "
-                                     "replayed -> SSS_PING");
-  sss::transport::addNodeFlags(command_line, arguments);
   sss::transport::ReplayFlags replay_flags;
-  sss::transport::addReplayFlags(command_line, "replay this .jsf or .xtf file instead of TCP", replay_flags);
-  if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
-  const std::string config_problems = readNodeOptions(arguments.config_path, options);
-  options.input.replay_file = replay_flags.file.value_or(options.input.replay_file);
-  options.input.replay_speed = replay_flags.speed.value_or(options.input.replay_speed);
-  if (const int code = sss::transport::configVerdict("sss-sonar-driver", config_problems, arguments.config_path,
-                                                      arguments.check_config_only);
+  if (const int code = sss::transport::parseNodeArguments(
+          "sss-sonar-driver", "EdgeTech 2205 JSF from the sonar processor's TCP data port, or a .jsf/.xtf file replayed -> SSS_PING",
+          "replay this .jsf or .xtf file instead of TCP", argc, argv, arguments, replay_flags);
       code >= 0) {
     return code;
   }
-  if (!arguments.lcm_url_override.empty()) options.process.lcm_url = arguments.lcm_url_override;
+  NodeOptions options;
+  const std::string config_problems = readNodeOptions(arguments.config_path, options);
+  options.input.replay_file = replay_flags.file.value_or(options.input.replay_file);
+  options.input.replay_speed = replay_flags.speed.value_or(options.input.replay_speed);
+  if (const int code = sss::transport::finishConfiguration(config_problems, arguments, options.process); code >= 0) {
+    return code;
+  }
   // Under systemd the sonar's raw bytes go to the unit's LogsDirectory= unless the config says
   // where; a file being replayed is already on disk.
   if (options.input.replay_file.empty()) {
     options.input.driver.recorder.directory =
         sss::edgetech::resolveRecordDirectory(options.input.driver.recorder.directory, std::getenv("LOGS_DIRECTORY"));
   }
-  return -1;
-}
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  NodeOptions options;
-  if (const int code = parseOptions(argc, argv, options); code >= 0) return code;
-
-  sss::transport::initLogging(options.process.process_name, options.process.log_level);
   sss::transport::ProcessLoop loop(options.process);
   sss::edgetech::SonarInputHooks hooks;
   hooks.ping = [&](const sss::edgetech::DriverPing& ping) {

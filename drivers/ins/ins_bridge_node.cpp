@@ -127,39 +127,28 @@ class InputOnLoop {
   int watched_fd_ = -1;
 };
 
-// The command line over the configuration file: an exit code when the process ends here (--help, a
-// bad flag or configuration, --check-config), else -1.
-int parseOptions(int argc, char** argv, NodeOptions& options) {
+}  // namespace
+
+int main(int argc, char** argv) {
   sss::transport::NodeArguments arguments;
-  sss::cli::CommandLine command_line("sss-ins-bridge",
-                                     "iXblue NMEA ($PIXSE) over UDP, TCP, a serial line or a file -> SSS_NAV; "
-                                     "absolute fixes -> SSS_FIX");
-  sss::transport::addNodeFlags(command_line, arguments);
   sss::transport::ReplayFlags replay_flags;
-  sss::transport::addReplayFlags(command_line, "replay this NMEA file (source: file)", replay_flags);
-  if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
+  if (const int code = sss::transport::parseNodeArguments(
+          "sss-ins-bridge", "iXblue NMEA ($PIXSE) over UDP, TCP, a serial line or a file -> SSS_NAV; absolute fixes -> SSS_FIX",
+          "replay this NMEA file (source: file)", argc, argv, arguments, replay_flags);
+      code >= 0) {
+    return code;
+  }
+  NodeOptions options;
   const std::string config_problems = readNodeOptions(arguments.config_path, options);
   if (replay_flags.file) {
     options.input.file = *replay_flags.file;
     options.input.source = "file";
   }
   options.replay_speed = replay_flags.speed.value_or(options.replay_speed);
-  if (const int code = sss::transport::configVerdict("sss-ins-bridge", config_problems, arguments.config_path,
-                                                      arguments.check_config_only);
-      code >= 0) {
+  if (const int code = sss::transport::finishConfiguration(config_problems, arguments, options.process); code >= 0) {
     return code;
   }
-  if (!arguments.lcm_url_override.empty()) options.process.lcm_url = arguments.lcm_url_override;
-  return -1;
-}
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  NodeOptions options;
-  if (const int code = parseOptions(argc, argv, options); code >= 0) return code;
-
-  sss::transport::initLogging(options.process.process_name, options.process.log_level);
   sss::transport::ProcessLoop loop(options.process);
   sss::core::ServiceLog log;
   sss::ins::InsBridgeService service(serviceOptions(options), log);

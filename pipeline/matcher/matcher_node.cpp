@@ -59,13 +59,11 @@ int main(int argc, char** argv) {
     }
     config_problems = config.problemReport();
   }
-  if (const int code = sss::transport::configVerdict("sss-matcher", config_problems, config_path, arguments.check_config_only); code >= 0) {
+  if (const int code = sss::transport::finishConfiguration(config_problems, arguments, options.process); code >= 0) {
     return code;
   }
-  if (!arguments.lcm_url_override.empty()) options.process.lcm_url = arguments.lcm_url_override;
   options.service.state_directory = sss::core::resolveSystemdDirectory(options.service.state_directory, std::getenv("STATE_DIRECTORY"));
 
-  sss::transport::initLogging(options.process.process_name, options.process.log_level);
   sss::transport::ProcessLoop loop(options.process);
   sss::core::HealthMonitor& health = loop.health();
   // The worker wakes the loop when it has outcomes (or something to say).

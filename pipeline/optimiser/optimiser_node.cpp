@@ -126,16 +126,14 @@ int main(int argc, char** argv) {
   if (usage_exit_code >= 0) return usage_exit_code;
   NodeOptions options;
   const std::string config_problems = readNodeOptions(arguments.config_path, options);
-  if (const int code = sss::transport::configVerdict("sss-optimiser", config_problems, arguments.config_path, arguments.check_config_only); code >= 0) {
+  if (const int code = sss::transport::finishConfiguration(config_problems, arguments, options.process); code >= 0) {
     return code;
   }
-  if (!arguments.lcm_url_override.empty()) options.process.lcm_url = arguments.lcm_url_override;
   options.service.state_directory = sss::core::resolveSystemdDirectory(options.service.state_directory, std::getenv("STATE_DIRECTORY"));
   if (options.service.products_directory.empty() && !options.service.state_directory.empty()) {
     options.service.products_directory = options.service.state_directory + "/products";
   }
 
-  sss::transport::initLogging(options.process.process_name, options.process.log_level);
   sss::transport::ProcessLoop loop(options.process);
   sss::core::HealthMonitor& health = loop.health();
   // The worker wakes the loop when it has results: the trajectory for the matcher, the status.

@@ -65,12 +65,10 @@ int main(int argc, char** argv) {
     section.rejectUnknownKeys();
     config_problems = config.problemReport();
   }
-  if (const int code = sss::transport::configVerdict("sss-subframe-buffer", config_problems, config_path, arguments.check_config_only); code >= 0) {
+  if (const int code = sss::transport::finishConfiguration(config_problems, arguments, options.process); code >= 0) {
     return code;
   }
-  if (!arguments.lcm_url_override.empty()) options.process.lcm_url = arguments.lcm_url_override;
 
-  sss::transport::initLogging(options.process.process_name, options.process.log_level);
   sss::transport::ProcessLoop loop(options.process);
   const std::string state_directory =
       sss::core::resolveSystemdDirectory(options.state_directory, std::getenv("STATE_DIRECTORY"));

@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <string>
 
+#include "pipeline/transport/logging.hpp"
+
 namespace sss::transport {
 
 void readProcessOptions(sss::core::ConfigSection& section, ProcessOptions& options) {
@@ -21,11 +23,15 @@ void readProcessOptions(sss::core::ConfigSection& section, ProcessOptions& optio
                    {oneOf({"trace", "debug", "info", "warn", "error", "critical", "off"})});
 }
 
+namespace {
+
 void addNodeFlags(sss::cli::CommandLine& command_line, NodeArguments& arguments) {
   command_line.add_option("--config", arguments.config_path, "YAML configuration (every key optional; see config/sss-slam.yaml)");
   command_line.add_flag("--check-config", arguments.check_config_only, "validate the configuration, print the verdict and exit");
   command_line.add_option("--lcm-url", arguments.lcm_url_override, "LCM URL instead of the configured one (udpm://, memq://, ...)");
 }
+
+}  // namespace
 
 int parseNodeArguments(const std::string& process_name, const std::string& description, int argc, char** argv,
                        NodeArguments& arguments) {
@@ -34,21 +40,27 @@ int parseNodeArguments(const std::string& process_name, const std::string& descr
   return sss::cli::parseCommandLine(command_line, argc, argv);
 }
 
-void addReplayFlags(sss::cli::CommandLine& command_line, const std::string& file_help, ReplayFlags& flags) {
-  command_line.add_option("--file", flags.file, file_help);
-  command_line.add_option("--speed", flags.speed, "replay speed (0: as fast as possible)")->check(CLI::Range(0.0, 1000.0));
+int parseNodeArguments(const std::string& process_name, const std::string& description, const std::string& file_help,
+                       int argc, char** argv, NodeArguments& arguments, ReplayFlags& replay_flags) {
+  sss::cli::CommandLine command_line(process_name, description);
+  addNodeFlags(command_line, arguments);
+  command_line.add_option("--file", replay_flags.file, file_help);
+  command_line.add_option("--speed", replay_flags.speed, "replay speed (0: as fast as possible)")->check(CLI::Range(0.0, 1000.0));
+  return sss::cli::parseCommandLine(command_line, argc, argv);
 }
 
-int configVerdict(const std::string& process_name, const std::string& problems, const std::string& config_path,
-                  bool check_config_only) {
+int finishConfiguration(const std::string& problems, const NodeArguments& arguments, ProcessOptions& process) {
+  const char* name = process.process_name.c_str();
   if (!problems.empty()) {
-    std::fprintf(stderr, "%s: invalid configuration:\n%s", process_name.c_str(), problems.c_str());
+    std::fprintf(stderr, "%s: invalid configuration:\n%s", name, problems.c_str());
     return 2;
   }
-  if (check_config_only) {
-    std::printf("%s: configuration '%s' is valid\n", process_name.c_str(), config_path.c_str());
+  if (arguments.check_config_only) {
+    std::printf("%s: configuration '%s' is valid\n", name, arguments.config_path.c_str());
     return 0;
   }
+  if (!arguments.lcm_url_override.empty()) process.lcm_url = arguments.lcm_url_override;
+  initLogging(process.process_name, process.log_level);
   return -1;
 }
 

@@ -32,8 +32,6 @@ struct NodeArguments {
   std::string lcm_url_override;
   bool check_config_only = false;
 };
-// Declares them on a process's command line (which may add its own).
-void addNodeFlags(sss::cli::CommandLine& command_line, NodeArguments& arguments);
 // The command line of a process that takes only those flags. -1 to go on; otherwise the exit code
 // to return (command_line.hpp: 0 for --help, 2 for bad flags).
 int parseNodeArguments(const std::string& process_name, const std::string& description, int argc, char** argv,
@@ -45,12 +43,15 @@ struct ReplayFlags {
   std::optional<std::string> file;
   std::optional<double> speed;
 };
-void addReplayFlags(sss::cli::CommandLine& command_line, const std::string& file_help, ReplayFlags& flags);
+// The command line of a driver: the flags above and the replay flags (file_help: what --file
+// replays). Returns as parseNodeArguments.
+int parseNodeArguments(const std::string& process_name, const std::string& description, const std::string& file_help,
+                       int argc, char** argv, NodeArguments& arguments, ReplayFlags& replay_flags);
 
 // The end of every process's configuration step. problems: Config::problemReport() (empty when
 // valid). Prints them and returns 2 when there are any; with --check-config says the file is valid
-// and returns 0; otherwise -1 (go on and run).
-int configVerdict(const std::string& process_name, const std::string& problems, const std::string& config_path,
-                  bool check_config_only);
+// and returns 0. Otherwise the process will run: --lcm-url replaces the configured URL, logging is
+// set up as configured (logging.hpp) and it returns -1.
+int finishConfiguration(const std::string& problems, const NodeArguments& arguments, ProcessOptions& process);
 
 }  // namespace sss::transport
