@@ -1,7 +1,20 @@
 // Shared emulator options, see emulator_options.hpp.
 #include "tools/emulators/emulator_options.hpp"
 
+#include <csignal>
+
 namespace sss::emulators {
+
+namespace {
+std::atomic<bool> g_stop_requested{false};
+void onTerminationSignal(int) { g_stop_requested = true; }
+}  // namespace
+
+const std::atomic<bool>& stopOnTerminationSignals() {
+  std::signal(SIGINT, onTerminationSignal);
+  std::signal(SIGTERM, onTerminationSignal);
+  return g_stop_requested;
+}
 
 void addStreamOptions(sss::cli::CommandLine& command_line, StreamServerOptions& options) {
   command_line.add_option("--bind,--host", options.bind_address, "address: TCP listens on it, UDP sends to it")

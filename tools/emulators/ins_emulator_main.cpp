@@ -4,7 +4,6 @@
 // UDP datagram per fix to --fixes-port, in step with the INS stream.
 //   sss-ins-emulator --file ins.nmea [--udp | --tcp] [--host 127.0.0.1] [--port 8110] [--speed 1]
 //                    [--fixes fixes.nmea --fixes-port 8111]
-#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -12,11 +11,6 @@
 
 #include "tools/emulators/emulator_options.hpp"
 #include "tools/emulators/recorded_streams.hpp"
-
-namespace {
-std::atomic<bool> g_stop{false};
-void onSignal(int) { g_stop = true; }
-}  // namespace
 
 int main(int argc, char** argv) {
   sss::emulators::StreamServerOptions options;
@@ -36,8 +30,7 @@ int main(int argc, char** argv) {
   command_line.add_flag("--tcp,!--udp", tcp, "serve as a TCP server instead of sending UDP datagrams");
   sss::emulators::addStreamOptions(command_line, options);
   if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
-  std::signal(SIGINT, onSignal);
-  std::signal(SIGTERM, onSignal);
+  const std::atomic<bool>& stop_requested = sss::emulators::stopOnTerminationSignals();
   sss::core::Result<std::vector<sss::emulators::TimedChunk>> loaded = sss::emulators::loadInsChunks(file);
   if (!loaded || loaded->empty()) {
     std::fprintf(stderr, "sss-ins-emulator: %s\n", loaded ? "no NMEA bursts in the file" : loaded.message().c_str());
@@ -64,9 +57,9 @@ int main(int argc, char** argv) {
     fix_options.pacing_origin_us = chunks.front().time_us;
     std::printf("sss-ins-emulator: %zu fixes from %s sent to %s:%d\n", fix_chunks.size(), fixes_file.c_str(),
                 options.bind_address.c_str(), fixes_port);
-    fixes_thread = std::thread([fix_options, fix_chunks = std::move(fix_chunks), &fixes_error]() mutable {
+    fixes_thread = std::thread([fix_options, fix_chunks = std::move(fix_chunks), &fixes_error, &stop_requested]() mutable {
       sss::emulators::UdpStreamSender sender(fix_options, std::move(fix_chunks));
-      if (const sss::core::Status sent = sender.run(g_stop); !sent) fixes_error = sent.message;
+      if (const sss::core::Status sent = sender.run(stop_requested); !sent) fixes_error = sent.message;
     });
   }
   std::fflush(stdout);
@@ -77,11 +70,11 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "sss-ins-emulator: %s\n", listening.message.c_str());
       return 1;
     }
-    server.run(g_stop);
+    server.run(stop_requested);
     stats = server.stats();
   } else {
     sss::emulators::UdpStreamSender sender(options, std::move(chunks));
-    if (const sss::core::Status sent = sender.run(g_stop); !sent) {
+    if (const sss::core::Status sent = sender.run(stop_requested); !sent) {
       std::fprintf(stderr, "sss-ins-emulator: %s\n", sent.message.c_str());
       return 1;
     }

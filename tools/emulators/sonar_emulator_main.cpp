@@ -1,17 +1,11 @@
 // sss-sonar-emulator: serves a .jsf file over TCP as an EdgeTech 2205 sonar processor's data
 // port does, paced by the ping times, with optional fault injection.
 //   sss-sonar-emulator --file sonar.jsf [--bind 127.0.0.1] [--port 1701] [--speed 1] [faults]
-#include <csignal>
 #include <cstdio>
 #include <string>
 
 #include "tools/emulators/emulator_options.hpp"
 #include "tools/emulators/recorded_streams.hpp"
-
-namespace {
-std::atomic<bool> g_stop{false};
-void onSignal(int) { g_stop = true; }
-}  // namespace
 
 int main(int argc, char** argv) {
   sss::emulators::StreamServerOptions options;
@@ -24,8 +18,7 @@ int main(int argc, char** argv) {
   command_line.add_flag("--repeat", repeat, "serve the file again after every pass");
   sss::emulators::addStreamOptions(command_line, options);
   if (const int code = sss::cli::parseCommandLine(command_line, argc, argv); code >= 0) return code;
-  std::signal(SIGINT, onSignal);
-  std::signal(SIGTERM, onSignal);
+  const std::atomic<bool>& stop_requested = sss::emulators::stopOnTerminationSignals();
   const sss::core::Result<std::vector<sss::emulators::TimedChunk>> loaded = sss::emulators::loadJsfChunks(file);
   if (!loaded || loaded->empty()) {
     std::fprintf(stderr, "sss-sonar-emulator: %s\n", loaded ? "no JSF messages in the file" : loaded.message().c_str());
@@ -41,7 +34,7 @@ int main(int argc, char** argv) {
     std::printf("sss-sonar-emulator: %zu messages from %s on %s:%d at speed %g\n", chunks.size(), file.c_str(),
                 options.bind_address.c_str(), server.port(), options.speed);
     std::fflush(stdout);
-    server.run(g_stop);
+    server.run(stop_requested);
     const auto& s = server.stats();
     std::printf("sss-sonar-emulator: sent %llu whole, %llu faulted, %llu garbage runs, %llu connections, %llu drops, "
                 "%llu pauses, %llu skipped\n",
@@ -50,6 +43,6 @@ int main(int argc, char** argv) {
                 static_cast<unsigned long long>(s.drops), static_cast<unsigned long long>(s.pauses),
                 static_cast<unsigned long long>(s.chunks_skipped));
     std::fflush(stdout);
-  } while (repeat && !g_stop);
+  } while (repeat && !stop_requested);
   return 0;
 }
