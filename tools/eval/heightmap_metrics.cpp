@@ -2,6 +2,7 @@
 #include "tools/eval/heightmap_metrics.hpp"
 
 #include "tools/eval/frame_alignment.hpp"
+#include "tools/eval/yaml_file.hpp"
 
 #include <yaml-cpp/yaml.h>
 
@@ -81,14 +82,9 @@ std::optional<double> HeightmapRaster::sampleBilinear(double north_m, double eas
 }
 
 Status readHeightmap(const std::string& yaml_path, HeightmapRaster& raster, const HeightmapReadOptions& options) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(yaml_path);
-  } catch (const YAML::BadFile&) {
-    return Status::error(yaml_path + ": cannot open; check the path");
-  } catch (const YAML::Exception& e) {
-    return Status::error(yaml_path + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
-  }
+  const sss::core::Result<YAML::Node> loaded = loadYamlFile(yaml_path);
+  if (!loaded) return loaded.status();
+  const YAML::Node& root = *loaded;
   if (!root.IsMap()) {
     return Status::error(yaml_path +
                          ":1: expected a YAML map with rows, cols, resolution_m, north_min_m, east_min_m, depth_file");

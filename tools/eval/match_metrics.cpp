@@ -9,6 +9,8 @@
 #include <tuple>
 
 #include "pipeline/core/config.hpp"
+#include "pipeline/core/pose.hpp"
+#include "pipeline/core/subframe_types.hpp"
 #include "pipeline/matcher/dense_matcher.hpp"
 #include "pipeline/subframe/canonical_transform.hpp"
 #include "tools/eval/csv_fields.hpp"
@@ -38,6 +40,13 @@ PairType classifyPair(double heading_a_rad, double heading_b_rad) {
   if (difference <= 30.0 * kPi / 180.0) return PairType::kParallel;
   if (difference >= 150.0 * kPi / 180.0) return PairType::kAntiParallel;
   return PairType::kCrossing;
+}
+
+PairType classifyPair(const sss::core::Subframe& a, const sss::core::Subframe& b) {
+  const auto centreHeadingRad = [](const sss::core::Subframe& s) {
+    return sss::core::eulerFromQuaternion(s.centre().T_world_body.rotation).heading_rad;
+  };
+  return classifyPair(centreHeadingRad(a), centreHeadingRad(b));
 }
 
 MatchEvaluation& MatchEvaluation::operator+=(const MatchEvaluation& other) {

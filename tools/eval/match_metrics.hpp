@@ -30,6 +30,7 @@ constexpr int kPairTypes = 3;
 // From the two subframes' centre headings: |difference| <= 30 deg parallel, >= 150 deg
 // anti-parallel, else crossing.
 PairType classifyPair(double heading_a_rad, double heading_b_rad);
+PairType classifyPair(const sss::core::Subframe& a, const sss::core::Subframe& b);
 // "parallel", "anti_parallel", "crossing" (the JSON key suffixes). Inline: the report uses it
 // without linking the simulator.
 inline const char* pairTypeName(PairType type) {

@@ -1,6 +1,7 @@
 // The heightmap error map PNG drawn with OpenCV (the report's charts are drawn by
 // report_figures.py) and the simulator's 8-bit mosaic reader. See plots.hpp.
 #include "tools/eval/plots.hpp"
+#include "tools/eval/yaml_file.hpp"
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -200,14 +201,9 @@ Status writeErrorMapPng(const std::string& path, const HeightmapRaster& map, con
 }
 
 Status readMosaic(const std::string& yaml_path, GreyMosaic& mosaic) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(yaml_path);
-  } catch (const YAML::BadFile&) {
-    return Status::error(yaml_path + ": cannot open; check the path");
-  } catch (const YAML::Exception& e) {
-    return Status::error(yaml_path + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
-  }
+  const sss::core::Result<YAML::Node> loaded = loadYamlFile(yaml_path);
+  if (!loaded) return loaded.status();
+  const YAML::Node& root = *loaded;
   GreyMosaic result;
   try {
     if (!root.IsMap()) throw YAML::Exception(root.Mark(), "not a map");

@@ -3,6 +3,7 @@
 #include "tools/eval/run_report.hpp"
 #include "tools/eval/frame_alignment.hpp"
 #include "tools/eval/run_report_internal.hpp"
+#include "tools/eval/yaml_file.hpp"
 
 namespace sss::eval {
 
@@ -134,14 +135,9 @@ LoopClosureCounts countClosures(const std::vector<LoopClosureRecord>& closures) 
 }
 
 Status readRunSummary(const std::string& path, RunSummary& summary) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(path);
-  } catch (const YAML::BadFile&) {
-    return Status::error(path + ": cannot open; check the path");
-  } catch (const YAML::Exception& e) {
-    return Status::error(path + ":" + std::to_string(e.mark.line + 1) + ": not valid JSON: " + e.msg);
-  }
+  const sss::core::Result<YAML::Node> loaded = loadYamlFile(path, "JSON");
+  if (!loaded) return loaded.status();
+  const YAML::Node& root = *loaded;
   if (!root.IsMap()) {
     return Status::error(path + ": expected a JSON object with pings, subframes, closures_accepted, wall_s, ...");
   }
