@@ -18,7 +18,7 @@
 #include "jsf_test_data.hpp"
 #include "pipeline/core/time.hpp"
 #include "tests/support/loopback_socket.hpp"
-#include "tests/support/poll_until.hpp"
+#include "tools/fixtures/poll_until.hpp"
 #include "tests/support/status_assertions.hpp"
 #include "tests/xtf/xtf_test_data.hpp"
 

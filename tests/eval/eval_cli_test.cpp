@@ -27,8 +27,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-using sss::testing::ProgramRun;
-using sss::testing::slurp;
+using sss::testing::ProgramRun, sss::testing::slurp;
 
 class EvalCli : public ::testing::Test {
  protected:

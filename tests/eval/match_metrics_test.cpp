@@ -2,6 +2,7 @@
 // against the same figures computed in process, on a parallel and a crossing pair of a small
 // simulated cross survey (integration: renders ~1800 pings and matches two pairs, a few seconds).
 #include "tools/eval/match_metrics.hpp"
+#include "tools/eval/survey_footprints.hpp"
 
 #include <gtest/gtest.h>
 
@@ -37,10 +38,6 @@ TEST(ClassifyPair, SplitsByHeadingDifferenceAcrossTheWrap) {
   EXPECT_STREQ(pairTypeName(PairType::kAntiParallel), "anti_parallel");
 }
 
-double headingOf(const sss::core::Subframe& s) {
-  return sss::core::eulerFromQuaternion(s.centre().T_world_body.rotation).heading_rad;
-}
-
 TEST(MatchFile, EvaluationFromTheFileEqualsTheInProcessOne) {
   // Two 200 m lines 40 m apart and two crossing lines 120 m long (one full subframe each).
   sss::sim::SimOptions sim;
@@ -51,20 +48,15 @@ TEST(MatchFile, EvaluationFromTheFileEqualsTheInProcessOne) {
   const sss::sim::SimulatedSurvey survey = sss::sim::simulateSurvey(sim);
 
   // The best-overlapping full pair of each type present (anti-parallel and crossing here).
-  const sss::matcher::OverlapOptions overlap;
-  std::vector<const sss::core::Subframe*> full;
-  std::vector<sss::matcher::Footprint> footprints;
-  for (const auto& s : survey.subframes) {
-    if (s.rows() != 200) continue;
-    full.push_back(&s);
-    footprints.push_back(sss::matcher::computeFootprint(s, sss::core::drPoses(s), overlap));
-  }
+  const SurveyFootprints candidates = fullSubframeFootprints(survey, sss::matcher::OverlapOptions());
+  const std::vector<const sss::core::Subframe*>& full = candidates.subframes;
+  const std::vector<sss::matcher::Footprint>& footprints = candidates.footprints;
   std::pair<size_t, size_t> best[kPairTypes];
   double best_area[kPairTypes] = {0.0, 0.0, 0.0};
   for (size_t i = 0; i < full.size(); ++i) {
     for (size_t j = i + 1; j < full.size(); ++j) {
       if (full[i]->line_id == full[j]->line_id) continue;
-      const int type = static_cast<int>(classifyPair(headingOf(*full[i]), headingOf(*full[j])));
+      const int type = static_cast<int>(classifyPair(*full[i], *full[j]));
       const double area = sss::matcher::overlapAreaM2(footprints[i], footprints[j]);
       if (area > best_area[type]) best_area[type] = area, best[type] = {i, j};
     }

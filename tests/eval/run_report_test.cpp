@@ -33,8 +33,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-using sss::testing::ProgramRun;
-using sss::testing::slurp;
+using sss::testing::ProgramRun, sss::testing::slurp;
 
 const std::vector<std::string> kFigures = {"trajectories.png",    "error_over_time.png",   "loop_closures.png",
                                            "mosaics_dr_slam.png", "heightmap_slam.png",    "heightmap_error_dr.png",

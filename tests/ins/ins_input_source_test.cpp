@@ -20,7 +20,7 @@
 
 #include "pipeline/core/time.hpp"
 #include "tests/support/loopback_socket.hpp"
-#include "tests/support/poll_until.hpp"
+#include "tools/fixtures/poll_until.hpp"
 #include "tests/support/status_assertions.hpp"
 
 namespace sss::ins {

@@ -172,16 +172,7 @@ TEST(MatcherEngine, StoredSubframesAreBoundedByMemoryWhateverTheirCount) {
 namespace fs = std::filesystem;
 using PairIds = std::set<std::pair<int64_t, int64_t>>;
 
-// The three-line survey's subframes: 0, 1 on line 0; 2, 3 on line 1; 4, 5 on line 2 (full, tail).
-// Line k gets k * (2 m north, 1.5 m east) of DR error, as above.
-sss::core::Subframe surveySubframe(int64_t id) {
-  for (auto s : test::threeLineSurvey().subframes) {
-    if (s.id != id) continue;
-    for (auto& ping : s.pings) ping.T_world_body.translation += s.line_id * Eigen::Vector3d(2.0, 1.5, 0.0);
-    return s;
-  }
-  throw std::runtime_error("no subframe " + std::to_string(id));
-}
+using test::surveySubframe;  // line k off by k * (2 m north, 1.5 m east), as above
 
 std::vector<TrajectoryNode> trueNodes(const std::vector<int64_t>& ids) {
   const auto& survey = test::threeLineSurvey();

@@ -32,14 +32,7 @@ using sss::core::HealthMonitor;
 using sss::core::ServiceLog;
 
 // Subframe `id` of the survey with line k's DR off by k * (2 m north, 1.5 m east), as a message.
-sss_msgs::subframe_t surveyMessage(int64_t id) {
-  for (auto s : test::threeLineSurvey().subframes) {
-    if (s.id != id) continue;
-    for (auto& ping : s.pings) ping.T_world_body.translation += s.line_id * Eigen::Vector3d(2.0, 1.5, 0.0);
-    return sss::messages::toSubframeMessage(s, 16, 16.0);
-  }
-  throw std::runtime_error("no subframe " + std::to_string(id));
-}
+sss_msgs::subframe_t surveyMessage(int64_t id) { return sss::messages::toSubframeMessage(test::surveySubframe(id), 16, 16.0); }
 
 // Takes the service's results as the loop would, until `subframes` have been taken in and the
 // worker is idle (bounded: a broken worker fails instead of hanging).

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "pipeline/matcher/dense_matcher.hpp"
@@ -38,6 +40,18 @@ inline const sss::core::Subframe* fullSubframeOfLine(const sss::sim::SimulatedSu
     if (s.line_id == line_id && s.rows() == 200) return &s;
   }
   return nullptr;
+}
+
+// Subframe `id` of the three-line survey (0, 1 on line 0; 2, 3 on line 1; 4, 5 on line 2: full,
+// tail) with line k's DR off by k * (2 m north, 1.5 m east) on top of the simulated drift.
+inline sss::core::Subframe surveySubframe(int64_t id) {
+  for (const sss::core::Subframe& candidate : threeLineSurvey().subframes) {
+    if (candidate.id != id) continue;
+    sss::core::Subframe s = candidate;
+    for (auto& ping : s.pings) ping.T_world_body.translation += s.line_id * Eigen::Vector3d(2.0, 1.5, 0.0);
+    return s;
+  }
+  throw std::runtime_error("no subframe " + std::to_string(id));
 }
 
 using sss::eval::evaluateMatches;

@@ -28,15 +28,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Subframe `id` of the survey with line k's DR off by k * (2 m north, 1.5 m east).
-sss::core::Subframe surveySubframe(int64_t id) {
-  for (auto s : test::threeLineSurvey().subframes) {
-    if (s.id != id) continue;
-    for (auto& ping : s.pings) ping.T_world_body.translation += s.line_id * Eigen::Vector3d(2.0, 1.5, 0.0);
-    return s;
-  }
-  throw std::runtime_error("no subframe " + std::to_string(id));
-}
+using test::surveySubframe;  // line k's DR off by k * (2 m north, 1.5 m east)
 
 struct Recorder {
   std::mutex mutex;

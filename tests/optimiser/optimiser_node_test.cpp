@@ -37,6 +37,9 @@
 #include "sss_msgs/pose_t.hpp"
 #include "sss_msgs/status_t.hpp"
 #include "sss_msgs/trajectory_t.hpp"
+#include "tools/fixtures/nav_message.hpp"
+#include "tools/fixtures/optimiser_node_config.hpp"
+#include "tools/fixtures/poll_until.hpp"
 #include "tools/fixtures/spawn_process.hpp"
 
 namespace sss::optimiser {
@@ -141,31 +144,7 @@ sss::core::LoopClosure makeClosure(int j) {
 
 sss_msgs::nav_t makeNav(int64_t utime_us, const sss::core::LocalTangentPlane& plane) {
   const State s = stateAt(utime_us);
-  sss_msgs::nav_t m{};
-  m.utime = utime_us;
-  const sss::core::GeodeticPosition geodetic = plane.toGeodetic(s.dr.translation);
-  m.latitude_deg = geodetic.latitude_deg;
-  m.longitude_deg = geodetic.longitude_deg;
-  m.origin_latitude_deg = plane.originLatitudeDeg();
-  m.origin_longitude_deg = plane.originLongitudeDeg();
-  m.depth_m = s.dr.translation.z();
-  for (int i = 0; i < 3; ++i) m.position_ned_m[i] = s.dr.translation[i];
-  const sss::core::EulerAngles euler = sss::core::eulerFromQuaternion(s.dr.rotation);
-  m.roll_rad = euler.roll_rad;
-  m.pitch_rad = euler.pitch_rad;
-  m.heading_rad = euler.heading_rad;
-  m.velocity_body_m_s[0] = kSpeed;
-  m.altitude_m = 10.0;
-  m.distance_travelled_m = s.distance_m;
-  for (int i = 0; i < 3; ++i) {
-    m.position_std_ned_m[i] = 0.5;
-    m.attitude_std_rad[i] = 0.001;
-    m.velocity_std_m_s[i] = 0.01;
-  }
-  m.altitude_std_m = 0.1;
-  m.validity = sss_msgs::nav_t::VALID_POSITION | sss_msgs::nav_t::VALID_ATTITUDE | sss_msgs::nav_t::VALID_HEADING |
-               sss_msgs::nav_t::VALID_VELOCITY | sss_msgs::nav_t::VALID_DEPTH | sss_msgs::nav_t::VALID_ALTITUDE;
-  return m;
+  return sss::test::makeNavMessage(utime_us, s.dr, s.distance_m, 10.0, kSpeed, plane);
 }
 
 Eigen::Vector3d positionOf(const sss_msgs::pose_t& p) {
@@ -231,23 +210,15 @@ TEST(OptimiserNode, NavToPoseClosuresCorrectDdsCheckpointRestartAndBadInput) {
   const uint32_t domain = 200 + static_cast<uint32_t>(self % 32);
   const std::string topic_name = "sss_navigation_correction_node_test";
   const std::string config = dir + "/optimiser.yaml";
-  {
-    std::ofstream file(config);
-    file << "mission:\n  origin_latitude_deg: " << kOriginLat << "\n  origin_longitude_deg: " << kOriginLon << "\n"
-         << "optimiser:\n"
-         << "  lcm_url: \"" << lcm_url << "\"\n"
-         << "  log_level: info\n"
-         << "  status_period_s: 0.2\n"
-         << "  update_period_s: 0.2\n"
-         << "  state_directory: \"" << state_dir << "\"\n"
-         << "  dds:\n"
-         << "    enabled: true\n"
-         << "    domain_id: " << domain << "\n"
-         << "    topic: " << topic_name << "\n"
-         << "    rate_hz: 10.0\n"
-         << "    vehicle_id: 7\n"
-         << "    loopback_only: true\n";
-  }
+  sss::test::OptimiserNodeConfig node_config;
+  node_config.origin_latitude_deg = kOriginLat;
+  node_config.origin_longitude_deg = kOriginLon;
+  node_config.lcm_url = lcm_url;
+  node_config.state_directory = state_dir;
+  node_config.dds_domain_id = domain;
+  node_config.dds_topic = topic_name;
+  node_config.vehicle_id = 7;
+  ASSERT_TRUE(sss::test::writeOptimiserNodeConfig(config, node_config));
   const sss::core::LocalTangentPlane plane(kOriginLat, kOriginLon);
 
   // ---- the test's side of the bus --------------------------------------------------------------------
@@ -297,12 +268,7 @@ TEST(OptimiserNode, NavToPoseClosuresCorrectDdsCheckpointRestartAndBadInput) {
     }
   };
   auto waitFor = [&](const std::function<bool()>& done, double timeout_s) {
-    const int64_t deadline = sss::core::monotonicUtime() + static_cast<int64_t>(timeout_s * 1e6);
-    while (!done()) {
-      if (sss::core::monotonicUtime() > deadline) return false;
-      pumpFor(0.01);
-    }
-    return true;
+    return sss::test::pollUntil([&] { pumpFor(0.01); }, done, timeout_s);
   };
   auto counterOf = [&](pid_t pid, const std::string& name) {
     const auto p = seen.counters.find(pid);

@@ -2,6 +2,7 @@
 // layouts: XTF in projected metres without altitude, XTF navigation packets or ship coordinates,
 // JSF situation or NMEA messages as the only navigation, a towed fish on a curved line.
 #include "tests/process/offline_runner_fixture.hpp"
+#include "tests/xtf/xtf_test_data.hpp"
 
 namespace {
 
@@ -10,12 +11,8 @@ namespace {
 // processed in the file's own grid (north = northing - N0 of the first fix), says so, and tracks
 // the bottom; and a multibeam-only file is refused in one line.
 TEST_F(OfflineRunnerTest, XtfInProjectedMetresWithoutAltitudeIsProcessedInItsGrid) {
-  sss::xtf::XtfWriterOptions options;
-  options.nav_units = sss::xtf::kNavUnitsMetres;
-  sss::xtf::XtfWriterChannel port, starboard;
-  starboard.type_of_channel = sss::xtf::kChannelStarboard;
-  starboard.name = "Starboard";
-  options.channels = {port, starboard};
+  // One 100 kHz port/starboard pair of 16-bit samples, navigation in projected metres.
+  const sss::xtf::XtfWriterOptions options = sss::test::makeXtfOptions({100.0f}, 2, sss::xtf::kNavUnitsMetres);
   const std::string path = root_ + "/projected.xtf";
   {
     sss::xtf::XtfWriter writer(path, options);

@@ -20,6 +20,7 @@
 #include "drivers/xtf/xtf_writer.hpp"
 #include "products/corrected_copy.hpp"
 #include "tests/support/status_assertions.hpp"
+#include "tests/xtf/xtf_test_data.hpp"
 
 namespace fs = std::filesystem;
 
@@ -154,12 +155,8 @@ TEST_F(CorrectedCopyTest, JsfPingsCarryTheNewNavigationAndNothingElseChanges) {
 }
 
 TEST_F(CorrectedCopyTest, XtfPingsInProjectedMetresCarryTheNewGridPosition) {
-  sss::xtf::XtfWriterOptions options;
-  options.nav_units = sss::xtf::kNavUnitsMetres;
-  sss::xtf::XtfWriterChannel port, starboard;
-  starboard.type_of_channel = sss::xtf::kChannelStarboard;
-  starboard.name = "Starboard";
-  options.channels = {port, starboard};
+  // One 100 kHz port/starboard pair of 16-bit samples, navigation in projected metres.
+  const sss::xtf::XtfWriterOptions options = sss::test::makeXtfOptions({100.0f}, 2, sss::xtf::kNavUnitsMetres);
   const std::string in = dir_ + "/line.xtf", out = dir_ + "/out/line.xtf";
   std::vector<size_t> ping_offsets;
   {

@@ -51,6 +51,9 @@
 #include "sss_msgs/nav_t.hpp"
 #include "sss_msgs/pose_t.hpp"
 #include "sss_msgs/status_t.hpp"
+#include "tools/fixtures/nav_message.hpp"
+#include "tools/fixtures/optimiser_node_config.hpp"
+#include "tools/fixtures/poll_until.hpp"
 #include "tools/fixtures/spawn_process.hpp"
 
 namespace {
@@ -147,31 +150,7 @@ sss::core::LoopClosure matcherClosure(const synthetic::Closure& c, const std::ma
 }
 
 sss_msgs::nav_t makeNav(int64_t utime_us, const Pose& dr, double distance_m, const sss::core::LocalTangentPlane& plane) {
-  sss_msgs::nav_t m{};
-  m.utime = utime_us;
-  const sss::core::GeodeticPosition geodetic = plane.toGeodetic(dr.translation);
-  m.latitude_deg = geodetic.latitude_deg;
-  m.longitude_deg = geodetic.longitude_deg;
-  m.origin_latitude_deg = plane.originLatitudeDeg();
-  m.origin_longitude_deg = plane.originLongitudeDeg();
-  m.depth_m = dr.translation.z();
-  for (int i = 0; i < 3; ++i) m.position_ned_m[i] = dr.translation[i];
-  const sss::core::EulerAngles euler = sss::core::eulerFromQuaternion(dr.rotation);
-  m.roll_rad = euler.roll_rad;
-  m.pitch_rad = euler.pitch_rad;
-  m.heading_rad = euler.heading_rad;
-  m.velocity_body_m_s[0] = kSpeedMS;
-  m.altitude_m = 18.0;
-  m.distance_travelled_m = distance_m;
-  for (int i = 0; i < 3; ++i) {
-    m.position_std_ned_m[i] = 0.5;
-    m.attitude_std_rad[i] = 0.001;
-    m.velocity_std_m_s[i] = 0.01;
-  }
-  m.altitude_std_m = 0.1;
-  m.validity = sss_msgs::nav_t::VALID_POSITION | sss_msgs::nav_t::VALID_ATTITUDE | sss_msgs::nav_t::VALID_HEADING |
-               sss_msgs::nav_t::VALID_VELOCITY | sss_msgs::nav_t::VALID_DEPTH | sss_msgs::nav_t::VALID_ALTITUDE;
-  return m;
+  return sss::test::makeNavMessage(utime_us, dr, distance_m, 18.0, kSpeedMS, plane);
 }
 
 // DDS samples as the navigation computer sees them, taken on their own thread as soon as they
@@ -322,22 +301,19 @@ int main(int argc, char** argv) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const std::string config = dir + "/optimiser.yaml";
-  {
-    std::ofstream file(config);
-    file << "mission:\n  origin_latitude_deg: " << kOriginLat << "\n  origin_longitude_deg: " << kOriginLon << "\n"
-         << "optimiser:\n"
-         << "  lcm_url: \"" << lcm_url << "\"\n"
-         << "  log_level: warn\n"
-         << "  status_period_s: 0.2\n"
-         << "  update_period_s: " << update_period_s << "\n"
-         << "  state_directory: \"" << dir << "/state\"\n"
-         << "  dds:\n"
-         << "    enabled: true\n"
-         << "    domain_id: " << domain << "\n"
-         << "    topic: " << topic_name << "\n"
-         << "    rate_hz: " << dds_rate_hz << "\n"
-         << "    vehicle_id: 1\n"
-         << "    loopback_only: true\n";
+  sss::test::OptimiserNodeConfig node_config;
+  node_config.origin_latitude_deg = kOriginLat;
+  node_config.origin_longitude_deg = kOriginLon;
+  node_config.lcm_url = lcm_url;
+  node_config.log_level = "warn";
+  node_config.update_period_s = update_period_s;
+  node_config.state_directory = dir + "/state";
+  node_config.dds_domain_id = domain;
+  node_config.dds_topic = topic_name;
+  node_config.dds_rate_hz = dds_rate_hz;
+  if (!sss::test::writeOptimiserNodeConfig(config, node_config)) {
+    std::fprintf(stderr, "sss-bench-latency: cannot write %s\n", config.c_str());
+    return 1;
   }
   std::printf("sss-bench-latency: %s, LCM %s, DDS domain %u (loopback), state %s\n", optimiser_path.c_str(),
               lcm_url.c_str(), domain, dir.c_str());
@@ -387,12 +363,7 @@ int main(int argc, char** argv) {
       bus.handleTimeout(static_cast<int>(std::max<int64_t>(1, (until - now) / 1000)));
   };
   auto waitFor = [&](const std::function<bool()>& done, double timeout_s) {
-    const int64_t deadline = sss::core::monotonicUtime() + static_cast<int64_t>(timeout_s * 1e6);
-    while (!done()) {
-      if (sss::core::monotonicUtime() > deadline) return false;
-      pumpFor(0.01);
-    }
-    return true;
+    return sss::test::pollUntil([&] { pumpFor(0.01); }, done, timeout_s);
   };
   auto counter = [&](const std::string& name) {
     const auto c = counters.find(name);

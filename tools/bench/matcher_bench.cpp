@@ -24,6 +24,7 @@
 #include "pipeline/matcher/pair_matcher.hpp"
 #include "pipeline/core/georeference.hpp"
 #include "tools/eval/match_metrics.hpp"
+#include "tools/eval/survey_footprints.hpp"
 #include "tools/sim/simulated_survey.hpp"
 
 namespace {
@@ -93,23 +94,16 @@ int main(int argc, char** argv) {
     options = engine.pair;
   }
   const sss::matcher::DenseMatcher dense(options.dense);
-  sss::matcher::OverlapOptions overlap;
-  std::vector<const sss::core::Subframe*> full;
-  std::vector<sss::matcher::Footprint> footprints;
-  for (const auto& s : survey.subframes) {
-    if (s.rows() != 200) continue;
-    full.push_back(&s);
-    footprints.push_back(sss::matcher::computeFootprint(s, sss::core::drPoses(s), overlap));
-  }
+  const sss::matcher::OverlapOptions overlap;
+  const sss::eval::SurveyFootprints candidates = sss::eval::fullSubframeFootprints(survey, overlap);
+  const std::vector<const sss::core::Subframe*>& full = candidates.subframes;
+  const std::vector<sss::matcher::Footprint>& footprints = candidates.footprints;
 
   std::vector<double> seconds, georef, kd, init, patchmatch, consistency, pose, along_err, lateral_err;
   long accepted = 0, pairs = 0;
   using sss::eval::PairType;
   sss::eval::MatchEvaluation total, by_type[sss::eval::kPairTypes];
   long pairs_by_type[sss::eval::kPairTypes] = {0, 0, 0};
-  const auto headingOf = [](const sss::core::Subframe& s) {
-    return sss::core::eulerFromQuaternion(s.centre().T_world_body.rotation).heading_rad;
-  };
   for (size_t i = 0; i < full.size(); ++i) {
     for (size_t j = i + 1; j < full.size(); ++j) {
       const auto& a = *full[i];
@@ -117,7 +111,7 @@ int main(int argc, char** argv) {
       if (a.line_id == b.line_id) continue;
       const double area = sss::matcher::overlapAreaM2(footprints[i], footprints[j]);
       if (area < overlap.min_overlap_fraction * std::min(footprints[i].area_m2, footprints[j].area_m2)) continue;
-      const PairType type = sss::eval::classifyPair(headingOf(a), headingOf(b));
+      const PairType type = sss::eval::classifyPair(a, b);
       for (int k = 0; k < repeat; ++k) {
         const auto match = sss::matcher::matchPair(a, sss::core::drPoses(a), b, sss::sim::posesWithDrError(a, b, dr_along_m, dr_lateral_m), dense,
                                                    options);
