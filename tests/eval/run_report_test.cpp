@@ -326,8 +326,9 @@ TEST_F(RunReport, MissingOptionalInputsLeaveTheirSectionsOutWithNotes) {
   EXPECT_EQ(json["outcome"].as<std::string>(), "better");
 }
 
-// No /usr/bin/python3 (or no matplotlib): the whole report without its figures, one note naming the
-// cause and tools/setup-deps.sh, status ok (sss-report exits 0, as for any missing figure).
+// No /usr/bin/python3: the report without its figures and without index.html (both drawn by
+// Python), report.md with every table, one note naming the cause and tools/setup-deps.sh, status ok
+// (sss-report exits 0, as for any missing figure).
 TEST_F(RunReport, WithoutPythonTheReportIsWrittenWithoutFiguresAndOneNote) {
   RunReportRequest request;
   request.mission_dir = mission_dir_.string();
@@ -339,15 +340,40 @@ TEST_F(RunReport, WithoutPythonTheReportIsWrittenWithoutFiguresAndOneNote) {
   ASSERT_EQ(report.notes.size(), 1u);
   EXPECT_NE(report.notes[0].find(request.figures.python + " not found"), std::string::npos) << report.notes[0];
   EXPECT_NE(report.notes[0].find("tools/setup-deps.sh"), std::string::npos) << report.notes[0];
-  const std::string html = slurp(out_dir() / "index.html");
-  EXPECT_NE(html.find("tools/setup-deps.sh"), std::string::npos);  // the notes are on the page
-  EXPECT_NE(html.find("ATE horizontal RMSE"), std::string::npos);  // the tables are all there
+  // The page is drawn by Python too: report.md is the report, with the notes and every table.
+  EXPECT_FALSE(fs::exists(out_dir() / "index.html"));
+  EXPECT_EQ(report.index_html, (out_dir() / "report.md").string());
+  const std::string markdown = slurp(out_dir() / "report.md");
+  EXPECT_NE(markdown.find("tools/setup-deps.sh"), std::string::npos);  // the notes
+  EXPECT_NE(markdown.find("ATE horizontal RMSE"), std::string::npos);  // the tables are all there
   for (const std::string& figure : kFigures) {
-    EXPECT_EQ(html.find("<img src=\"" + figure + "\""), std::string::npos) << figure;
+    EXPECT_EQ(markdown.find("](" + figure + ")"), std::string::npos) << figure;
     EXPECT_FALSE(fs::exists(out_dir() / figure)) << figure;
   }
   EXPECT_TRUE(fs::exists(out_dir() / "metrics.json"));
-  EXPECT_TRUE(fs::exists(out_dir() / "report.md"));
+}
+
+// The page script missing (a broken install): the figures are drawn, report.md is the report and
+// one note says where the script was looked for.
+TEST_F(RunReport, WithoutThePageScriptTheFiguresAreDrawnAndReportMdIsTheReport) {
+  RunReportRequest request;
+  request.mission_dir = mission_dir_.string();
+  request.run_dir = run_dir().string();
+  request.out_dir = out_dir().string();
+  request.figures.page_script = (dir_ / "no-report_page.py").string();
+  const sss::eval::RunReport report = writeRunReport(request);
+  ASSERT_EQ(report.status, RunReportStatus::ok) << report.error;
+  ASSERT_EQ(report.notes.size(), 1u);
+  EXPECT_EQ(report.notes[0].rfind("index.html not written: the page script " + request.figures.page_script, 0), 0u)
+      << report.notes[0];
+  EXPECT_FALSE(fs::exists(out_dir() / "index.html"));
+  EXPECT_EQ(report.index_html, (out_dir() / "report.md").string());
+  const std::string markdown = slurp(out_dir() / "report.md");
+  EXPECT_NE(markdown.find("index.html not written: the page script"), std::string::npos);  // the note
+  for (const std::string& figure : kFigures) {
+    EXPECT_TRUE(fs::exists(out_dir() / figure)) << figure;
+    EXPECT_NE(markdown.find("](" + figure + ")"), std::string::npos) << figure;
+  }
 }
 
 TEST_F(RunReport, SaysPlainlyWhenSlamIsWorseThanDeadReckoning) {

@@ -51,32 +51,32 @@ std::string lastLine(const std::string& path) {
   return last;
 }
 
-// Runs python script data_dir out_dir with stdout and stderr into log_path; its exit status, or a
+// Runs `python script data_dir out_dir` with stdout and stderr into log_path; its exit status, or a
 // failure when it could not be started or did not exit normally.
-sss::core::Result<int> runScript(const FigureScriptOptions& options, const std::string& data_dir,
+sss::core::Result<int> runScript(const std::string& python, const std::string& script, const std::string& data_dir,
                                  const std::string& out_dir, const std::string& log_path) {
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
   posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  std::vector<std::string> args = {options.python, options.script, data_dir, out_dir};
+  std::vector<std::string> args = {python, script, data_dir, out_dir};
   std::vector<char*> argv;
   for (std::string& arg : args) argv.push_back(arg.data());
   argv.push_back(nullptr);
   pid_t pid = 0;
-  const int spawned = posix_spawn(&pid, options.python.c_str(), &actions, nullptr, argv.data(), environ);
+  const int spawned = posix_spawn(&pid, python.c_str(), &actions, nullptr, argv.data(), environ);
   posix_spawn_file_actions_destroy(&actions);
   if (spawned != 0) {
-    return sss::core::Status::error("cannot start " + options.python + ": " + std::strerror(spawned));
+    return sss::core::Status::error("cannot start " + python + ": " + std::strerror(spawned));
   }
   int status = 0;
   while (waitpid(pid, &status, 0) < 0) {
     if (errno != EINTR) {
-      return sss::core::Status::error("waiting for " + options.script + ": " + std::strerror(errno));
+      return sss::core::Status::error("waiting for " + script + ": " + std::strerror(errno));
     }
   }
   if (!WIFEXITED(status)) {
-    return sss::core::Status::error(options.script + " was killed by signal " +
+    return sss::core::Status::error(script + " was killed by signal " +
                                     std::to_string(WTERMSIG(status)));
   }
   return WEXITSTATUS(status);
@@ -104,6 +104,17 @@ std::string defaultFigureScript() {
   std::error_code ec;
   if (fs::is_regular_file(SSS_FIGURE_SCRIPT_SOURCE, ec)) return SSS_FIGURE_SCRIPT_SOURCE;
   return SSS_FIGURE_SCRIPT_INSTALLED;
+}
+
+std::string defaultPageScript() {
+  std::error_code ec;
+  if (fs::is_regular_file(SSS_PAGE_SCRIPT_SOURCE, ec)) return SSS_PAGE_SCRIPT_SOURCE;
+  return SSS_PAGE_SCRIPT_INSTALLED;
+}
+
+std::string pythonProblem(const FigureScriptOptions& options) {
+  if (access(options.python.c_str(), X_OK) == 0) return {};
+  return options.python + " not found; install python3 and python3-matplotlib with tools/setup-deps.sh";
 }
 
 std::string paletteColour(int index) { return "C" + std::to_string(((index % 10) + 10) % 10); }
@@ -195,12 +206,12 @@ FigureRun drawFigures(const FigureBatch& batch, const std::string& out_dir, cons
     out.close();
     if (!out) problem = "cannot write " + spec_path + "; check the folder is writable";
   }
-  if (problem.empty() && access(options.python.c_str(), X_OK) != 0) {
-    problem = options.python + " not found; install python3 and python3-matplotlib with tools/setup-deps.sh";
+  if (problem.empty() && !pythonProblem(options).empty()) {
+    problem = pythonProblem(options);
   } else if (problem.empty() && !fs::is_regular_file(options.script, ec)) {
     problem = "the figure script " + options.script + " is missing; run from the build tree or reinstall (cmake --install)";
   } else if (problem.empty()) {
-    const sss::core::Result<int> code = runScript(options, batch.data_dir, out_dir, log_path);
+    const sss::core::Result<int> code = runScript(options.python, options.script, batch.data_dir, out_dir, log_path);
     if (!code) {
       problem = code.message();
     } else if (*code == 3) {
@@ -225,6 +236,36 @@ FigureRun drawFigures(const FigureBatch& batch, const std::string& out_dir, cons
     run.problem = "figures not drawn (" + names + "): " + problem;
   }
   return run;
+}
+
+sss::core::Status drawPage(const Json& page, const std::string& data_dir, const std::string& out_dir,
+                           const FigureScriptOptions& options) {
+  std::error_code ec;
+  const fs::path html_path = fs::path(out_dir) / "index.html";
+  fs::remove(html_path, ec);  // what exists afterwards is what this run wrote
+  if (const std::string problem = pythonProblem(options); !problem.empty()) return sss::core::Status::error(problem);
+  if (!fs::is_regular_file(options.page_script, ec)) {
+    return sss::core::Status::error("the page script " + options.page_script +
+                                    " is missing; run from the build tree or reinstall (cmake --install)");
+  }
+  fs::create_directories(data_dir, ec);
+  const std::string page_path = (fs::path(data_dir) / "page.json").string();
+  const std::string log_path = (fs::path(data_dir) / "report_page.log").string();
+  std::ofstream out(page_path, std::ios::binary);
+  out << page.dump(1) << "\n";
+  out.close();
+  if (!out) return sss::core::Status::error("cannot write " + page_path + "; check the folder is writable");
+  const sss::core::Result<int> code = runScript(options.python, options.page_script, data_dir, out_dir, log_path);
+  if (!code) return code.status();
+  if (*code != 0) {
+    return sss::core::Status::error(options.page_script + " failed (exit " + std::to_string(*code) +
+                                    "): " + lastLine(log_path) + "; whole log in " + log_path);
+  }
+  if (!fs::is_regular_file(html_path, ec)) {
+    return sss::core::Status::error(options.page_script + " exited 0 without writing " + html_path.string() +
+                                    "; see " + log_path);
+  }
+  return sss::core::Status::success();
 }
 
 }  // namespace sss::eval

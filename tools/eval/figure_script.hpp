@@ -1,5 +1,6 @@
 // The evaluation figures (sss-report, sss-eval --plot) drawn by tools/eval/report_figures.py with
-// matplotlib: the C++ side describes each figure in DATA_DIR/figures.json, rasters as .npy beside it.
+// matplotlib: the C++ side describes each figure in DATA_DIR/figures.json, rasters as .npy beside it;
+// and sss-report's HTML page, written by tools/eval/report_page.py from DATA_DIR/page.json.
 #pragma once
 
 #include "tools/eval/heightmap_metrics.hpp"
@@ -18,11 +19,16 @@ namespace sss::eval {
 // The script next to this file in the source tree when it is there (a build tree), else the
 // installed copy (CMake bakes both paths in).
 std::string defaultFigureScript();
+std::string defaultPageScript();  // the same for report_page.py
 
 struct FigureScriptOptions {
   std::string python = "/usr/bin/python3";  // Debian's: the one that sees python3-matplotlib
   std::string script = defaultFigureScript();
+  std::string page_script = defaultPageScript();
 };
+
+// Empty when options.python can be run; else one line: what is missing and how to install it.
+std::string pythonProblem(const FigureScriptOptions& options);
 
 // Figures to draw, described one by one, then drawn all at once by drawFigures(). Rasters are
 // written into data_dir as they are added (so the report need not keep them).
@@ -68,5 +74,11 @@ struct FigureRun {
 // data_dir/report_figures.log). A missing interpreter, script or matplotlib, or a failing script
 // is reported in FigureRun::problem, never thrown: the report goes on without those figures.
 FigureRun drawFigures(const FigureBatch& batch, const std::string& out_dir, const FigureScriptOptions& options = {});
+
+// Writes data_dir/page.json and runs `python page_script data_dir out_dir`, which writes
+// out_dir/index.html from it (an old index.html is removed first). On failure one line: what went
+// wrong and what to do.
+sss::core::Status drawPage(const Json& page, const std::string& data_dir, const std::string& out_dir,
+                           const FigureScriptOptions& options = {});
 
 }  // namespace sss::eval

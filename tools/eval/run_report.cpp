@@ -356,7 +356,12 @@ RunReport writeRunReport(const RunReportRequest& request, const RunReportOptions
     heightmapFigures(context);
     productsSection(context);
     // Every figure in one run of the script (one interpreter start-up), then the pages.
-    dropUndrawnFigures(context, drawFigures(figures, request.out_dir, request.figures));
+    FigureRun drawn = drawFigures(figures, request.out_dir, request.figures);
+    const std::string python_problem = pythonProblem(request.figures);
+    if (!python_problem.empty()) {  // one note for the figures and the page
+      drawn.problem = "figures and index.html not drawn: " + python_problem + "; report.md and metrics.json have every table";
+    }
+    dropUndrawnFigures(context, drawn);
 
     const Table key = keyTable(report, options);
     const std::vector<Table> tables = metricTables(report, options);
@@ -372,11 +377,18 @@ RunReport writeRunReport(const RunReportRequest& request, const RunReportOptions
     const std::string html_path = joinPath(request.out_dir, "index.html");
     const std::string md_path = joinPath(request.out_dir, "report.md");
     const std::string json_path = joinPath(request.out_dir, "metrics.json");
-    // Files listed before they are written, so metrics.json lists itself and both pages.
-    for (const std::string& path : {html_path, md_path, json_path}) report.files.push_back(path);
-    report.index_html = html_path;
-    Status written = writeText(html_path, renderHtml(report, request, key, sections, tables, inputs));
-    if (written) written = writeText(md_path, renderMarkdown(report, request, key, sections, tables, inputs));
+    // The HTML page by report_page.py; without it report.md is the report.
+    const Status page = drawPage(pageJson(report, request, key, sections, tables, inputs), figures.data_dir,
+                                 request.out_dir, request.figures);
+    if (page) {
+      report.files.push_back(html_path);
+    } else if (python_problem.empty()) {
+      report.notes.push_back("index.html not written: " + page.message + "; report.md has the same content");
+    }
+    report.index_html = page ? html_path : md_path;
+    // Files listed before they are written, so metrics.json lists itself and report.md.
+    for (const std::string& path : {md_path, json_path}) report.files.push_back(path);
+    Status written = writeText(md_path, renderMarkdown(report, request, key, sections, tables, inputs));
     if (written) written = writeText(json_path, runReportJson(report, request));
     if (!written) return fail(RunReportStatus::write_failed, written.message);
   } catch (const std::bad_alloc&) {

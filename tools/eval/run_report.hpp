@@ -7,7 +7,9 @@
 // heightmap_dr.yaml, mosaic_dr.yaml / mosaic_slam.yaml (+ .png), summary.json. A missing or
 // unreadable optional input drops its section and adds a note; it never fails the report.
 // Figures: drawn by report_figures.py (matplotlib) from OUT_DIR/figure_data/ (figures.json + .npy);
-// without python3-matplotlib the report is written without them, with one note saying why.
+// the page, index.html, by report_page.py from OUT_DIR/figure_data/page.json. report.md (the same
+// content as Markdown) and metrics.json are written here. Without python3-matplotlib the report has
+// no figures, without python3 no index.html either; one note says why.
 //
 // metrics.json (schema "sss-report/1"; numbers that do not exist are null; stats = {"count",
 // "rmse", "mean", "median", "max"}; improvement = (DR - SLAM) / DR * 100, positive = SLAM better):
@@ -193,7 +195,7 @@ struct RunReport {
   RunSummary summary;
 
   std::vector<std::string> files;  // every file written, out_dir/NAME
-  std::string index_html;          // out_dir/index.html
+  std::string index_html;          // out_dir/index.html, or report.md when the page could not be drawn
 };
 
 // Reads every input, computes the metrics and writes the report. Never throws for bad input.

@@ -75,20 +75,6 @@ inline std::string count(double value) {
   return text;
 }
 
-inline std::string htmlEscape(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-
 inline std::string markdownEscape(const std::string& text) {
   std::string out;
   for (char c : text) {
@@ -98,7 +84,7 @@ inline std::string markdownEscape(const std::string& text) {
   return out;
 }
 
-// ---- tables shared by the HTML and the Markdown ------------------------------------------
+// ---- tables shared by the page and the Markdown -------------------------------------------
 
 // A table cell; tone marks improvement (+1, green) or deterioration (-1, red).
 struct Cell {
@@ -296,13 +282,14 @@ void heightmapFigures(FigureContext& context);
 std::vector<Table> metricTables(const RunReport& report, const RunReportOptions& options);
 Table keyTable(const RunReport& report, const RunReportOptions& options);
 
-// index.html and report.md (run_report_render.cpp).
-std::string renderHtml(const RunReport& report, const RunReportRequest& request, const Table& key,
-                       const std::vector<Section>& sections, const std::vector<Table>& tables,
-                       const std::vector<std::string>& inputs);
+// report.md, and the model of index.html (title, verdict, key table, notes, sections with their
+// figures and tables, metric tables, inputs) that report_page.py renders (run_report_render.cpp).
 std::string renderMarkdown(const RunReport& report, const RunReportRequest& request, const Table& key,
                            const std::vector<Section>& sections, const std::vector<Table>& tables,
                            const std::vector<std::string>& inputs);
+Json pageJson(const RunReport& report, const RunReportRequest& request, const Table& key,
+              const std::vector<Section>& sections, const std::vector<Table>& tables,
+              const std::vector<std::string>& inputs);
 sss::core::Status writeText(const std::string& path, const std::string& text);
 
 }  // namespace sss::eval::report_internal

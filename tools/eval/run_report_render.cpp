@@ -1,31 +1,10 @@
-// The per-run report as index.html and report.md. See run_report.hpp.
+// The per-run report as report.md, and the model of index.html that report_page.py renders. See
+// run_report.hpp.
 #include "tools/eval/run_report_internal.hpp"
 
 namespace sss::eval::report_internal {
 
-// ---- HTML and Markdown ---------------------------------------------------------------------
-
-std::string htmlTable(const Table& table) {
-  std::ostringstream out;
-  out << "<table>\n";
-  if (!table.caption.empty()) out << "<caption>" << htmlEscape(table.caption) << "</caption>\n";
-  out << "<tr>";
-  for (const std::string& h : table.header) out << "<th>" << htmlEscape(h) << "</th>";
-  out << "</tr>\n";
-  for (const auto& row : table.rows) {
-    out << "<tr>";
-    for (size_t c = 0; c < row.size(); ++c) {
-      const char* tone = row[c].tone > 0 ? " class=\"good\"" : row[c].tone < 0 ? " class=\"bad\"" : "";
-      const std::string span =
-          row[c].span > 1 ? " colspan=\"" + std::to_string(row[c].span) + "\" style=\"text-align:left\"" : "";
-      out << (c == 0 ? "<th scope=\"row\"" : "<td") << tone << span << ">" << htmlEscape(row[c].text)
-          << (c == 0 ? "</th>" : "</td>");
-    }
-    out << "</tr>\n";
-  }
-  out << "</table>\n";
-  return out.str();
-}
+// ---- Markdown and the page model --------------------------------------------------------------
 
 std::string markdownTable(const Table& table) {
   std::ostringstream out;
@@ -46,63 +25,50 @@ std::string markdownTable(const Table& table) {
   return out.str() + "\n";
 }
 
-const char* kCss =
-    "body{font-family:system-ui,-apple-system,'Segoe UI',Roboto,sans-serif;max-width:1240px;margin:1.5em auto;"
-    "padding:0 1em;color:#222;line-height:1.4}\n"
-    "h1{font-size:1.5em;margin-bottom:.3em}h2{font-size:1.2em;margin-top:1.8em;border-bottom:1px solid #ddd}\n"
-    ".verdict{font-size:1.15em;padding:.7em 1em;border-left:6px solid #888;background:#f4f4f4}\n"
-    ".verdict.better{border-color:#2a9d2a;background:#eaf6ea}.verdict.worse{border-color:#c62828;background:#fbeaea}\n"
-    "table{border-collapse:collapse;margin:.6em 0 1.2em}caption{text-align:left;font-weight:600;padding:.3em 0}\n"
-    "th,td{border:1px solid #ccc;padding:.25em .6em;text-align:right}th[scope=row]{text-align:left;font-weight:normal}\n"
-    "tr:first-child th{background:#f0f0f0}td.good{background:#dff2df}td.bad{background:#f8dcdc}\n"
-    "figure{margin:.5em 0 1.2em}figure img{max-width:100%;border:1px solid #ccc}figcaption{color:#555;font-size:.92em}\n"
-    ".row{display:flex;gap:1em;flex-wrap:wrap}.row figure{flex:1 1 45%}\n"
-    ".notes{background:#fff8e1;border:1px solid #f0d890;padding:.5em 1em}.small{color:#666;font-size:.9em}\n";
+namespace {
 
-std::string renderHtml(const RunReport& report, const RunReportRequest& request, const Table& key,
-                       const std::vector<Section>& sections, const std::vector<Table>& tables,
-                       const std::vector<std::string>& inputs) {
-  std::ostringstream out;
-  out << "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>" << htmlEscape(report.title)
-      << "</title>\n<style>\n" << kCss << "</style>\n</head>\n<body>\n";
-  out << "<h1>" << htmlEscape(report.title) << "</h1>\n";
-  out << "<p class=\"small\">mission " << htmlEscape(request.mission_dir) << " &middot; run " << htmlEscape(request.run_dir)
-      << "</p>\n";
-  out << "<p class=\"verdict " << report.outcome << "\">" << htmlEscape(report.verdict) << "</p>\n";
-  out << htmlTable(key);
-  if (!report.notes.empty()) {
-    out << "<div class=\"notes\"><strong>Notes</strong> (missing or unusable inputs; their sections are left out)\n<ul>\n";
-    for (const std::string& note : report.notes) out << "<li>" << htmlEscape(note) << "</li>\n";
-    out << "</ul></div>\n";
+Json tableJson(const Table& table) {
+  Json rows = Json::array();
+  for (const auto& row : table.rows) {
+    Json cells = Json::array();
+    for (const Cell& cell : row) cells.push_back({{"text", cell.text}, {"tone", cell.tone}, {"span", cell.span}});
+    rows.push_back(std::move(cells));
   }
+  return {{"caption", table.caption}, {"header", table.header}, {"rows", std::move(rows)}};
+}
+
+}  // namespace
+
+Json pageJson(const RunReport& report, const RunReportRequest& request, const Table& key,
+              const std::vector<Section>& sections, const std::vector<Table>& tables,
+              const std::vector<std::string>& inputs) {
+  Json page = Json::object();
+  page["schema"] = "sss-report-page/1";
+  page["title"] = report.title;
+  page["mission_dir"] = request.mission_dir;
+  page["run_dir"] = request.run_dir;
+  page["outcome"] = report.outcome;
+  page["verdict"] = report.verdict;
+  page["key"] = tableJson(key);
+  page["notes"] = report.notes;
+  Json section_list = Json::array();
   for (const Section& section : sections) {
-    out << "<h2>" << htmlEscape(section.heading) << "</h2>\n";
-    if (!section.text.empty()) out << "<p>" << htmlEscape(section.text) << "</p>\n";
-    std::string open_row;
-    for (size_t i = 0; i < section.figures.size(); ++i) {
-      const Figure& f = section.figures[i];
-      const bool grouped = !f.section.empty();
-      const bool starts = grouped && (i == 0 || section.figures[i - 1].section != f.section);
-      const bool ends = grouped && (i + 1 == section.figures.size() || section.figures[i + 1].section != f.section);
-      if (starts) out << "<div class=\"row\">\n";
-      out << "<figure><img src=\"" << htmlEscape(f.file) << "\" alt=\"" << htmlEscape(f.alt) << "\"><figcaption>"
-          << htmlEscape(f.caption) << "</figcaption></figure>\n";
-      if (ends) out << "</div>\n";
+    Json figures = Json::array(), section_tables = Json::array();
+    for (const Figure& f : section.figures) {
+      figures.push_back({{"group", f.section}, {"file", f.file}, {"alt", f.alt}, {"caption", f.caption}});
     }
-    for (const Table& table : section.tables) out << htmlTable(table);
+    for (const Table& table : section.tables) section_tables.push_back(tableJson(table));
+    section_list.push_back({{"heading", section.heading},
+                            {"text", section.text},
+                            {"figures", std::move(figures)},
+                            {"tables", std::move(section_tables)}});
   }
-  out << "<h2>7. Metrics</h2>\n";
-  out << "<p class=\"small\">improvement = (DR - SLAM) / DR; green: SLAM better, red: SLAM worse. ATE: absolute "
-         "trajectory error against the truth at the same time stamps; SE(3)-aligned: after the best rigid alignment "
-         "of the whole trajectory; gauge-free: after the best horizontal rotation and scale about the estimate's first "
-         "position, without a shift (what a constant heading bias and a DVL scale factor do, which no loop closure "
-         "sees). RPE: relative pose error over the given path length.</p>\n";
-  for (const Table& table : tables) out << htmlTable(table);
-  out << "<h2>Inputs</h2>\n<ul class=\"small\">\n";
-  for (const std::string& input : inputs) out << "<li>" << htmlEscape(input) << "</li>\n";
-  out << "</ul>\n<p class=\"small\">Written by sss-report (machine-readable: <a href=\"metrics.json\">metrics.json</a>).</p>\n";
-  out << "</body>\n</html>\n";
-  return out.str();
+  page["sections"] = std::move(section_list);
+  Json metric_tables = Json::array();
+  for (const Table& table : tables) metric_tables.push_back(tableJson(table));
+  page["metric_tables"] = std::move(metric_tables);
+  page["inputs"] = inputs;
+  return page;
 }
 
 std::string renderMarkdown(const RunReport& report, const RunReportRequest& request, const Table& key,
