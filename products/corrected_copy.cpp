@@ -74,7 +74,7 @@ Status writeCorrectedJsf(const std::string& in_path, const std::string& out_path
   sss::edgetech::JsfMessage message;
   while (reader.next(message)) {
     if (message.header.message_type != sss::edgetech::kJsfSonarData) continue;
-    const sss::core::Result<sss::edgetech::SonarChannelRecord> decoded =
+    const sss::core::Result<sss::sonar::SonarChannelRecord> decoded =
         sss::edgetech::decodeSonarData(message.header, message.body.data(), message.body.size());
     const std::optional<PingNavigation> nav =
         decoded.ok() ? navigation(decoded->ping_time_us) : std::nullopt;
@@ -82,7 +82,7 @@ Status writeCorrectedJsf(const std::string& in_path, const std::string& out_path
       ++counters.records_without_pose;
       continue;
     }
-    sss::edgetech::SonarChannelRecord record = *decoded;
+    sss::sonar::SonarChannelRecord record = *decoded;
     record.projected_position = nav->projected;
     record.latitude_deg = nav->latitude_deg;
     record.longitude_deg = nav->longitude_deg;
@@ -94,8 +94,8 @@ Status writeCorrectedJsf(const std::string& in_path, const std::string& out_path
     record.roll_rad = nav->roll_rad;
     // The original validity bits (the decoder may have cleared some), with the fields now written.
     uint16_t validity = static_cast<uint16_t>(message.body[30] | (message.body[31] << 8));
-    validity |= sss::edgetech::kValidHeading | sss::edgetech::kValidDepth | sss::edgetech::kValidPitchRoll;
-    if (!nav->projected) validity |= sss::edgetech::kValidLatLon;
+    validity |= sss::sonar::kValidHeading | sss::sonar::kValidDepth | sss::sonar::kValidPitchRoll;
+    if (!nav->projected) validity |= sss::sonar::kValidLatLon;
     record.validity = validity;
     std::vector<uint8_t> header(message.body.begin(), message.body.begin() + sss::edgetech::kSonarDataHeaderSize);
     sss::edgetech::encodeSonarNavigation(record, header.data());
@@ -119,7 +119,7 @@ Status writeCorrectedXtf(const std::string& in_path, const std::string& out_path
   sss::core::Result<File> copy = copyForUpdate(in_path, out_path);
   if (!copy) return copy.status();
   File out = std::move(*copy);
-  sss::edgetech::DriverPing ping;
+  sss::sonar::DriverPing ping;
   std::vector<uint8_t> header(sss::xtf::kPingHeaderBytes);
   while (reader.next(ping)) {
     const std::optional<PingNavigation> nav = navigation(ping.utime_us);

@@ -46,11 +46,6 @@ int16_t clampToInt16(double value) {
 
 }  // namespace
 
-double SonarChannelRecord::slantRangeM(size_t sample_index) const {
-  return (static_cast<double>(start_depth_samples) + static_cast<double>(sample_index)) * sample_interval_s *
-         static_cast<double>(sound_speed_m_s) * 0.5;
-}
-
 std::vector<uint16_t> quantiseEnvelope(const std::vector<float>& magnitudes, int16_t& weighting_factor) {
   float largest = 0.0f;
   for (float m : magnitudes) {

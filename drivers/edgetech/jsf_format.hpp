@@ -10,9 +10,27 @@
 #include <string>
 #include <vector>
 
+#include "drivers/sonar/sonar_ping.hpp"
 #include "pipeline/core/status.hpp"
 
 namespace sss::edgetech {
+
+// Type 80 messages decode into the ping every sonar reader hands on (drivers/sonar/sonar_ping.hpp):
+// one SonarChannelRecord per message, its subsystem, channel and validity bits JSF's own.
+using sss::sonar::kChannelPort;
+using sss::sonar::kChannelStarboard;
+using sss::sonar::kSubsystemSideScanHigh;
+using sss::sonar::kSubsystemSideScanLow;
+using sss::sonar::kValidAltitude;
+using sss::sonar::kValidCourse;
+using sss::sonar::kValidDepth;
+using sss::sonar::kValidHeading;
+using sss::sonar::kValidLatLon;
+using sss::sonar::kValidPitchRoll;
+using sss::sonar::kValidPressure;
+using sss::sonar::kValidSoundSpeed;
+using sss::sonar::kValidSpeed;
+using sss::sonar::SonarChannelRecord;
 
 constexpr uint16_t kJsfStartMarker = 0x1601;
 constexpr size_t kJsfHeaderSize = 16;
@@ -31,12 +49,6 @@ enum JsfMessageType : uint16_t {
   kJsfSituation2 = 2091,
 };
 
-// Side-scan subsystems and channels.
-constexpr uint8_t kSubsystemSideScanLow = 20;
-constexpr uint8_t kSubsystemSideScanHigh = 21;
-constexpr uint8_t kChannelPort = 0;
-constexpr uint8_t kChannelStarboard = 1;
-
 struct JsfMessageHeader {
   uint8_t protocol_version = 0x0D;
   uint8_t session_id = 0;
@@ -46,49 +58,6 @@ struct JsfMessageHeader {
   uint8_t channel = kChannelPort;
   uint8_t sequence = 0;
   int32_t byte_count = 0;  // body bytes after the header
-};
-
-// Validity bits of the sonar data header (offset 30).
-constexpr uint16_t kValidLatLon = 1u << 0;
-constexpr uint16_t kValidCourse = 1u << 1;
-constexpr uint16_t kValidSpeed = 1u << 2;
-constexpr uint16_t kValidHeading = 1u << 3;
-constexpr uint16_t kValidPressure = 1u << 4;
-constexpr uint16_t kValidPitchRoll = 1u << 5;
-constexpr uint16_t kValidAltitude = 1u << 6;
-constexpr uint16_t kValidDepth = 1u << 9;
-constexpr uint16_t kValidSoundSpeed = 1u << 14;
-
-// One type 80 message: one channel (port or starboard) of one ping.
-struct SonarChannelRecord {
-  uint8_t subsystem = kSubsystemSideScanLow;
-  uint8_t channel = kChannelPort;
-  int64_t ping_time_us = 0;        // seconds (offset 0) + milliseconds (offset 200), sonar clock
-  uint32_t ping_number = 0;
-  uint32_t start_depth_samples = 0;  // window offset: sample 0 is at this many samples of range
-  double sample_interval_s = 0.0;  // stored in ns (offset 116)
-  float sound_speed_m_s = 1500.0f;
-  float start_frequency_hz = 0.0f;  // stored in units of 10 Hz
-  float end_frequency_hz = 0.0f;
-  uint16_t data_format = 0;        // 0 envelope u16, 1 analytic I/Q (2 x i16)
-  int16_t weighting_factor = 0;    // samples are scaled by 2^-N
-  uint16_t validity = 0;           // kValid* bits
-  double latitude_deg = 0.0;       // stored as minutes of arc x 10000 (coordinate units 2)
-  double longitude_deg = 0.0;
-  // A position in projected metres instead (XTF NavUnits 0: the file's grid, its CRS not
-  // recorded); JSF never sets it.
-  bool projected_position = false;
-  double easting_m = 0.0;
-  double northing_m = 0.0;
-  double depth_m = 0.0;            // stored in mm
-  double altitude_m = 0.0;         // stored in mm
-  double heading_rad = 0.0;        // stored in 0.01 degree, [0, 360)
-  double pitch_rad = 0.0;          // bow up positive, stored x 180/32768 degree
-  double roll_rad = 0.0;           // port up positive
-  std::vector<float> samples;      // envelope magnitude, 2^-N applied (I/Q: sqrt(I^2 + Q^2))
-
-  // Slant range of sample i: (start_depth_samples + i) * sample_interval_s * c / 2.
-  double slantRangeM(size_t sample_index) const;
 };
 
 // Quantises magnitudes to the u16 envelope codes a sonar would send, choosing the weighting
@@ -109,6 +78,10 @@ void encodeSonarNavigation(const SonarChannelRecord& record, uint8_t* body);
 std::optional<JsfMessageHeader> decodeHeader(const uint8_t* bytes);
 void encodeHeader(const JsfMessageHeader& header, uint8_t* bytes);
 
+// On the wire a type 80 header stores the ping time as seconds (offset 0) + milliseconds (200),
+// the sample interval in ns (116), frequencies in 10 Hz, the position in minutes of arc x 10000
+// (coordinate units 2) or mm (1), depth and altitude in mm, heading in 0.01 degree, pitch and roll
+// in 180/32768 degree; SonarChannelRecord holds them in plain units.
 // Decodes a type 80 body (everything after the 16-byte header). Fails with the reason when the
 // body is too short for its header or its samples, or the data format is unknown.
 sss::core::Result<SonarChannelRecord> decodeSonarData(const JsfMessageHeader& header, const uint8_t* body,

@@ -12,15 +12,7 @@
 
 namespace sss::edgetech {
 
-struct AssembledPing {
-  uint32_t ping_number = 0;
-  std::optional<SonarChannelRecord> port;
-  std::optional<SonarChannelRecord> starboard;
-  int64_t last_arrival_us = 0;  // monotonic arrival of the last channel (latency reference)
-  bool complete() const { return port && starboard; }
-  // The sonar's ping time (both sides carry the same one).
-  int64_t pingTimeUs() const { return port ? port->ping_time_us : starboard->ping_time_us; }
-};
+using sss::sonar::AssembledPing;  // drivers/sonar/sonar_ping.hpp
 
 struct PingAssemblerOptions {
   uint8_t subsystem = kSubsystemSideScanLow;  // the side-scan frequency to use; others are ignored

@@ -29,11 +29,7 @@ struct SonarDriverOptions {
   TimeSource time_source = TimeSource::kEstimateOffset;
 };
 
-struct DriverPing {
-  AssembledPing ping;
-  int64_t utime_us = 0;     // ping time in the vehicle's time base
-  int64_t sonar_utime_us = 0;
-};
+using sss::sonar::DriverPing;  // drivers/sonar/sonar_ping.hpp: what the driver hands out
 
 // Where raw JSF from the sonar is recorded: the configured directory; when that is empty,
 // systemd's LogsDirectory= as passed in $LOGS_DIRECTORY (its first entry: systemd joins several

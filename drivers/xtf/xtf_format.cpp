@@ -8,8 +8,8 @@
 
 namespace sss::xtf {
 
-using sss::edgetech::DriverPing;
-using sss::edgetech::SonarChannelRecord;
+using sss::sonar::DriverPing;
+using sss::sonar::SonarChannelRecord;
 
 namespace {
 
@@ -333,10 +333,10 @@ SonarDecodeResult decodeSonarPacket(const XtfFileInfo& info, const SonarDecodeOp
   const float stored_speed = readF32(p, offset::kSoundVelocity);
   if (stored_speed >= 600.0f && stored_speed <= 900.0f) {
     common.sound_speed_m_s = 2.0f * stored_speed;
-    common.validity |= sss::edgetech::kValidSoundSpeed;
+    common.validity |= sss::sonar::kValidSoundSpeed;
   } else if (stored_speed >= 1300.0f && stored_speed <= 1700.0f) {
     common.sound_speed_m_s = stored_speed;
-    common.validity |= sss::edgetech::kValidSoundSpeed;
+    common.validity |= sss::sonar::kValidSoundSpeed;
   } else {
     common.sound_speed_m_s = options.fallback_sound_speed_m_s;
     result.sound_speed_fallback = true;
@@ -357,7 +357,7 @@ SonarDecodeResult decodeSonarPacket(const XtfFileInfo& info, const SonarDecodeOp
       std::fabs(sensor_y) <= 90.0 && std::fabs(sensor_x) <= 180.0 && !(sensor_y == 0.0 && sensor_x == 0.0)) {
     common.latitude_deg = sensor_y;
     common.longitude_deg = sensor_x;
-    common.validity |= sss::edgetech::kValidLatLon;
+    common.validity |= sss::sonar::kValidLatLon;
   } else if (info.nav_units == kNavUnitsMetres && std::isfinite(sensor_y) && std::isfinite(sensor_x) &&
              !(sensor_y == 0.0 && sensor_x == 0.0) && std::fabs(sensor_y) < 1e8 && std::fabs(sensor_x) < 1e8) {
     common.projected_position = true;
@@ -367,12 +367,12 @@ SonarDecodeResult decodeSonarPacket(const XtfFileInfo& info, const SonarDecodeOp
   const float depth_m = readF32(p, offset::kSensorDepth);
   if (std::isfinite(depth_m)) {
     common.depth_m = depth_m;
-    common.validity |= sss::edgetech::kValidDepth;
+    common.validity |= sss::sonar::kValidDepth;
   }
   const float altitude_m = readF32(p, offset::kSensorPrimaryAltitude);
   if (std::isfinite(altitude_m) && altitude_m > 0.0f) {  // 0 is "no altitude" in practice
     common.altitude_m = altitude_m;
-    common.validity |= sss::edgetech::kValidAltitude;
+    common.validity |= sss::sonar::kValidAltitude;
   }
   // XTF: pitch positive nose up, roll positive to starboard (starboard down), heading degrees
   // clockwise from north: the same senses as ours, only units change.
@@ -382,14 +382,14 @@ SonarDecodeResult decodeSonarPacket(const XtfFileInfo& info, const SonarDecodeOp
       std::fabs(roll_deg) <= 180.0f) {
     common.pitch_rad = pitch_deg * kDegToRad;
     common.roll_rad = roll_deg * kDegToRad;
-    common.validity |= sss::edgetech::kValidPitchRoll;
+    common.validity |= sss::sonar::kValidPitchRoll;
   }
   const float heading_deg = readF32(p, offset::kSensorHeading);
   if (std::isfinite(heading_deg) && std::fabs(heading_deg) <= 720.0f) {
     double wrapped = std::fmod(static_cast<double>(heading_deg), 360.0);
     if (wrapped < 0.0) wrapped += 360.0;
     common.heading_rad = wrapped * kDegToRad;
-    common.validity |= sss::edgetech::kValidHeading;
+    common.validity |= sss::sonar::kValidHeading;
   }
 
   DriverPing out;
@@ -437,7 +437,7 @@ SonarDecodeResult decodeSonarPacket(const XtfFileInfo& info, const SonarDecodeOp
         return result;
       }
       SonarChannelRecord record = common;
-      record.channel = is_port ? sss::edgetech::kChannelPort : sss::edgetech::kChannelStarboard;
+      record.channel = is_port ? sss::sonar::kChannelPort : sss::sonar::kChannelStarboard;
       record.start_frequency_hz = record.end_frequency_hz = frequencyHz(channel.frequency);
       // Sample spacing from the recorded slant range (range = i x SlantRange / NumSamples), or
       // else from the two-way TimeDuration; stored as two-way time so slantRangeM() agrees.

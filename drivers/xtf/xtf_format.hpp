@@ -46,7 +46,7 @@
 #include <string>
 #include <vector>
 
-#include "drivers/edgetech/sonar_driver.hpp"
+#include "drivers/sonar/sonar_ping.hpp"
 #include "pipeline/core/status.hpp"
 
 namespace sss::xtf {
@@ -185,13 +185,13 @@ std::optional<PacketHeader> decodePacketHeader(const uint8_t* bytes);
 struct SonarDecodeOptions {
   int port_channel = -1;       // CHANINFO indices to extract (from sideScanPairs)
   int starboard_channel = -1;
-  uint8_t subsystem = sss::edgetech::kSubsystemSideScanLow;  // stamped on the records
+  uint8_t subsystem = sss::sonar::kSubsystemSideScanLow;  // stamped on the records
   float fallback_sound_speed_m_s = 1500.0f;
   bool polar_as_signed = false;  // UniPolar = 0 channels carry signed samples (magnitude taken)
 };
 
 struct SonarDecodeResult {
-  std::optional<sss::edgetech::DriverPing> ping;  // empty on error or when no chosen channel
+  std::optional<sss::sonar::DriverPing> ping;  // empty on error or when no chosen channel
   std::string error;
   bool no_selected_channel = false;  // valid packet without the chosen port or starboard
   bool sound_speed_fallback = false; // SoundVelocity unusable: the fallback was used

@@ -103,7 +103,7 @@ void XtfReader::openWith() {
   }
   decode_.port_channel = pair_.port;
   decode_.starboard_channel = pair_.starboard;
-  decode_.subsystem = static_cast<uint8_t>(sss::edgetech::kSubsystemSideScanLow + std::min(options_.pair_index, 1));
+  decode_.subsystem = static_cast<uint8_t>(sss::sonar::kSubsystemSideScanLow + std::min(options_.pair_index, 1));
   decode_.fallback_sound_speed_m_s = options_.fallback_sound_speed_m_s;
   decode_.polar_as_signed = options_.polar_as_signed;
   consume(std::min(info_.header_bytes, buffer_.size() - start_));
@@ -155,7 +155,7 @@ std::vector<XtfNavigationRecord> XtfReader::takeNavigation() {
   return records;
 }
 
-bool XtfReader::next(sss::edgetech::DriverPing& ping) {
+bool XtfReader::next(sss::sonar::DriverPing& ping) {
   if (!open_) return false;
   while (true) {
     if (!ensure(kPacketStartBytes)) {

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "drivers/edgetech/sonar_driver.hpp"
+#include "drivers/sonar/sonar_ping.hpp"
 #include "drivers/xtf/xtf_format.hpp"
 
 namespace sss::xtf {
@@ -63,7 +63,7 @@ class XtfReader {
   const ChannelPair& pair() const { return pair_; }
 
   // The next sonar ping; false at the end of the data.
-  bool next(sss::edgetech::DriverPing& ping);
+  bool next(sss::sonar::DriverPing& ping);
   // Byte offset in the file of the sonar packet the last next() gave (to patch it in a copy).
   uint64_t lastPingOffset() const { return last_ping_offset_; }
   // The navigation packets (types 3, 42, 107) read since the last call, in file order: those

@@ -8,9 +8,9 @@
 
 namespace sss::test {
 
-inline edgetech::SonarChannelRecord makeRecord(uint32_t ping_number, uint8_t channel) {
-  edgetech::SonarChannelRecord r;
-  r.subsystem = edgetech::kSubsystemSideScanLow;
+inline sonar::SonarChannelRecord makeRecord(uint32_t ping_number, uint8_t channel) {
+  sonar::SonarChannelRecord r;
+  r.subsystem = sonar::kSubsystemSideScanLow;
   r.channel = channel;
   r.ping_time_us = 1780300800123000LL + static_cast<int64_t>(ping_number) * 250000;  // 2026-06-01T08:00:00.123Z
   r.ping_number = ping_number;
@@ -19,8 +19,8 @@ inline edgetech::SonarChannelRecord makeRecord(uint32_t ping_number, uint8_t cha
   r.sound_speed_m_s = 1500.0f;
   r.start_frequency_hz = 390000.0f;
   r.end_frequency_hz = 420000.0f;
-  r.validity = edgetech::kValidLatLon | edgetech::kValidHeading | edgetech::kValidPitchRoll | edgetech::kValidAltitude |
-               edgetech::kValidDepth;
+  r.validity = sonar::kValidLatLon | sonar::kValidHeading | sonar::kValidPitchRoll | sonar::kValidAltitude |
+               sonar::kValidDepth;
   r.latitude_deg = 59.351234;
   r.longitude_deg = 18.071234;
   r.depth_m = 42.125;
@@ -37,7 +37,7 @@ inline std::vector<float> makeMagnitudes(size_t count, uint32_t seed) {
   return magnitudes;
 }
 
-inline std::vector<uint8_t> encodeRecord(edgetech::SonarChannelRecord record, size_t samples) {
+inline std::vector<uint8_t> encodeRecord(sonar::SonarChannelRecord record, size_t samples) {
   const std::vector<uint16_t> codes = edgetech::quantiseEnvelope(makeMagnitudes(samples, record.ping_number), record.weighting_factor);
   return edgetech::encodeSonarData(record, codes);
 }
@@ -46,7 +46,7 @@ inline std::vector<uint8_t> encodeRecord(edgetech::SonarChannelRecord record, si
 inline std::vector<std::vector<uint8_t>> makeMessages(int pings, size_t samples = 500) {
   std::vector<std::vector<uint8_t>> messages;
   for (int p = 0; p < pings; ++p) {
-    for (uint8_t channel : {edgetech::kChannelPort, edgetech::kChannelStarboard}) {
+    for (uint8_t channel : {sonar::kChannelPort, sonar::kChannelStarboard}) {
       messages.push_back(encodeRecord(makeRecord(static_cast<uint32_t>(1000 + p), channel), samples + static_cast<size_t>(p)));
     }
   }

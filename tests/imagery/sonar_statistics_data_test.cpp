@@ -72,7 +72,7 @@ TEST(SonarStatisticsData, RealIver2FileMatchesItsDescription) {
   xtf::XtfReader reader(path);
   ASSERT_TRUE(reader.isOpen()) << reader.error();
   std::vector<StatisticsPing> pings;
-  edgetech::DriverPing driver_ping;
+  sonar::DriverPing driver_ping;
   while (reader.next(driver_ping)) {
     const auto& ping = driver_ping.ping;
     ASSERT_TRUE(ping.port && ping.starboard);

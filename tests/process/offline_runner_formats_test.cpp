@@ -105,7 +105,7 @@ TEST_F(OfflineRunnerTest, XtfInProjectedMetresWithoutAltitudeIsProcessedInItsGri
     for (const auto& p : corrected_slam.poses) slam_at[p.utime_us] = p.T_world_body.translation;
     sss::xtf::XtfReader reader(products.corrected_dir + "/projected.xtf");
     ASSERT_TRUE(reader.isOpen()) << reader.error();
-    sss::edgetech::DriverPing ping;
+    sss::sonar::DriverPing ping;
     size_t compared = 0;
     double worst_m = 0.0;
     while (reader.next(ping)) {
@@ -276,13 +276,13 @@ TEST_F(OfflineRunnerTest, JsfSituationOrNmeaMessagesPositionPingsWithoutPosition
       sss::edgetech::encodeHeader(header, header_bytes);
       out.write(reinterpret_cast<const char*>(header_bytes), 16);
       out.write(reinterpret_cast<const char*>(body.data()), static_cast<std::streamsize>(body.size()));
-      for (uint8_t channel : {sss::edgetech::kChannelPort, sss::edgetech::kChannelStarboard}) {
-        sss::edgetech::SonarChannelRecord record;
+      for (uint8_t channel : {sss::sonar::kChannelPort, sss::sonar::kChannelStarboard}) {
+        sss::sonar::SonarChannelRecord record;
         record.channel = channel;
         record.ping_time_us = utime_us;
         record.ping_number = static_cast<uint32_t>(i);
         record.sample_interval_s = 4e-5;  // 3 cm
-        record.validity = sss::edgetech::kValidHeading | sss::edgetech::kValidSoundSpeed;  // no position, no altitude
+        record.validity = sss::sonar::kValidHeading | sss::sonar::kValidSoundSpeed;  // no position, no altitude
         record.heading_rad = heading_rad;
         std::vector<float> magnitudes;
         for (int k = 0; k < 2500; ++k) {

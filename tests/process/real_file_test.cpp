@@ -55,7 +55,7 @@ FileFacts readFacts() {
   sss::xtf::XtfReader reader(kRealFile);
   EXPECT_TRUE(reader.isOpen()) << reader.error();
   sss::subframe::BottomTracker tracker;
-  sss::edgetech::DriverPing ping;
+  sss::sonar::DriverPing ping;
   while (reader.next(ping)) {
     ++facts.pings;
     const auto& side = ping.ping.port ? *ping.ping.port : *ping.ping.starboard;
@@ -207,7 +207,7 @@ TEST(RealFile, GeoTiffsInItsUtmZoneAndACorrectedCopyThatReadsBackAsSlam) {
   for (const auto& pose : slam.poses) slam_at[pose.utime_us] = pose.T_world_body.translation;
   sss::xtf::XtfReader reader(copy);
   ASSERT_TRUE(reader.isOpen()) << reader.error();
-  sss::edgetech::DriverPing ping;
+  sss::sonar::DriverPing ping;
   std::vector<uint64_t> offsets;
   size_t compared = 0;
   double worst_m = 0.0;

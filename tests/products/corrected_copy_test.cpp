@@ -71,13 +71,13 @@ TEST_F(CorrectedCopyTest, JsfPingsCarryTheNewNavigationAndNothingElseChanges) {
   std::vector<uint8_t> file;
   std::vector<size_t> sonar_offsets;  // of each type 80 message
   for (int i = 0; i < 20; ++i) {
-    for (uint8_t channel : {sss::edgetech::kChannelPort, sss::edgetech::kChannelStarboard}) {
-      sss::edgetech::SonarChannelRecord record;
+    for (uint8_t channel : {sss::sonar::kChannelPort, sss::sonar::kChannelStarboard}) {
+      sss::sonar::SonarChannelRecord record;
       record.channel = channel;
       record.ping_number = static_cast<uint32_t>(i);
       record.ping_time_us = kStartUs + i * 250000LL;
       record.sample_interval_s = 2e-5;
-      record.validity = sss::edgetech::kValidLatLon | sss::edgetech::kValidAltitude;
+      record.validity = sss::sonar::kValidLatLon | sss::sonar::kValidAltitude;
       record.latitude_deg = 59.35 + i * 2.5e-6;
       record.longitude_deg = 18.07;
       record.depth_m = 30.0;
@@ -130,8 +130,8 @@ TEST_F(CorrectedCopyTest, JsfPingsCarryTheNewNavigationAndNothingElseChanges) {
     EXPECT_NEAR(r.pitch_rad, want.pitch_rad, 0.5 * 180.0 / 32768.0 * kDegToRad + 1e-9);
     EXPECT_NEAR(r.roll_rad, want.roll_rad, 0.5 * 180.0 / 32768.0 * kDegToRad + 1e-9);
     EXPECT_NEAR(r.altitude_m, 15.0, 1e-9) << "the altitude is the sonar's own measurement: kept";
-    EXPECT_TRUE(r.validity & sss::edgetech::kValidHeading);
-    EXPECT_TRUE(r.validity & sss::edgetech::kValidAltitude) << "validity bits are added, never cleared";
+    EXPECT_TRUE(r.validity & sss::sonar::kValidHeading);
+    EXPECT_TRUE(r.validity & sss::sonar::kValidAltitude) << "validity bits are added, never cleared";
   }
   EXPECT_EQ(pings, 40);
 
@@ -193,7 +193,7 @@ TEST_F(CorrectedCopyTest, XtfPingsInProjectedMetresCarryTheNewGridPosition) {
 
   sss::xtf::XtfReader reader(out);
   ASSERT_TRUE(reader.isOpen()) << reader.error();
-  sss::edgetech::DriverPing ping;
+  sss::sonar::DriverPing ping;
   int pings = 0;
   while (reader.next(ping)) {
     ++pings;

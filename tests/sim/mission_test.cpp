@@ -103,10 +103,10 @@ TEST(Mission, JsfSonarDataFieldsAtExactOffsets) {
     const std::optional<edgetech::JsfMessageHeader> header =
         edgetech::decodeHeader(reinterpret_cast<const uint8_t*>(bytes.data() + base));
     ASSERT_TRUE(header.has_value());
-    const sss::core::Result<edgetech::SonarChannelRecord> decoded =
+    const sss::core::Result<sonar::SonarChannelRecord> decoded =
         edgetech::decodeSonarData(*header, reinterpret_cast<const uint8_t*>(bytes.data() + h), message_size - 16);
     ASSERT_OK(decoded);
-    const edgetech::SonarChannelRecord& record = *decoded;
+    const sonar::SonarChannelRecord& record = *decoded;
     EXPECT_EQ(record.ping_number, ping);
     EXPECT_EQ(record.channel, channel);
     EXPECT_EQ(record.ping_time_us / 1000, utime / 1000);  // JSF carries milliseconds

@@ -163,10 +163,10 @@ TEST(XtfFormat, SoundVelocityHalfOrFullGivesTheSameRanges) {
   for (const float stored : {750.0f, 1500.0f}) {
     const xtf::SonarDecodeResult result = decodeOne(stored, 75.0f, 0.0f);
     ASSERT_TRUE(result.ping) << result.error;
-    const edgetech::SonarChannelRecord& port = *result.ping->ping.port;
+    const sonar::SonarChannelRecord& port = *result.ping->ping.port;
     EXPECT_FLOAT_EQ(port.sound_speed_m_s, 1500.0f);
     EXPECT_NEAR(port.slantRangeM(99), 75.0 * 99 / 100, 1e-9);
-    EXPECT_TRUE(port.validity & edgetech::kValidSoundSpeed);
+    EXPECT_TRUE(port.validity & sonar::kValidSoundSpeed);
   }
   const xtf::SonarDecodeResult odd = decodeOne(0.0f, 75.0f, 0.0f);
   ASSERT_TRUE(odd.ping);

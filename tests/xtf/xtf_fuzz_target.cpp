@@ -18,7 +18,7 @@ int fuzzXtf(const uint8_t* data, size_t size) {
   XtfReader reader(data, size, options);
   if (!reader.isOpen()) return 0;
   int pings = 0;
-  sss::edgetech::DriverPing ping;
+  sss::sonar::DriverPing ping;
   while (reader.next(ping)) {
     ++pings;
     if (!ping.ping.port && !ping.ping.starboard) std::abort();

@@ -16,7 +16,7 @@
 namespace sss {
 namespace {
 
-using edgetech::DriverPing;
+using sonar::DriverPing;
 
 std::vector<DriverPing> readAll(xtf::XtfReader& reader) {
   std::vector<DriverPing> pings;
@@ -48,10 +48,10 @@ TEST(XtfReader, RoundTripTwoChannelSixteenBitDegreesFromFile) {
     EXPECT_EQ(ping.ping.ping_number, p);
     EXPECT_EQ(ping.utime_us, test::kXtfFirstPingUs + test::kXtfPingPeriodUs * p);
     EXPECT_EQ(ping.sonar_utime_us, ping.utime_us);
-    const edgetech::SonarChannelRecord& port = *ping.ping.port;
-    const edgetech::SonarChannelRecord& starboard = *ping.ping.starboard;
-    EXPECT_EQ(port.channel, edgetech::kChannelPort);
-    EXPECT_EQ(starboard.channel, edgetech::kChannelStarboard);
+    const sonar::SonarChannelRecord& port = *ping.ping.port;
+    const sonar::SonarChannelRecord& starboard = *ping.ping.starboard;
+    EXPECT_EQ(port.channel, sonar::kChannelPort);
+    EXPECT_EQ(starboard.channel, sonar::kChannelStarboard);
     EXPECT_EQ(port.ping_time_us, ping.utime_us);
     ASSERT_EQ(port.samples.size(), 300u);
     ASSERT_EQ(starboard.samples.size(), 300u);
@@ -62,8 +62,8 @@ TEST(XtfReader, RoundTripTwoChannelSixteenBitDegreesFromFile) {
     EXPECT_FLOAT_EQ(port.sound_speed_m_s, 1500.0f);  // stored 750: Isis' half speed
     EXPECT_NEAR(port.slantRangeM(300), 75.0, 1e-6);
     EXPECT_FLOAT_EQ(port.start_frequency_hz, 100000.0f);
-    const uint16_t expected = edgetech::kValidLatLon | edgetech::kValidDepth | edgetech::kValidAltitude |
-                              edgetech::kValidPitchRoll | edgetech::kValidHeading | edgetech::kValidSoundSpeed;
+    const uint16_t expected = sonar::kValidLatLon | sonar::kValidDepth | sonar::kValidAltitude |
+                              sonar::kValidPitchRoll | sonar::kValidHeading | sonar::kValidSoundSpeed;
     EXPECT_EQ(port.validity, expected);
     EXPECT_DOUBLE_EQ(port.latitude_deg, 59.9 + 1e-5 * p);
     EXPECT_DOUBLE_EQ(port.longitude_deg, 10.7 + 2e-5 * p);
@@ -135,9 +135,9 @@ TEST(XtfReader, MetresNavUnitsGiveNoLatLon) {
   ASSERT_TRUE(reader.isOpen()) << reader.error();
   const std::vector<DriverPing> pings = readAll(reader);
   ASSERT_EQ(pings.size(), 2u);
-  EXPECT_FALSE(pings[0].ping.port->validity & edgetech::kValidLatLon);
+  EXPECT_FALSE(pings[0].ping.port->validity & sonar::kValidLatLon);
   EXPECT_EQ(pings[0].ping.port->latitude_deg, 0.0);
-  EXPECT_TRUE(pings[0].ping.port->validity & edgetech::kValidHeading);
+  EXPECT_TRUE(pings[0].ping.port->validity & sonar::kValidHeading);
   EXPECT_NE(reader.summary().find("metres"), std::string::npos);
 }
 

@@ -75,8 +75,8 @@ int main(int argc, char** argv) {
   std::vector<float> magnitudes(samples);
   for (size_t i = 0; i < samples; ++i) magnitudes[i] = 100.0f + 50.0f * std::sin(0.001f * static_cast<float>(i));
   for (int p = 0; p < pings; ++p) {
-    for (uint8_t channel : {sss::edgetech::kChannelPort, sss::edgetech::kChannelStarboard}) {
-      sss::edgetech::SonarChannelRecord record;
+    for (uint8_t channel : {sss::sonar::kChannelPort, sss::sonar::kChannelStarboard}) {
+      sss::sonar::SonarChannelRecord record;
       record.channel = channel;
       record.ping_number = static_cast<uint32_t>(p);
       record.ping_time_us = start_utime + static_cast<int64_t>(p * 1e6 / ping_rate_hz);

@@ -13,8 +13,8 @@ std::vector<uint8_t> makeStream(int pings, size_t samples) {
   std::vector<float> magnitudes(samples);
   for (size_t i = 0; i < samples; ++i) magnitudes[i] = 100.0f + 50.0f * std::sin(0.01f * static_cast<float>(i));
   for (int p = 0; p < pings; ++p) {
-    for (uint8_t channel : {sss::edgetech::kChannelPort, sss::edgetech::kChannelStarboard}) {
-      sss::edgetech::SonarChannelRecord record;
+    for (uint8_t channel : {sss::sonar::kChannelPort, sss::sonar::kChannelStarboard}) {
+      sss::sonar::SonarChannelRecord record;
       record.channel = channel;
       record.ping_number = static_cast<uint32_t>(p);
       record.ping_time_us = 1'780'000'000'000'000 + p * 100'000;

@@ -35,19 +35,19 @@ bool endsWith(const std::string& text, const std::string& suffix) {
 }
 
 // Samples from slant range 0: a recording window that starts later is padded with zeros.
-std::vector<float> fromRangeZero(const sss::edgetech::SonarChannelRecord& side) {
+std::vector<float> fromRangeZero(const sss::sonar::SonarChannelRecord& side) {
   std::vector<float> samples(side.start_depth_samples, 0.0f);
   samples.insert(samples.end(), side.samples.begin(), side.samples.end());
   return samples;
 }
 
-sss::imagery::StatisticsPing toStatisticsPing(const sss::edgetech::AssembledPing& ping) {
+sss::imagery::StatisticsPing toStatisticsPing(const sss::sonar::AssembledPing& ping) {
   sss::imagery::StatisticsPing out;
-  const sss::edgetech::SonarChannelRecord& any = ping.port ? *ping.port : *ping.starboard;
+  const sss::sonar::SonarChannelRecord& any = ping.port ? *ping.port : *ping.starboard;
   if (ping.port) out.port = fromRangeZero(*ping.port);
   if (ping.starboard) out.starboard = fromRangeZero(*ping.starboard);
   out.sample_spacing_m = any.slantRangeM(1) - any.slantRangeM(0);
-  if ((any.validity & sss::edgetech::kValidAltitude) && any.altitude_m > 0.0) out.altitude_m = any.altitude_m;
+  if ((any.validity & sss::sonar::kValidAltitude) && any.altitude_m > 0.0) out.altitude_m = any.altitude_m;
   return out;
 }
 
@@ -88,7 +88,7 @@ bool writeWaterfall(const std::vector<sss::imagery::StatisticsPing>& pings, cons
 
 int main(int argc, char** argv) {
   std::string sonar_path, json_path, waterfall_path;
-  int subsystem = sss::edgetech::kSubsystemSideScanLow, pair = 0;
+  int subsystem = sss::sonar::kSubsystemSideScanLow, pair = 0;
   long max_pings = 0;
   sss::imagery::SonarStatisticsOptions stats_options;
   std::vector<int> block;
@@ -128,7 +128,7 @@ int main(int argc, char** argv) {
       std::cerr << "sss-sonar-stats: " << reader.error() << "\n";
       return 2;
     }
-    sss::edgetech::DriverPing ping;
+    sss::sonar::DriverPing ping;
     while (!full() && reader.next(ping)) pings.push_back(toStatisticsPing(ping.ping));
     for (const std::string& fault : reader.takeNewFaultMessages()) std::cerr << "sss-sonar-stats: " << fault << "\n";
   } else {
@@ -142,7 +142,7 @@ int main(int argc, char** argv) {
     options.time_source = sss::edgetech::TimeSource::kSonarClock;
     sss::edgetech::SonarDriver driver(options);
     std::vector<char> chunk(1 << 20);
-    std::vector<sss::edgetech::DriverPing> out;
+    std::vector<sss::sonar::DriverPing> out;
     while (!full() && file) {
       file.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
       const std::streamsize n = file.gcount();

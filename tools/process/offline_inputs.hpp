@@ -43,7 +43,7 @@ class PingSource {
  public:
   virtual ~PingSource() = default;
   // Appends what the next read gives (possibly nothing); false at the end of the input.
-  virtual bool read(std::deque<sss::edgetech::DriverPing>& out) = 0;
+  virtual bool read(std::deque<sss::sonar::DriverPing>& out) = 0;
   virtual double fractionRead() const = 0;
   virtual uint64_t faults() const = 0;
   // Navigation packets read so far (XTF types 3, 42, 107), and whether their coordinates are
@@ -76,13 +76,13 @@ class JsfSource : public PingSource {
     return out;
   }
   bool good() const { return file_.good(); }
-  bool read(std::deque<sss::edgetech::DriverPing>& out) override {
+  bool read(std::deque<sss::sonar::DriverPing>& out) override {
     if (finished_) return false;
     std::vector<char> chunk(1 << 20);
     file_.read(chunk.data(), static_cast<std::streamsize>(chunk.size()));
     const std::streamsize n = file_.gcount();
     read_ += static_cast<uint64_t>(std::max<std::streamsize>(n, 0));
-    std::vector<sss::edgetech::DriverPing> pings;
+    std::vector<sss::sonar::DriverPing> pings;
     if (n > 0) driver_.onBytes(reinterpret_cast<const uint8_t*>(chunk.data()), static_cast<size_t>(n), 0, 0, pings);
     if (n <= 0 || !file_) {
       driver_.finish(0, 0, pings);
@@ -112,8 +112,8 @@ class XtfSource : public PingSource {
     size_ = fs::file_size(path, ec);
   }
   const sss::xtf::XtfReader& reader() const { return reader_; }
-  bool read(std::deque<sss::edgetech::DriverPing>& out) override {
-    sss::edgetech::DriverPing ping;
+  bool read(std::deque<sss::sonar::DriverPing>& out) override {
+    sss::sonar::DriverPing ping;
     if (!reader_.next(ping)) return false;
     out.push_back(std::move(ping));
     return true;
@@ -181,7 +181,7 @@ class EmbeddedNavigation {
   const std::optional<sss::core::MissionOrigin>& origin() const { return origin_; }
   // Set once a ping with projected metres (XTF NavUnits 0) founded the frame: its easting, northing.
   const std::optional<Eigen::Vector2d>& projectedOrigin() const { return projected_origin_; }
-  std::optional<NavInput> fromPing(const sss::edgetech::DriverPing& driver_ping) {
+  std::optional<NavInput> fromPing(const sss::sonar::DriverPing& driver_ping) {
     const auto& side = driver_ping.ping.port ? *driver_ping.ping.port : *driver_ping.ping.starboard;
     // The header fields a navigation packet borrows (not the samples: this runs for every ping).
     last_side_.validity = side.validity;
@@ -202,17 +202,17 @@ class EmbeddedNavigation {
     if (record.depth_m) packet_depth_m_ = record.depth_m;
     if (record.altitude_m) packet_altitude_m_ = record.altitude_m;
     if (!record.y || !record.x) return std::nullopt;
-    sss::edgetech::SonarChannelRecord side = last_side_;
+    sss::sonar::SonarChannelRecord side = last_side_;
     side.pitch_rad = packet_pitch_rad_.value_or(side.pitch_rad);
     side.roll_rad = packet_roll_rad_.value_or(side.roll_rad);
     side.heading_rad = packet_heading_rad_.value_or(side.heading_rad);
     side.depth_m = packet_depth_m_.value_or(side.depth_m);
     if (packet_altitude_m_ && *packet_altitude_m_ > 0.0) {
       side.altitude_m = *packet_altitude_m_;
-      side.validity |= sss::edgetech::kValidAltitude;
+      side.validity |= sss::sonar::kValidAltitude;
     }
     side.projected_position = projected_units;
-    side.validity = static_cast<uint16_t>(side.validity & ~sss::edgetech::kValidLatLon);
+    side.validity = static_cast<uint16_t>(side.validity & ~sss::sonar::kValidLatLon);
     if (projected_units) {
       side.northing_m = *record.y;
       side.easting_m = *record.x;
@@ -220,15 +220,15 @@ class EmbeddedNavigation {
       if (std::abs(*record.y) > 90.0 || std::abs(*record.x) > 180.0) return std::nullopt;
       side.latitude_deg = *record.y;
       side.longitude_deg = *record.x;
-      side.validity |= sss::edgetech::kValidLatLon;
+      side.validity |= sss::sonar::kValidLatLon;
     }
     return fromSide(record.utime_us, side);
   }
 
  private:
-  std::optional<NavInput> fromSide(int64_t utime_us, const sss::edgetech::SonarChannelRecord& side) {
+  std::optional<NavInput> fromSide(int64_t utime_us, const sss::sonar::SonarChannelRecord& side) {
     if (side.projected_position) return fromProjected(utime_us, side);
-    if (!(side.validity & sss::edgetech::kValidLatLon) && side.latitude_deg == 0.0 && side.longitude_deg == 0.0) {
+    if (!(side.validity & sss::sonar::kValidLatLon) && side.latitude_deg == 0.0 && side.longitude_deg == 0.0) {
       return std::nullopt;  // no position in this ping
     }
     if (!plane_) {
@@ -247,7 +247,7 @@ class EmbeddedNavigation {
   // E0 of the first fix (the CRS is not in the file, so no latitude/longitude). The heading is
   // used as recorded: true north, which differs from the grid's north by the projection's
   // meridian convergence (within a degree or two in UTM).
-  std::optional<NavInput> fromProjected(int64_t utime_us, const sss::edgetech::SonarChannelRecord& side) {
+  std::optional<NavInput> fromProjected(int64_t utime_us, const sss::sonar::SonarChannelRecord& side) {
     if (!projected_origin_) projected_origin_ = Eigen::Vector2d(side.easting_m, side.northing_m);
     NavInput nav;
     nav.utime_us = utime_us;
@@ -256,18 +256,18 @@ class EmbeddedNavigation {
     fillAttitude(nav, side);
     return nav;
   }
-  void fillAttitude(NavInput& nav, const sss::edgetech::SonarChannelRecord& side) {
+  void fillAttitude(NavInput& nav, const sss::sonar::SonarChannelRecord& side) {
     nav.roll_rad = side.roll_rad;
     nav.pitch_rad = side.pitch_rad;
     nav.heading_rad = side.heading_rad;
     nav.altitude_m = side.altitude_m;
-    nav.altitude_valid = (side.validity & sss::edgetech::kValidAltitude) != 0 && side.altitude_m > 0.0;
+    nav.altitude_valid = (side.validity & sss::sonar::kValidAltitude) != 0 && side.altitude_m > 0.0;
     if (last_) distance_m_ += (nav.position_ned_m - *last_).head<2>().norm();
     last_ = nav.position_ned_m;
     nav.distance_travelled_m = distance_m_;
   }
   std::optional<Eigen::Vector2d> projected_origin_;
-  sss::edgetech::SonarChannelRecord last_side_;  // the last ping's header (depth, altitude, attitude)
+  sss::sonar::SonarChannelRecord last_side_;  // the last ping's header (depth, altitude, attitude)
   std::optional<double> packet_pitch_rad_, packet_roll_rad_, packet_heading_rad_, packet_depth_m_, packet_altitude_m_;
   void setOrigin(const sss::core::MissionOrigin& origin) {
     origin_ = origin;

@@ -172,7 +172,7 @@ OfflineResult runOffline(const OfflineRequest& request) {
       event.data = bytes.data();
       recording->writeEvent(&event);
     };
-    std::deque<sss::edgetech::DriverPing> ping_queue;
+    std::deque<sss::sonar::DriverPing> ping_queue;
     std::deque<sss_msgs::nav_t> nav_queue;
     // Navigation packets of the sonar file (XTF 3/42/107), used while its pings carry no
     // position of their own: fed in time order before the pings they precede.
@@ -204,7 +204,7 @@ OfflineResult runOffline(const OfflineRequest& request) {
         nav_queue.pop_front();
         continue;
       }
-      sss::edgetech::DriverPing ping = std::move(ping_queue.front());
+      sss::sonar::DriverPing ping = std::move(ping_queue.front());
       ping_queue.pop_front();
       feedPackets(ping.utime_us);
       if (embedded) {

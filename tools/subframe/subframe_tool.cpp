@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
     }
     out.clear();
   };
-  std::vector<sss::edgetech::DriverPing> pings;
+  std::vector<sss::sonar::DriverPing> pings;
   std::vector<char> chunk(1 << 20);
   bool eof = false;
   while (!eof) {
