@@ -1,7 +1,7 @@
 // Heightmaps: MAE of an estimate with a known offset on another grid, NaN cells ignored, coverage,
 // the writer/reader round trip and its file:line errors, and the error-map PNG.
 #include "tools/eval/heightmap_metrics.hpp"
-#include "tools/eval/plots.hpp"
+#include "tools/eval/run_report_internal.hpp"
 #include "tests/support/status_assertions.hpp"
 
 #include <gtest/gtest.h>
@@ -201,24 +201,8 @@ TEST(HeightmapIo, ReportsBadFilesWithFileAndLine) {
   fs::remove_all(dir);
 }
 
-TEST(HeightmapPng, WritesAReadableErrorMap) {
-  size_t nan_cells = 0, outside_cells = 0;
-  const HeightmapErrorResult result = compareHeightmaps(truthPlane(), offsetEstimate(nan_cells, outside_cells));
-  ASSERT_TRUE(result.ok);
-  const fs::path path = fs::temp_directory_path() / "sss_eval_error_map.png";
-  std::string error;
-  double limit = 0.0;
-  ASSERT_OK(writeErrorMapPng(path.string(), result.error_map, "test", {}, &limit));
-  EXPECT_DOUBLE_EQ(limit, 0.5);  // 99th percentile 0.25 m rounded up to 1-2-5
-  std::ifstream in(path, std::ios::binary);
-  char signature[8] = {};
-  in.read(signature, 8);
-  EXPECT_EQ(std::string(signature + 1, 3), "PNG");
-  fs::remove(path);
-  error = sss::testing::failureMessage(writeErrorMapPng("/nonexistent/dir/e.png", result.error_map, "test"));
-}
-
-TEST(Plots, NiceCeilRoundsUpToOneTwoFive) {
+TEST(ReportScale, NiceCeilRoundsUpToOneTwoFive) {
+  using report_internal::niceCeil;
   EXPECT_DOUBLE_EQ(niceCeil(0.25), 0.5);
   EXPECT_DOUBLE_EQ(niceCeil(0.2), 0.2);
   EXPECT_DOUBLE_EQ(niceCeil(3.0), 5.0);

@@ -5,7 +5,7 @@
 
 #include "tools/eval/heightmap_metrics.hpp"
 #include "tools/eval/json_values.hpp"
-#include "tools/eval/plots.hpp"
+#include "tools/eval/grey_mosaic.hpp"
 #include "tools/eval/trajectory_metrics.hpp"
 
 #include <Eigen/Core>

@@ -1,6 +1,6 @@
 // Heightmaps in the simulator's seabed format (YAML header + raw float32 raster, NaN = no data):
 // reading, writing, and the depth error of an estimated map against the true seabed (the error
-// map's PNG is in plots.hpp).
+// map's PNG is drawn by report_figures.py, see figure_script.hpp).
 #pragma once
 
 #include <cmath>

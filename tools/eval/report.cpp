@@ -324,7 +324,7 @@ Status writeFigures(const EvalRequest& request, EvalReport& report) {
                     h.result.abs_error_m.mean, 100.0 * h.result.coverage_fraction);
       Json& figure = add("error_map", "_heightmap_" + safe, title);
       figure["raster"] = heightmapRaster(figures, h.result.error_map, "heightmap_error_" + safe);
-      figure["limit_m"] = report.options.error_map_png.limit_m;  // <= 0: the script picks the p99
+      figure["limit_m"] = report.options.error_map_limit_m;  // <= 0: the script picks the p99
       h.error_map_png = paths.back();
     }
   }

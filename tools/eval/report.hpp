@@ -65,7 +65,7 @@
 #include "tools/eval/landmark_consistency.hpp"
 #include "tools/eval/json_values.hpp"
 #include "tools/eval/match_metrics.hpp"
-#include "tools/eval/plots.hpp"
+#include "tools/eval/grey_mosaic.hpp"
 #include "tools/eval/trajectory_io.hpp"
 #include "tools/eval/trajectory_metrics.hpp"
 
@@ -100,7 +100,9 @@ struct EvalRequest {
 struct EvalOptions {
   TrajectoryEvaluationOptions trajectory;
   double table_rpe_window_m = 50.0;  // the table shows the configured window closest to this
-  ErrorMapPngOptions error_map_png;
+  // Colour scale of the heightmap error maps, +-this; <= 0: the 99th percentile of |error| rounded
+  // up to 1, 2 or 5 x 10^k (report_figures.py).
+  double error_map_limit_m = 0.0;
   bool closure_table = false;  // the table lists every closure (else only the statistics)
   bool match_table = false;    // the table lists every matched pair (else per pair type)
   TrueCorrespondenceOptions lce;

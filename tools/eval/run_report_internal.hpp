@@ -6,7 +6,7 @@
 #include "tools/eval/csv_fields.hpp"
 #include "tools/eval/json_values.hpp"
 #include "tools/eval/figure_script.hpp"
-#include "tools/eval/plots.hpp"
+#include "tools/eval/grey_mosaic.hpp"
 #include "tools/eval/report.hpp"
 
 #include <yaml-cpp/yaml.h>
@@ -180,6 +180,16 @@ inline HeightmapRaster cropToData(const HeightmapRaster& map) {
     for (int c = 0; c < crop.cols; ++c) crop.at(r, c) = map.at(r + row_min, c + col_min);
   }
   return crop;
+}
+
+// Round up to 1, 2 or 5 x 10^k (a colour scale's limit).
+inline double niceCeil(double value) {
+  if (!(value > 0.0) || !std::isfinite(value)) return 1.0;
+  const double magnitude = std::pow(10.0, std::floor(std::log10(value)));
+  for (double m : {1.0, 2.0, 5.0, 10.0}) {
+    if (m * magnitude >= value * (1.0 - 1e-12)) return m * magnitude;
+  }
+  return 10.0 * magnitude;
 }
 
 // p99 of |error| over the maps: one colour limit for both error maps, so they compare.
