@@ -206,9 +206,8 @@ FigureRun drawFigures(const FigureBatch& batch, const std::string& out_dir, cons
     out.close();
     if (!out) problem = "cannot write " + spec_path + "; check the folder is writable";
   }
-  if (problem.empty() && !pythonProblem(options).empty()) {
-    problem = pythonProblem(options);
-  } else if (problem.empty() && !fs::is_regular_file(options.script, ec)) {
+  if (problem.empty()) problem = pythonProblem(options);
+  if (problem.empty() && !fs::is_regular_file(options.script, ec)) {
     problem = "the figure script " + options.script + " is missing; run from the build tree or reinstall (cmake --install)";
   } else if (problem.empty()) {
     const sss::core::Result<int> code = runScript(options.python, options.script, batch.data_dir, out_dir, log_path);
