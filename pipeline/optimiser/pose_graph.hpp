@@ -129,6 +129,10 @@ struct PoseGraphOptions {
   // variance of the opposite-side closures by the disputed amount (estimate^2 + sigma^2), so they
   // keep what they say along track and in heading and stop pulling the lines together.
   bool separation_bias_widen = false;
+  // The same widening once absolute fixes were accepted: the DVL scale is then estimated in the
+  // solve that measures the bias (calibration auto), so a significant shortening is the closures'
+  // and not DR's scale on the turns, the confusion that keeps separation_bias_widen off by default.
+  bool separation_bias_widen_with_fixes = true;
   double separation_bias_min_lateral_m = 10.0;
   double separation_bias_significance = 3.0;
 
@@ -545,7 +549,8 @@ class SlidingWindowPoseGraph {
   // Unit direction (in A's body frame) along which the separation bias moves the closure's
   // measured B, or zero when the closure is not between opposite-side lines.
   Eigen::Vector3d separationDirection(const Closure& closure) const;
-  // separation_bias_widen in effect: the last estimate significant and not applied.
+  // separation_bias_widen (or separation_bias_widen_with_fixes with accepted fixes and the DVL scale
+  // estimated) in effect: the last estimate significant, a shortening and not applied.
   bool separationWidened() const;
   // Variance components of closures and odometry at the current estimate, solving again with the
   // new factors until they settle (full smoothing, every node active).

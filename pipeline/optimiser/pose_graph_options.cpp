@@ -107,6 +107,7 @@ void readPoseGraphOptions(sss::core::ConfigSection& section, PoseGraphOptions& o
   section.optional("separation_bias_min_lateral_m", options.separation_bias_min_lateral_m, {inRange(0.0, 10000.0)});
   section.optional("separation_bias_apply", options.separation_bias_apply);
   section.optional("separation_bias_widen", options.separation_bias_widen);
+  section.optional("separation_bias_widen_with_fixes", options.separation_bias_widen_with_fixes);
   section.optional("separation_bias_significance", options.separation_bias_significance, {inRange(0.0, 100.0)});
   section.optional("fix_gate_chi2", options.fix_gate_chi2, {greaterThan(0.0)});
   section.optional("calibration", options.calibration, {sss::core::oneOf({"auto", "heading", "always", "never"})});

@@ -84,7 +84,9 @@ Eigen::Vector3d SlidingWindowPoseGraph::separationDirection(const Closure& c) co
 bool SlidingWindowPoseGraph::separationWidened() const {
   // Only a shortening (tested_m > 0) is what feature faces seen from opposite sides do to closures;
   // closures that put the lines farther apart than DR point at DR (e.g. its scale on the turns).
-  return options_.separation_bias_widen && separation_bias_.significant && !separation_bias_.applied &&
+  const bool wanted = options_.separation_bias_widen ||
+                      (options_.separation_bias_widen_with_fixes && fix_counters_.accepted > 0 && scaleWanted());
+  return wanted && separation_bias_.significant && !separation_bias_.applied &&
          separation_bias_.tested_m > 0.0 && std::isfinite(separation_bias_.sigma_m);
 }
 
