@@ -297,8 +297,39 @@ bool SlidingWindowPoseGraph::tieFix(Fix& f, int n) const {
   return f.sqrt_information.allFinite();
 }
 
+Eigen::Matrix2d SlidingWindowPoseGraph::calibrationDriftCovariance(int m, int n) const {
+  // A DVL scale error s stretches every DR step; a heading error b + a_c cos psi + a_s sin psi turns
+  // it (to starboard for a clockwise error). The chords between nodes stand for the path.
+  Eigen::Matrix<double, 2, 4> sensitivity = Eigen::Matrix<double, 2, 4>::Zero();
+  for (int k = std::max(m, 0) + 1; k <= n && k < static_cast<int>(nodes_.size()); ++k) {
+    const Eigen::Vector2d step = (nodes_[k].dr.translation - nodes_[k - 1].dr.translation).head<2>();
+    if (!(step.norm() > 0.0)) continue;
+    const double heading_rad = std::atan2(step.y(), step.x());
+    const Eigen::Vector2d turned(-step.y(), step.x());
+    sensitivity.col(0) += step;
+    sensitivity.col(1) += turned;
+    sensitivity.col(2) += std::cos(heading_rad) * turned;
+    sensitivity.col(3) += std::sin(heading_rad) * turned;
+  }
+  const Eigen::Vector4d prior(options_.calibration_scale_sigma, options_.calibration_heading_bias_sigma_rad,
+                              options_.calibration_heading_deviation_sigma_rad,
+                              options_.calibration_heading_deviation_sigma_rad);
+  Eigen::Vector4d sigma = prior;
+  if (calibration_.estimated) {
+    for (int i = 0; i < 4; ++i)
+      if (std::isfinite(calibration_.sigma(i))) sigma(i) = std::min(calibration_.sigma(i), prior(i));
+  }
+  return sensitivity * sigma.cwiseAbs2().asDiagonal() * sensitivity.transpose();
+}
+
 void SlidingWindowPoseGraph::decideFixes(bool final) {
   if (nodes_.empty()) return;
+  // Nodes that fixes accepted before this pass tie down: their information is in the estimate (a fix
+  // accepted in this pass is not yet, and the next one must not be gated against the old estimate
+  // as if it were).
+  std::vector<int> tied_nodes;
+  for (const Fix& f : fixes_)
+    if (f.record.status == FixStatus::kAccepted && f.node >= 0) tied_nodes.push_back(f.node);
   for (int index = 0; index < static_cast<int>(fixes_.size()); ++index) {
     Fix& f = fixes_[index];
     if (f.node < 0) {
@@ -329,7 +360,15 @@ void SlidingWindowPoseGraph::decideFixes(bool final) {
     jacobian.rightCols<3>() = -(rotation * skew).topRows<2>();
     const Eigen::Matrix2d fix_covariance = (f.sqrt_information.transpose() * f.sqrt_information).inverse();
     const Matrix6d node_covariance = node.has_covariance ? node.covariance : Matrix6d::Zero();
-    const Eigen::Matrix2d s = jacobian * node_covariance * jacobian.transpose() + fix_covariance;
+    // Plus the systematic drift the held calibration leaves since the newest node an accepted fix
+    // ties down (or the first node): the window's covariance grows with the square root of the
+    // distance, a heading bias or DVL scale error linearly (GNSS at the dive and at the surfacing
+    // alone was gated out after 5 km with 20 m of drift).
+    int tied_down = 0;
+    for (const int tied : tied_nodes)
+      if (tied <= f.node) tied_down = std::max(tied_down, tied);
+    const Eigen::Matrix2d s = jacobian * node_covariance * jacobian.transpose() + fix_covariance +
+                              calibrationDriftCovariance(tied_down, f.node);
     f.record.innovation_chi2 = innovation.dot(s.ldlt().solve(innovation));
     const bool accepted = std::isfinite(f.record.innovation_chi2) && f.record.innovation_chi2 <= options_.fix_gate_chi2;
     f.record.status = accepted ? FixStatus::kAccepted : FixStatus::kRejected;

@@ -518,6 +518,10 @@ class SlidingWindowPoseGraph {
   void decideFixes(bool final);
   // Ties fix f to node n: its body-frame offset and whitening (also used by the checkpoint).
   bool tieFix(Fix& f, int n) const;
+  // North/east covariance of node n's position relative to node m that the DR calibration's
+  // uncertainty leaves (its sigma once estimated, else the priors): the window holds the
+  // calibration constant, so its covariance does not carry the systematic drift between them.
+  Eigen::Matrix2d calibrationDriftCovariance(int m, int n) const;
   bool passesGate(const Closure& closure, const Eigen::MatrixXd& covariance, const std::vector<int>& slot) const;
   bool pairConsistent(const Closure& i, const Closure& j) const;
   sss::core::Matrix6d chainCovariance(int from, int to) const;
