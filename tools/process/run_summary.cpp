@@ -91,6 +91,14 @@ std::vector<std::string> explainRun(const OfflineSummary& s, const Options& opti
                       "the sonar records per side: no seabed is seen from two lines (closer lines or a longer "
                       "range would overlap)",
                       s.nearest_other_line_m, swath_m);
+      } else if (options.buffer.canonical.swath_from_range) {
+        // The swath is already the recorded range: what is missing is overlap, not swath.
+        std::snprintf(text, sizeof text,
+                      "no pair to match: the nearest lines run %.0f m apart, and the %.0f m of seabed the sonar "
+                      "records per side leave their subframes less overlap than a pair needs "
+                      "(matcher.overlap.min_overlap_fraction of the smaller footprint); closer lines or a longer "
+                      "range would overlap",
+                      s.nearest_other_line_m, swath_m);
       } else {
         std::snprintf(text, sizeof text,
                       "no pair to match: no two subframes of different lines overlap within the canonical swath of "
