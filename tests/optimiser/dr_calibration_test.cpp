@@ -17,28 +17,6 @@ namespace {
 
 using namespace test_helpers;
 
-// Every node's closures and a USBL fix (1 m) at every other node, then full smoothing.
-SlidingWindowPoseGraph solved(const synthetic::Mission& mission, const PoseGraphOptions& options, bool fixes,
-                              uint64_t seed) {
-  std::mt19937_64 random(seed);
-  SlidingWindowPoseGraph graph(options);
-  for (size_t i = 0; i < mission.nodes.size(); ++i) {
-    const synthetic::Node& n = mission.nodes[i];
-    EXPECT_TRUE(graph.addNode(n.subframe_id, n.utime_us, n.dr, n.distance_m).ok);
-    for (const synthetic::Closure& c : mission.closures) {
-      if (c.newer_node == static_cast<int>(i)) {
-        EXPECT_TRUE(graph.addLoopClosure(c.closure).ok);
-      }
-    }
-    if (fixes && i % 2 == 0) {
-      EXPECT_TRUE(graph.addFix(fixAt(n, 1.0, random, "usbl")).ok);
-    }
-    EXPECT_TRUE(graph.optimize().ok);
-  }
-  EXPECT_TRUE(graph.fullSmoothing().ok);
-  return graph;
-}
-
 // A 2 % scale error and a 0.5 deg steaming error, no other heading error: both are found within
 // 2 sigma, the constant bias and a_s (zero in truth) too, and the ATE improves on fixes alone.
 TEST(DrCalibration, ScaleAndSteamingErrorAreRecoveredFromFixes) {
@@ -50,8 +28,8 @@ TEST(DrCalibration, ScaleAndSteamingErrorAreRecoveredFromFixes) {
     const synthetic::Mission mission = synthetic::makeLawnmowerMission(o);
     PoseGraphOptions never = graphOptions();
     never.calibration = "never";
-    const SlidingWindowPoseGraph fixes_only = solved(mission, never, true, seed);
-    const SlidingWindowPoseGraph calibrated = solved(mission, graphOptions(), true, seed);
+    const SlidingWindowPoseGraph fixes_only = solvedWithUsbl(mission, never, true, seed);
+    const SlidingWindowPoseGraph calibrated = solvedWithUsbl(mission, graphOptions(), true, seed);
     const DrCalibration& c = calibrated.calibration();
     ASSERT_TRUE(c.estimated);
     EXPECT_FALSE(fixes_only.calibration().estimated);
@@ -78,8 +56,8 @@ TEST(DrCalibration, WithoutFixesNothingChangesAndUnobservedSigmasStayAtThePrior)
   const synthetic::Mission mission = synthetic::makeLawnmowerMission(missionOptions(2));
   PoseGraphOptions never = graphOptions();
   never.calibration = "never";
-  const SlidingWindowPoseGraph plain = solved(mission, never, false, 2);
-  const SlidingWindowPoseGraph automatic = solved(mission, graphOptions(), false, 2);
+  const SlidingWindowPoseGraph plain = solvedWithUsbl(mission, never, false, 2);
+  const SlidingWindowPoseGraph automatic = solvedWithUsbl(mission, graphOptions(), false, 2);
   EXPECT_FALSE(automatic.calibration().estimated);
   EXPECT_TRUE(std::isnan(automatic.calibration().sigma(0)));
   const auto a = estimates(plain), b = estimates(automatic);
@@ -90,7 +68,7 @@ TEST(DrCalibration, WithoutFixesNothingChangesAndUnobservedSigmasStayAtThePrior)
   }
   PoseGraphOptions always = graphOptions();
   always.calibration = "always";
-  const SlidingWindowPoseGraph closures_only = solved(mission, always, false, 2);
+  const SlidingWindowPoseGraph closures_only = solvedWithUsbl(mission, always, false, 2);
   const DrCalibration& c = closures_only.calibration();
   ASSERT_TRUE(c.estimated);
   std::printf("closures only: sigma scale %.5f, b %.5f, a_c %.5f, a_s %.5f (priors %.4f)\n", c.sigma(0), c.sigma(1),
@@ -110,7 +88,7 @@ TEST(DrCalibration, HeadingModeFindsTheSteamingErrorFromClosuresAlone) {
     const synthetic::Mission mission = synthetic::makeLawnmowerMission(o);
     PoseGraphOptions heading = graphOptions();
     heading.calibration = "heading";
-    const SlidingWindowPoseGraph graph = solved(mission, heading, false, seed);
+    const SlidingWindowPoseGraph graph = solvedWithUsbl(mission, heading, false, seed);
     const DrCalibration& c = graph.calibration();
     std::printf("seed %llu: a_c %.5f +- %.5f (0.0087), a_s %.5f +- %.5f (0), scale %.5f +- %.5f\n",
                 static_cast<unsigned long long>(seed), c.heading_cos_rad, c.sigma(2), c.heading_sin_rad, c.sigma(3),
@@ -204,7 +182,7 @@ TEST(DrCalibration, SurvivesACheckpoint) {
   synthetic::MissionOptions o = missionOptions(3);
   o.velocity_scale_error = 0.01;
   const synthetic::Mission mission = synthetic::makeLawnmowerMission(o);
-  SlidingWindowPoseGraph graph = solved(mission, graphOptions(), true, 3);
+  SlidingWindowPoseGraph graph = solvedWithUsbl(mission, graphOptions(), true, 3);
   ASSERT_TRUE(graph.calibration().estimated);
   SlidingWindowPoseGraph restored(graphOptions());
   const Status status = restored.restoreCheckpointText(graph.checkpointText());

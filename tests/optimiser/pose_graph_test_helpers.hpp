@@ -43,6 +43,29 @@ inline AbsoluteFix fixAt(const synthetic::Node& node, double sigma_m, std::mt199
   return fix;
 }
 
+// Every node's closures and, with fixes, a USBL fix (1 m, drawn from `seed`) at every other node,
+// one update per node, then full smoothing.
+inline SlidingWindowPoseGraph solvedWithUsbl(const synthetic::Mission& mission, const PoseGraphOptions& options,
+                                             bool fixes, uint64_t seed) {
+  std::mt19937_64 random(seed);
+  SlidingWindowPoseGraph graph(options);
+  for (size_t i = 0; i < mission.nodes.size(); ++i) {
+    const synthetic::Node& n = mission.nodes[i];
+    EXPECT_TRUE(graph.addNode(n.subframe_id, n.utime_us, n.dr, n.distance_m).ok);
+    for (const synthetic::Closure& c : mission.closures) {
+      if (c.newer_node == static_cast<int>(i)) {
+        EXPECT_TRUE(graph.addLoopClosure(c.closure).ok);
+      }
+    }
+    if (fixes && i % 2 == 0) {
+      EXPECT_TRUE(graph.addFix(fixAt(n, 1.0, random, "usbl")).ok);
+    }
+    EXPECT_TRUE(graph.optimize().ok);
+  }
+  EXPECT_TRUE(graph.fullSmoothing().ok);
+  return graph;
+}
+
 inline std::vector<Pose> estimates(const SlidingWindowPoseGraph& graph) {
   std::vector<Pose> out;
   for (const NodeState& n : graph.nodes()) out.push_back(n.T_world_body);
