@@ -31,7 +31,9 @@ std::vector<FootprintStrip> slamStrips(const std::vector<SubframeFootprint>& foo
 
 // For GIS (QGIS opens them as they are; RFC 7946, WGS 84 longitude/latitude): dir/track.geojson, the
 // SLAM and DR tracks (a vertex every 4 poses), and dir/subframes.geojson, each footprint's polygon
-// under the corrected poses with its id and line. Nothing without an origin (a projected frame).
+// under the corrected poses with its id and line (rings counterclockwise). A track or footprint that
+// crosses the antimeridian is cut there into a MultiLineString / MultiPolygon (RFC 7946 §3.1.9).
+// Nothing without an origin (a projected frame).
 sss::core::Status writeGeoJsonFiles(const std::string& dir, const std::vector<sss::optimiser::StampedPose>& slam,
                                     const std::vector<sss::optimiser::StampedPose>& dr,
                                     const std::vector<SubframeFootprint>& footprints,

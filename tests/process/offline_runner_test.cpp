@@ -139,10 +139,11 @@ TEST_F(OfflineRunnerTest, SonarAndInsFilesGiveEveryOutputAndBeatDeadReckoning) {
       EXPECT_EQ(ring.front(), ring.back()) << "a closed ring";
       std::vector<Eigen::Vector2d> corners;
       for (const auto& c : ring) corners.push_back(plane.toNed({c[1].get<double>(), c[0].get<double>(), 0.0}).head<2>());
-      // The ring: port edge forward, starboard edge back. Its width is twice the swath.
+      // The ring: starboard edge forward, port edge back (counterclockwise, RFC 7946). Its width is
+      // twice the swath.
       const size_t half = (corners.size() - 1) / 2;
       EXPECT_NEAR((corners[0] - corners[corners.size() - 2]).norm(), 2.0 * feature["properties"]["swath_m"].get<double>(), 0.5);
-      // The midpoint of the first port and starboard corners is the SLAM pose at the subframe's start.
+      // The midpoint of the first starboard and port corners is the SLAM pose at the subframe's start.
       const Eigen::Vector2d middle = 0.5 * (corners[0] + corners[corners.size() - 2]);
       const int64_t start_us = [&] {
         for (const auto& p : slam.poses)
@@ -153,6 +154,11 @@ TEST_F(OfflineRunnerTest, SonarAndInsFilesGiveEveryOutputAndBeatDeadReckoning) {
       const auto at = std::find_if(slam.poses.begin(), slam.poses.end(), [&](const auto& p) { return p.utime_us == start_us; });
       EXPECT_LT((middle - at->T_world_body.translation.head<2>()).norm(), 0.05) << feature["properties"];
       EXPECT_EQ(half * 2 + 1, corners.size());
+      double twice_area_deg2 = 0.0;  // shoelace on longitude (x) and latitude (y): > 0 counterclockwise
+      for (size_t i = 0; i + 1 < ring.size(); ++i)
+        twice_area_deg2 += ring[i][0].get<double>() * ring[i + 1][1].get<double>() -
+                           ring[i + 1][0].get<double>() * ring[i][1].get<double>();
+      EXPECT_GT(twice_area_deg2, 0.0) << feature["properties"];
     }
   }
 

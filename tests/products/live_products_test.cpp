@@ -1,11 +1,13 @@
 // What sss-optimiser leaves in its products folder, from the engine after a synthetic lawnmower (3
 // lines of 4 subframes, closures with seabed correspondences): every file sss-process writes that
 // needs no sonar file, consistent with the engine, GeoTIFFs in the origin's UTM zone; without an
-// origin, no file that needs one.
+// origin, no file that needs one; across the antimeridian, GeoJSON cut there.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -13,7 +15,10 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "pipeline/optimiser/optimiser_engine.hpp"
+#include "products/footprints.hpp"
 #include "tools/fixtures/synthetic_subframes.hpp"
 #include "products/live_products.hpp"
 #include "tests/optimiser/pose_graph_test_helpers.hpp"
@@ -110,6 +115,74 @@ TEST_F(LiveProductsTest, EveryProductIsWrittenAndTheRastersLandInTheOriginsUtmZo
   // Three parallel lines: some cells are seen from two of them.
   const auto coverage = sss::test::readGeoTiff(dir_ + "/coverage.tif");
   EXPECT_GE(*std::max_element(coverage.values.begin(), coverage.values.end()), 2.0);
+}
+
+// A survey across 180 E (origin set so that the meridian runs through its middle): the tracks and the
+// footprints it cuts are split there (RFC 7946 §3.1.9), every longitude in [-180, 180], no edge that
+// jumps across the globe, footprint rings counterclockwise.
+TEST_F(LiveProductsTest, GeoJsonAcrossTheAntimeridianIsCutThere) {
+  const std::vector<sss::optimiser::StampedPose> slam = engine_->pingTrajectory(true);
+  double east_min_m = 1e9, east_max_m = -1e9;
+  for (const auto& p : slam) {
+    east_min_m = std::min(east_min_m, p.T_world_body.translation.y());
+    east_max_m = std::max(east_max_m, p.T_world_body.translation.y());
+  }
+  ASSERT_GT(east_max_m - east_min_m, 100.0);
+  const double latitude_deg = -45.0;
+  // Metres per degree of longitude on the WGS-84 ellipsoid at 45 S (prime vertical radius x cos lat).
+  const double metres_per_deg = 78846.8;
+  const sss::core::MissionOrigin origin{latitude_deg, 180.0 - 0.5 * (east_min_m + east_max_m) / metres_per_deg};
+  fs::create_directories(dir_);
+  ASSERT_TRUE(writeGeoJsonFiles(dir_, slam, engine_->pingTrajectory(false), footprints_, *engine_, origin).ok);
+
+  // Every vertex wrapped; consecutive vertices of one piece never more than a degree apart.
+  auto checkPiece = [](const nlohmann::json& piece) {
+    for (size_t i = 0; i < piece.size(); ++i) {
+      const double lon = piece[i][0].get<double>();
+      EXPECT_GE(lon, -180.0);
+      EXPECT_LE(lon, 180.0);
+      if (i > 0) {
+        EXPECT_LT(std::abs(lon - piece[i - 1][0].get<double>()), 1.0);
+      }
+    }
+  };
+  const nlohmann::json tracks = nlohmann::json::parse(readText(dir_ + "/track.geojson"));
+  ASSERT_EQ(tracks["features"].size(), 2u);
+  for (const auto& feature : tracks["features"]) {
+    ASSERT_EQ(feature["geometry"]["type"], "MultiLineString") << feature["properties"]["name"];
+    const auto& pieces = feature["geometry"]["coordinates"];
+    ASSERT_GE(pieces.size(), 2u);
+    for (size_t k = 0; k < pieces.size(); ++k) {
+      checkPiece(pieces[k]);
+      if (k == 0) continue;
+      // A piece starts where the previous one ended, on the other side of the antimeridian.
+      const auto& end = pieces[k - 1].back();
+      const auto& start = pieces[k].front();
+      EXPECT_DOUBLE_EQ(std::abs(end[0].get<double>()), 180.0);
+      EXPECT_DOUBLE_EQ(start[0].get<double>(), -end[0].get<double>());
+      EXPECT_DOUBLE_EQ(start[1].get<double>(), end[1].get<double>());
+    }
+  }
+  const nlohmann::json polygons = nlohmann::json::parse(readText(dir_ + "/subframes.geojson"));
+  ASSERT_EQ(polygons["features"].size(), footprints_.size());
+  size_t cut = 0;
+  for (const auto& feature : polygons["features"]) {
+    const bool multi = feature["geometry"]["type"] == "MultiPolygon";
+    cut += multi ? 1 : 0;
+    const nlohmann::json parts = multi ? feature["geometry"]["coordinates"]
+                                       : nlohmann::json::array({feature["geometry"]["coordinates"]});
+    for (const auto& polygon : parts) {
+      const auto& ring = polygon[0];
+      checkPiece(ring);
+      EXPECT_EQ(ring.front(), ring.back());
+      double twice_area = 0.0;
+      for (size_t i = 0; i + 1 < ring.size(); ++i)
+        twice_area += ring[i][0].get<double>() * ring[i + 1][1].get<double>() -
+                      ring[i + 1][0].get<double>() * ring[i][1].get<double>();
+      EXPECT_GT(twice_area, 0.0) << "clockwise ring in subframe " << feature["properties"]["subframe_id"];
+    }
+  }
+  EXPECT_GE(cut, 1u);
 }
 
 TEST_F(LiveProductsTest, WithoutAnOriginTheFilesThatNeedOneAreLeftOut) {
