@@ -123,6 +123,9 @@ struct OfflineSummary {
   uint64_t pings_without_position = 0;  // embedded navigation: a ping header without a position
   uint64_t nav_from_packets = 0;        // navigation samples from the sonar file's own nav packets
   uint64_t survey_lines = 0;
+  // Lines holding fewer pings than one full subframe: short lines, or the pieces a turn slower than
+  // the turn-rate threshold is cut into (a new line at every max_heading_deviation_rad of heading).
+  uint64_t short_lines = 0;
   // Across-track distance of the nearest subframe of another line lying beside one (more across
   // than along); < 0: none beside another (one line, or lines following one another).
   double nearest_other_line_m = -1.0;

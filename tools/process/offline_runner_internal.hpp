@@ -167,6 +167,9 @@ class Runner {
       if (std::find(lines.begin(), lines.end(), line) == lines.end()) lines.push_back(line);
     }
     summary_.survey_lines = lines.size();
+    summary_.short_lines = 0;
+    for (const auto& [line, pings] : pings_per_line_)
+      if (pings < static_cast<size_t>(options_.buffer.subframes.pings_per_subframe)) ++summary_.short_lines;
     // Of two subframes of different lines, the one's centre in the other's frame: side by side
     // (more across than along) is a pair the swath could cover; ahead or behind is the same track
     // going on (a line split where the heading changed).
@@ -278,6 +281,7 @@ class Runner {
         continue;
       }
       centres_.push_back({subframe.line_id, subframe.centre().T_world_body});
+      pings_per_line_[subframe.line_id] += subframe.pings.size();
       footprints_.push_back(sss::products::footprintOf(subframe));
       if (request_.write_mosaics) mosaic_store_.add(subframe);
       addOutcomes(timedMatch([&] { return matcher_.addSubframe(std::move(subframe)); }));
@@ -295,6 +299,7 @@ class Runner {
   std::vector<sss::core::Subframe> subframes_;  // reused
   sss::products::MosaicStore mosaic_store_;  // every subframe at mosaic resolution (no bound offline)
   std::vector<std::pair<int, sss::core::Pose>> centres_;  // line id and DR centre pose of every subframe
+  std::map<int, size_t> pings_per_line_;                   // in the subframes of each line
   std::vector<sss::products::SubframeFootprint> footprints_;  // of every subframe, for GeoJSON and coverage
   std::vector<sss::optimiser::StampedPose> dr_per_ping_;
   sss::ins::FixAligner fix_aligner_;  // the request's fixes, tied to the navigation as it comes

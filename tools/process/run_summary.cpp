@@ -74,6 +74,22 @@ std::vector<std::string> explainRun(const OfflineSummary& s, const Options& opti
                        "and left out (first: " + s.first_subframe_refusal + "); this is a bug in the subframe buffer, " +
                        "please report it with the input file");
   }
+  // Most lines shorter than a subframe: the track turns slowly rather than running straight lines
+  // joined by turns (a towed sonar behind a ship, a wide turn radius). Below the turn-rate threshold
+  // a turn is cut into a new line at every max_heading_deviation_rad of heading.
+  if (s.short_lines >= 2 && 2 * s.short_lines > s.survey_lines) {
+    char text[640];
+    std::snprintf(text, sizeof text,
+                  "%llu of the %llu survey lines hold less than one subframe (%d pings): the track turns more "
+                  "slowly than subframe_buffer.canonical.max_heading_rate_rad_s (%.3g rad/s), so a turn is not "
+                  "left out but cut into a new line at every subframe_buffer.lines.max_heading_deviation_rad "
+                  "(%.3g rad) of heading, and the pieces are matched like lines; if they are wide turns, a lower "
+                  "max_heading_rate_rad_s leaves them out",
+                  static_cast<unsigned long long>(s.short_lines), static_cast<unsigned long long>(s.survey_lines),
+                  options.buffer.subframes.pings_per_subframe, options.buffer.canonical.max_heading_rate_rad_s,
+                  options.buffer.lines.max_heading_deviation_rad);
+    findings.push_back(text);
+  }
   const double swath_m = s.canonical_swath_m;
   if (s.pairs_attempted == 0) {
     if (s.survey_lines < 2) {
@@ -314,6 +330,7 @@ sss::core::Status writeSummaryJson(const std::string& path, const OfflineRequest
   anchor_json["sigma_east_m"] = jsonValue(s.anchor_sigma_ne_m(1), 4);
   Json& lines_json = (json["lines"] = Json::object());
   lines_json["survey_lines"] = jsonValue(s.survey_lines);
+  lines_json["short_lines"] = jsonValue(s.short_lines);
   lines_json["turn_pings"] = jsonValue(s.buffer.builder.turn_pings);
   lines_json["short_tail_pings"] = jsonValue(s.buffer.builder.dropped_tail_pings);
   lines_json["nearest_other_line_m"] = jsonValue(s.nearest_other_line_m, 6);
