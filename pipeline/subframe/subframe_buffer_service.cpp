@@ -116,6 +116,7 @@ void SubframeBufferService::reportHealth(sss::core::HealthMonitor& health, int64
   set("subframes_out", c.builder.subframes);
   set("partial_subframes", c.builder.partial_subframes);
   set("dropped_short_tails", c.builder.dropped_short_tails);
+  set("curved_pieces", c.builder.curved_pieces);
   set("memory_bytes", buffer_.memoryBytes());
   set("numbering_write_failures", numbering_write_failures_);
 

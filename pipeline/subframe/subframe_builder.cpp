@@ -10,6 +10,7 @@ void readLineSegmenterOptions(sss::core::ConfigSection& section, LineSegmenterOp
   section.optional("max_heading_deviation_rad", options.max_heading_deviation_rad, {inRange(0.001, 3.14)});
   section.optional("min_steady_pings", options.min_steady_pings, {inRange(1, 10000)});
   section.optional("max_ping_gap_s", options.max_ping_gap_s, {greaterThan(0.0)});
+  section.optional("curved_pieces_are_turns", options.curved_pieces_are_turns);
 }
 
 void readSubframeOptions(sss::core::ConfigSection& section, SubframeOptions& options) {
@@ -54,7 +55,19 @@ void SubframeBuilder::addPing(CanonicalPing ping, std::vector<Subframe>& out) {
       appendToLine(std::move(ping), out);
       return;
     }
-    closeLine(out);  // a heading change without a turn-rate signature: a new line
+    if (line_options_.curved_pieces_are_turns && !line_emitted_ && !current_.empty() &&
+        std::abs(sss::core::wrapAngle(current_.back().fused.steady_heading_rad -
+                                      current_.front().fused.steady_heading_rad)) >
+            line_options_.max_heading_deviation_rad) {
+      // Out of its heading before one subframe, having turned through the tolerance itself (a
+      // straight piece ended by a sudden heading change stays a line): a piece of a slow turn.
+      line_open_ = false;
+      ++counters_.curved_pieces;
+      counters_.turn_pings += current_.size();
+      current_.clear();
+    } else {
+      closeLine(out);  // a heading change without a turn-rate signature: a new line
+    }
   }
   // Hysteresis: a line opens only after min_steady_pings steady pings with one heading.
   if (!candidate_.empty() &&
@@ -66,6 +79,7 @@ void SubframeBuilder::addPing(CanonicalPing ping, std::vector<Subframe>& out) {
   candidate_.push_back(std::move(ping));
   if (static_cast<int>(candidate_.size()) >= line_options_.min_steady_pings) {
     line_open_ = true;
+    line_emitted_ = false;
     ++line_id_;
     ++counters_.lines;
     line_sin_sum_ = line_cos_sum_ = 0.0;
@@ -127,6 +141,7 @@ void SubframeBuilder::emit(std::vector<Subframe>& out) {
   }
   subframe.last_ping_arrival_monotonic_us = current_.back().fused.ping.arrival_monotonic_us;
   ++counters_.subframes;
+  line_emitted_ = true;
   current_.clear();
   out.push_back(std::move(subframe));
 }

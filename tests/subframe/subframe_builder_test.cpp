@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <map>
+
 namespace sss::subframe {
 namespace {
 
@@ -13,8 +16,8 @@ struct Rows {
   std::vector<Subframe> out;
   SubframeBuilder builder;
 
-  explicit Rows(const SubframeOptions& options = {})
-      : builder(LineSegmenterOptions{}, options, SubframeGeometry{4, 0.1, 0.0, {}}) {}
+  explicit Rows(const SubframeOptions& options = {}, const LineSegmenterOptions& line_options = {})
+      : builder(line_options, options, SubframeGeometry{4, 0.1, 0.0, {}}) {}
 
   void add(int count, double heading_rad, bool turn = false) {
     for (int i = 0; i < count; ++i) {
@@ -120,6 +123,41 @@ TEST(SubframeBuilder, AHeadingChangeOrAPingGapEndsTheLine) {
   EXPECT_EQ(rows.out[1].line_id, 1);
   EXPECT_EQ(rows.out[2].line_id, 2);
   EXPECT_EQ(rows.out[1].pings.front().ping_number, 120);
+}
+
+// A wide turn below the turn-rate mask (0.015 rad/s at 4 Hz: 0.00375 rad per ping) between two
+// lines: its pieces leave their heading within one subframe having turned through it, so they are
+// turn pings, not lines; the lines on either side keep every subframe, and a straight piece ended
+// by a sudden heading change (AHeadingChangeOrAPingGapEndsTheLine) stays a line.
+TEST(SubframeBuilder, PiecesOfASlowTurnAreTurnPingsNotLines) {
+  for (const bool pieces_are_turns : {true, false}) {
+    LineSegmenterOptions line_options;
+    line_options.curved_pieces_are_turns = pieces_are_turns;
+    Rows rows(SubframeOptions{}, line_options);
+    rows.add(400, 0.0);  // line: two subframes
+    const int turn_pings = 838;  // pi rad at 0.00375 rad per ping
+    for (int i = 1; i <= turn_pings; ++i) rows.add(1, 0.00375 * i);
+    rows.add(400, M_PI);  // the next line, back the other way
+    rows.builder.finish(rows.out);
+    const auto& c = rows.builder.counters();
+    std::map<int, int> rows_per_line;
+    for (const Subframe& s : rows.out) rows_per_line[s.line_id] += s.rows();
+    int short_lines = 0;
+    for (const auto& [line, count] : rows_per_line) short_lines += count < 200;
+    std::printf("pieces are turns: %d; lines %zu (%d shorter than a subframe), curved pieces %llu, turn pings %llu\n",
+                pieces_are_turns, rows_per_line.size(), short_lines, (unsigned long long)c.curved_pieces,
+                (unsigned long long)c.turn_pings);
+    if (pieces_are_turns) {
+      EXPECT_LE(short_lines, 2);       // at most the ends of the turn, each a tail of a line
+      EXPECT_GE(c.curved_pieces, 10u);  // pi rad in pieces of ~0.2 rad
+      EXPECT_GE(c.turn_pings, 600u);
+    } else {
+      EXPECT_GE(short_lines, 10);  // the turn as lines
+      EXPECT_EQ(c.curved_pieces, 0u);
+    }
+    EXPECT_GE(rows_per_line.begin()->second, 400);   // the first line whole
+    EXPECT_GE(rows_per_line.rbegin()->second, 400);  // and the last
+  }
 }
 
 TEST(SubframeBuilder, ASteadyBlipInsideATurnDoesNotOpenALine) {

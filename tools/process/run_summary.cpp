@@ -78,13 +78,14 @@ std::vector<std::string> explainRun(const OfflineSummary& s, const Options& opti
   // joined by turns (a towed sonar behind a ship, a wide turn radius). Below the turn-rate threshold
   // a turn is cut into a new line at every max_heading_deviation_rad of heading.
   if (s.short_lines >= 2 && 2 * s.short_lines > s.survey_lines) {
-    char text[640];
+    char text[768];
     std::snprintf(text, sizeof text,
                   "%llu of the %llu survey lines hold less than one subframe (%d pings): the track turns more "
                   "slowly than subframe_buffer.canonical.max_heading_rate_rad_s (%.3g rad/s), so a turn is not "
                   "left out but cut into a new line at every subframe_buffer.lines.max_heading_deviation_rad "
-                  "(%.3g rad) of heading, and the pieces are matched like lines; if they are wide turns, a lower "
-                  "max_heading_rate_rad_s leaves them out",
+                  "(%.3g rad) of heading, and the pieces are matched like lines; if they are wide turns, "
+                  "subframe_buffer.lines.curved_pieces_are_turns: true (or a lower max_heading_rate_rad_s) "
+                  "leaves them out",
                   static_cast<unsigned long long>(s.short_lines), static_cast<unsigned long long>(s.survey_lines),
                   options.buffer.subframes.pings_per_subframe, options.buffer.canonical.max_heading_rate_rad_s,
                   options.buffer.lines.max_heading_deviation_rad);
@@ -333,6 +334,7 @@ sss::core::Status writeSummaryJson(const std::string& path, const OfflineRequest
   lines_json["short_lines"] = jsonValue(s.short_lines);
   lines_json["turn_pings"] = jsonValue(s.buffer.builder.turn_pings);
   lines_json["short_tail_pings"] = jsonValue(s.buffer.builder.dropped_tail_pings);
+  lines_json["curved_pieces"] = jsonValue(s.buffer.builder.curved_pieces);
   lines_json["nearest_other_line_m"] = jsonValue(s.nearest_other_line_m, 6);
   lines_json["canonical_swath_m"] = jsonValue(s.canonical_swath_m, 6);
   Json& pairs_rejected_json = (json["pairs_rejected"] = Json::object());
