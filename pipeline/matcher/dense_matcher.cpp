@@ -212,21 +212,28 @@ void computePatchStatistics(GridImage& image, int half, double min_stddev) {
 // and far range). Both centres must be at least `half` pixels inside the grid.
 class PatchScorer {
  public:
+  // inverted: the score is -ZNCC (A against B's contrast inverted; see reject_inverted_relief).
   PatchScorer(const GridImage& source, const GridImage& target, int half, double min_valid_fraction,
-              double min_stddev)
-      : source_(source), target_(target), half_(half), size_(2 * half + 1) {
+              double min_stddev, bool inverted = false)
+      : source_(source), target_(target), half_(half), size_(2 * half + 1), inverted_(inverted) {
     min_count_ = static_cast<float>(min_valid_fraction * size_ * size_);
     min_variance_ = static_cast<float>(min_stddev * min_stddev);
   }
 
   float operator()(int sr, int sc, int tr, int tc) const {
+    const float zncc = plain(sr, sc, tr, tc);
+    return inverted_ && zncc > kNoScore ? -zncc : zncc;
+  }
+
+ private:
+  float plain(int sr, int sc, int tr, int tc) const {
     const std::uint8_t s_state = source_.state(sr, sc), t_state = target_.state(tr, tc);
     if (s_state == kFlat || t_state == kFlat) return kNoScore;
     if (s_state == kFull && t_state == kFull) return full(sr, sc, tr, tc);
     return masked(sr, sc, tr, tc);
   }
 
- private:
+
   float full(int sr, int sc, int tr, int tc) const {
     // Per-column accumulators: independent lanes the compiler vectorises without reordering sums.
     float acc[32] = {};
@@ -270,6 +277,7 @@ class PatchScorer {
   const GridImage& target_;
   int half_;
   int size_;
+  bool inverted_;
   float min_count_;
   float min_variance_;
 };
@@ -601,6 +609,31 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
   runPatchMatch(forward, score_ab, window, grid_rows, grid_cols, half, o, 0x5A5A0001ULL);
   t.patch_match_s = secondsSince(stage);
 
+  // ---- the same nodes against B's contrast inverted, where the looks are opposed --------------
+  Field inverted;
+  if (o.reject_inverted_relief) {
+    inverted = forward;
+    long opposed_nodes = 0;
+    for (int i = 0; i < forward.rows; ++i) {
+      for (int j = 0; j < forward.cols; ++j) {
+        const int k = forward.index(i, j);
+        inverted.active[k] = 0;
+        if (!forward.active[k] || forward.score[k] < o.min_zncc) continue;
+        const int gr = forward.gridRow(i), gc = forward.gridCol(j);
+        const cv::Vec2f in_b = map_to_b(gr, gc);
+        const int br = std::clamp(static_cast<int>(std::lround(in_b[0])), 0, b.intensity.rows - 1);
+        const int bc = std::clamp(static_cast<int>(std::lround(in_b[1])), 0, b.intensity.cols - 1);
+        if (!opposedLooks(a, gr - pad_r, gc - pad_c, b, br, bc)) continue;
+        inverted.active[k] = 1;
+        ++opposed_nodes;
+      }
+    }
+    if (opposed_nodes > 0) {
+      const PatchScorer score_inverted(grid_a, grid_b, half, o.min_valid_fraction, o.min_patch_stddev, true);
+      runPatchMatch(inverted, score_inverted, window, grid_rows, grid_cols, half, o, 0x1A1A0003ULL);
+    }
+  }
+
   // ---- forward-backward consistency, sub-pixel refinement, thresholds ------------------------
   stage = Clock::now();
   Field backward;
@@ -693,6 +726,11 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
       if (nearest_r < 0 || nearest_c < 0 || nearest_r >= b.valid.rows || nearest_c >= b.valid.cols ||
           !b.valid(nearest_r, nearest_c))
         continue;
+      // Contrast-inverted relief (checked on the nodes whose DR-predicted B pixel looks opposed).
+      if (o.reject_inverted_relief && inverted.active[k] && inverted.score[k] >= o.min_zncc) {
+        ++t.inverted_relief_rejected;
+        continue;
+      }
       const bool opposed = (o.reject_mirrored_relief || test_relief) &&
                            opposedLooks(a, sr - pad_r, sc - pad_c, b, nearest_r, nearest_c);
       if (opposed && o.reject_mirrored_relief &&

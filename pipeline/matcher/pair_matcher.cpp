@@ -107,6 +107,7 @@ void addTimings(MatchTimings& total, const MatchTimings& pass) {
   total.overlapping_pixels = std::max(total.overlapping_pixels, pass.overlapping_pixels);
   total.mirrored_relief_rejected += pass.mirrored_relief_rejected;
   total.shadowed_relief_rejected += pass.shadowed_relief_rejected;
+  total.inverted_relief_rejected += pass.inverted_relief_rejected;
 }
 
 }  // namespace

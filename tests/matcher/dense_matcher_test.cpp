@@ -267,6 +267,73 @@ TEST(DenseMatcher, FlatTextureSeenFromOppositeSidesKeepsItsMatchesWhenRejectingM
   EXPECT_GE(static_cast<double>(rejecting.size()), 0.85 * static_cast<double>(plain.size()));
 }
 
+// Sand waves of 4 m (8 px at 0.5 m) across the track, seen from two anti-parallel lines 60 m apart:
+// each line sees the slopes facing it bright, so the two views are the same pattern with its
+// contrast inverted, and plain ZNCC pairs them half a wavelength (2 m, 4 px) off the truth, every
+// match alike, which the forward-backward and coherence checks cannot see.
+Pair sandWavePair(double wavelength_m, double texture_contrast = 0.3) {
+  Pair pair;
+  pair.line_a.rows = 160;
+  pair.line_a.columns_per_side = 130;
+  pair.line_a.bin_size_m = 0.5;
+  pair.line_a.nadir_bins = 4;
+  pair.line_b = synthetic::secondLine(pair.line_a, Direction::kAntiParallel, 60.0, 2.0);
+  synthetic::Seabed seabed;
+  seabed.seed = 5;
+  seabed.texture_contrast = texture_contrast;
+  seabed.sand_wave_wavelength_m = wavelength_m;
+  synthetic::RenderOptions render_a, render_b;
+  render_a.speckle_seed = 11;
+  render_b.speckle_seed = 12;
+  pair.a = synthetic::render(seabed, pair.line_a, render_a);
+  pair.b = synthetic::render(seabed, pair.line_b, render_b);
+  synthetic::addDrError(pair.b, {0.5, -0.5}, 0.0);
+  return pair;
+}
+
+TEST(DenseMatcher, SandWavesSeenFromOppositeSidesAreNotMatchedHalfAWavelengthOff) {
+  DenseMatcherOptions options;
+  options.patch_size = 13;
+  const Pair pair = sandWavePair(4.0);
+  MatchTimings plain_timings, rejecting_timings;
+  const std::vector<Correspondence> plain = DenseMatcher(options).match(pair.a, pair.b, &plain_timings);
+  options.reject_inverted_relief = true;
+  const std::vector<Correspondence> rejecting = DenseMatcher(options).match(pair.a, pair.b, &rejecting_timings);
+  const synthetic::Evaluation e_plain =
+      synthetic::evaluate(plain, pair.line_a, pair.a, pair.line_b, pair.b, options.stride, options.patch_size, 2.0);
+  const synthetic::Evaluation e_rejecting = synthetic::evaluate(rejecting, pair.line_a, pair.a, pair.line_b, pair.b,
+                                                                options.stride, options.patch_size, 2.0);
+  std::printf("anti-parallel sand waves (4 m): %zu matches, within 2 px %.3f, across-track bias %+.3f m; rejecting "
+              "inverted relief: %zu (%ld dropped), within 2 px %.3f, bias %+.3f m\n",
+              plain.size(), e_plain.withinFraction(), meanAcrossTrackError(plain, pair), rejecting.size(),
+              rejecting_timings.inverted_relief_rejected, e_rejecting.withinFraction(),
+              meanAcrossTrackError(rejecting, pair));
+  EXPECT_EQ(plain_timings.inverted_relief_rejected, 0);
+  ASSERT_GT(plain.size(), 200u);
+  EXPECT_LT(e_plain.withinFraction(), 0.5);  // most matches half a wavelength off
+  EXPECT_GT(rejecting_timings.inverted_relief_rejected, static_cast<long>(plain.size() / 2));
+  // What is left is either right or too little to make a closure from (min_matches: 100).
+  if (rejecting.size() >= 100u) {
+    EXPECT_GT(e_rejecting.withinFraction(), 0.8);
+  }
+}
+
+TEST(DenseMatcher, TextureWithoutSandWavesKeepsMostMatchesWhenRejectingInvertedRelief) {
+  // Reflectivity does not invert; what is lost is chance: a patch of A matching B's inverted
+  // contrast above min_zncc somewhere in the search window.
+  DenseMatcherOptions options;
+  options.patch_size = 13;
+  const Pair pair = sandWavePair(0.0, 1.0);
+  const std::vector<Correspondence> plain = DenseMatcher(options).match(pair.a, pair.b);
+  options.reject_inverted_relief = true;
+  MatchTimings timings;
+  const std::vector<Correspondence> rejecting = DenseMatcher(options).match(pair.a, pair.b, &timings);
+  std::printf("anti-parallel texture without sand waves: %zu matches, %zu when rejecting inverted relief (%ld dropped)\n",
+              plain.size(), rejecting.size(), timings.inverted_relief_rejected);
+  ASSERT_GT(plain.size(), 200u);
+  EXPECT_GE(static_cast<double>(rejecting.size()), 0.8 * static_cast<double>(plain.size()));
+}
+
 // The same boulder field seen at far range from lines 100 m apart, 8 m above the seabed: grazing
 // 9-13 deg over the shared strip, so a boulder's shadow is 4-8 times its height while its lit face
 // stays a pixel or two, as on a survey's outer swath.
