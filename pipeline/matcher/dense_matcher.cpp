@@ -233,7 +233,6 @@ class PatchScorer {
     return masked(sr, sc, tr, tc);
   }
 
-
   float full(int sr, int sc, int tr, int tc) const {
     // Per-column accumulators: independent lanes the compiler vectorises without reordering sums.
     float acc[32] = {};
@@ -607,7 +606,6 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
   const PatchScorer score_mirrored(grid_a, o.reject_mirrored_relief ? grid_b_mirrored : grid_b, half,
                                    o.min_valid_fraction, o.min_patch_stddev);
   runPatchMatch(forward, score_ab, window, grid_rows, grid_cols, half, o, 0x5A5A0001ULL);
-  t.patch_match_s = secondsSince(stage);
 
   // ---- the same nodes against B's contrast inverted, where the looks are opposed --------------
   Field inverted;
@@ -633,6 +631,7 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
       runPatchMatch(inverted, score_inverted, window, grid_rows, grid_cols, half, o, 0x1A1A0003ULL);
     }
   }
+  t.patch_match_s = secondsSince(stage);
 
   // ---- forward-backward consistency, sub-pixel refinement, thresholds ------------------------
   stage = Clock::now();

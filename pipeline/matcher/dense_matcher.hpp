@@ -105,7 +105,7 @@ struct Correspondence {
 struct MatchTimings {
   double kd_tree_s = 0.0;         // building the kd-tree over B's valid geo-referenced pixels
   double initialisation_s = 0.0;  // kd-tree queries and resampling B onto A's pixel grid
-  double patch_match_s = 0.0;     // random search + propagation, forward (A -> B)
+  double patch_match_s = 0.0;     // random search + propagation, forward (A -> B) and inverted
   double consistency_s = 0.0;     // backward PatchMatch (B -> A), FB check, sub-pixel, thresholds
   double total_s = 0.0;
   long overlapping_pixels = 0;    // valid A pixels on the stride grid with a B pixel within reach

@@ -174,27 +174,35 @@ TEST(DenseMatcher, SameMatchesForOneAndTwoThreads) {
   }
 }
 
+// Two anti-parallel lines of 160 pings at 0.5 m pixels (4 nadir bins) over one seabed, speckle
+// seeds 11 and 12, B geo-referenced with a DR error: the pairs of the relief tests below.
+Pair antiParallelHalfMetrePair(const synthetic::Seabed& seabed, int columns_per_side, double line_spacing_m,
+                               double altitude_m, const Eigen::Vector2d& dr_error_b_m) {
+  Pair pair;
+  pair.line_a.rows = 160;
+  pair.line_a.columns_per_side = columns_per_side;
+  pair.line_a.bin_size_m = 0.5;
+  pair.line_a.nadir_bins = 4;
+  pair.line_b = synthetic::secondLine(pair.line_a, Direction::kAntiParallel, line_spacing_m, 2.0);
+  synthetic::RenderOptions render_a, render_b;
+  render_a.speckle_seed = 11;
+  render_b.speckle_seed = 12;
+  render_a.altitude_m = render_b.altitude_m = altitude_m;
+  pair.a = synthetic::render(seabed, pair.line_a, render_a);
+  pair.b = synthetic::render(seabed, pair.line_b, render_b);
+  synthetic::addDrError(pair.b, dr_error_b_m, 0.0);
+  return pair;
+}
+
 // A boulder field seen from two lines: 0.5 m pixels, 65 m per side, lines 60 m apart, 10 m altitude,
 // boulders of 0.6-1.4 m radius (as high), about one per 12 x 12 m (70 per hectare, as the simulator's
 // boulder fields) over the overlap, on faint texture.
 Pair boulderPair(double line_spacing_m, double boulders_east_min_m) {
-  Pair pair;
-  pair.line_a.rows = 160;
-  pair.line_a.columns_per_side = 130;
-  pair.line_a.bin_size_m = 0.5;
-  pair.line_a.nadir_bins = 4;
-  pair.line_b = synthetic::secondLine(pair.line_a, Direction::kAntiParallel, line_spacing_m, 2.0);
   synthetic::Seabed seabed;
   seabed.seed = 5;
   seabed.texture_contrast = 0.4;
   seabed.boulders = synthetic::scatterBoulders(9, {-5.0, boulders_east_min_m}, {85.0, 62.0}, 12.0, 0.6, 1.4);
-  synthetic::RenderOptions render_a, render_b;
-  render_a.speckle_seed = 11;
-  render_b.speckle_seed = 12;
-  pair.a = synthetic::render(seabed, pair.line_a, render_a);
-  pair.b = synthetic::render(seabed, pair.line_b, render_b);
-  synthetic::addDrError(pair.b, {1.0, -1.5}, 0.0);
-  return pair;
+  return antiParallelHalfMetrePair(seabed, 130, line_spacing_m, 10.0, {1.0, -1.5});
 }
 
 // Mean error of the matches' B points along A's starboard axis (towards B): what a closure's
@@ -272,23 +280,11 @@ TEST(DenseMatcher, FlatTextureSeenFromOppositeSidesKeepsItsMatchesWhenRejectingM
 // contrast inverted, and plain ZNCC pairs them half a wavelength (2 m, 4 px) off the truth, every
 // match alike, which the forward-backward and coherence checks cannot see.
 Pair sandWavePair(double wavelength_m, double texture_contrast = 0.3) {
-  Pair pair;
-  pair.line_a.rows = 160;
-  pair.line_a.columns_per_side = 130;
-  pair.line_a.bin_size_m = 0.5;
-  pair.line_a.nadir_bins = 4;
-  pair.line_b = synthetic::secondLine(pair.line_a, Direction::kAntiParallel, 60.0, 2.0);
   synthetic::Seabed seabed;
   seabed.seed = 5;
   seabed.texture_contrast = texture_contrast;
   seabed.sand_wave_wavelength_m = wavelength_m;
-  synthetic::RenderOptions render_a, render_b;
-  render_a.speckle_seed = 11;
-  render_b.speckle_seed = 12;
-  pair.a = synthetic::render(seabed, pair.line_a, render_a);
-  pair.b = synthetic::render(seabed, pair.line_b, render_b);
-  synthetic::addDrError(pair.b, {0.5, -0.5}, 0.0);
-  return pair;
+  return antiParallelHalfMetrePair(seabed, 130, 60.0, 10.0, {0.5, -0.5});
 }
 
 TEST(DenseMatcher, SandWavesSeenFromOppositeSidesAreNotMatchedHalfAWavelengthOff) {
@@ -338,24 +334,11 @@ TEST(DenseMatcher, TextureWithoutSandWavesKeepsMostMatchesWhenRejectingInvertedR
 // 9-13 deg over the shared strip, so a boulder's shadow is 4-8 times its height while its lit face
 // stays a pixel or two, as on a survey's outer swath.
 Pair farRangeBoulderPair() {
-  Pair pair;
-  pair.line_a.rows = 160;
-  pair.line_a.columns_per_side = 140;
-  pair.line_a.bin_size_m = 0.5;
-  pair.line_a.nadir_bins = 4;
-  pair.line_b = synthetic::secondLine(pair.line_a, Direction::kAntiParallel, 100.0, 2.0);
   synthetic::Seabed seabed;
   seabed.seed = 5;
   seabed.texture_contrast = 0.4;
   seabed.boulders = synthetic::scatterBoulders(9, {-5.0, 32.0}, {85.0, 68.0}, 12.0, 0.6, 1.4);
-  synthetic::RenderOptions render_a, render_b;
-  render_a.speckle_seed = 11;
-  render_b.speckle_seed = 12;
-  render_a.altitude_m = render_b.altitude_m = 8.0;
-  pair.a = synthetic::render(seabed, pair.line_a, render_a);
-  pair.b = synthetic::render(seabed, pair.line_b, render_b);
-  synthetic::addDrError(pair.b, {1.0, -1.5}, 0.0);
-  return pair;
+  return antiParallelHalfMetrePair(seabed, 140, 100.0, 8.0, {1.0, -1.5});
 }
 
 TEST(DenseMatcher, ReliefFeaturesAreTheShadowsAndLitFacesNotTheSeabedTexture) {

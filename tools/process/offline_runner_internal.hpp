@@ -162,11 +162,7 @@ class Runner {
     summary_.buffer = buffer_.counters();
     summary_.bottom_track = buffer_.bottomTrackCounters();
     summary_.canonical_swath_m = buffer_.geometry().bins_per_side * buffer_.geometry().bin_size_m;
-    std::vector<int> lines;
-    for (const auto& [line, centre] : centres_) {
-      if (std::find(lines.begin(), lines.end(), line) == lines.end()) lines.push_back(line);
-    }
-    summary_.survey_lines = lines.size();
+    summary_.survey_lines = pings_per_line_.size();
     summary_.short_lines = 0;
     for (const auto& [line, pings] : pings_per_line_)
       if (pings < static_cast<size_t>(options_.buffer.subframes.pings_per_subframe)) ++summary_.short_lines;
