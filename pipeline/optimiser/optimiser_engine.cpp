@@ -75,7 +75,11 @@ Status writeTum(const std::string& path, const std::vector<StampedPose>& poses, 
   return Status::success();
 }
 
-OptimiserEngine::OptimiserEngine(const OptimiserEngineOptions& options) : options_(options), graph_(options.graph) {}
+OptimiserEngine::OptimiserEngine(const OptimiserEngineOptions& options)
+    : options_(options),
+      graph_(options.graph),
+      ins_drift_(InsDriftEstimatorOptions{options.graph.ins_drift_min_distance_m, InsDriftEstimatorOptions{}.min_growth_m,
+                                          options.graph.ins_drift_min_fraction, options.graph.ins_drift_max_fraction}) {}
 
 Status OptimiserEngine::addSubframe(const sss::core::Subframe& subframe) {
   ++counters_.subframes_in;
@@ -335,10 +339,18 @@ size_t OptimiserEngine::memoryBytes() const {
 }
 
 void OptimiserEngine::addNavAccuracy(const NavAccuracy& accuracy) {
-  if (anchor_decided_) return;
   const bool reported = std::isfinite(accuracy.north_std_m) && std::isfinite(accuracy.east_std_m) &&
                         accuracy.north_std_m > 0.0 && accuracy.east_std_m > 0.0;
   if (!reported) return;
+  if (options_.graph.odometry_drift_from_ins) {
+    ins_drift_.add(accuracy.distance_travelled_m, 0.5 * (accuracy.north_std_m + accuracy.east_std_m));
+    const std::optional<double> drift = ins_drift_.driftFraction();
+    const double held = graph_.odometryDriftFraction();
+    if (drift && (counters_.odometry_drift_updates == 0 || std::abs(*drift - held) > kDriftUpdateRatio * held)) {
+      if (graph_.setOdometryDriftFraction(*drift).ok) ++counters_.odometry_drift_updates;
+    }
+  }
+  if (anchor_decided_) return;
   // One per second is plenty (the INS's accuracy changes slowly); 20 min of them at most, oldest
   // dropped: the first subframe's centre is well within that of its last ping.
   constexpr int64_t kSpacingUs = 1'000'000;

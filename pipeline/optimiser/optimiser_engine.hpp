@@ -19,6 +19,7 @@
 #include "pipeline/core/pose.hpp"
 #include "pipeline/core/closure_types.hpp"
 #include "pipeline/optimiser/bathymetry.hpp"
+#include "pipeline/optimiser/ins_drift_estimator.hpp"
 #include "pipeline/optimiser/pose_graph.hpp"
 #include "pipeline/core/subframe_types.hpp"
 
@@ -51,6 +52,8 @@ struct OptimiserEngineCounters {
   uint64_t closures_waiting = 0;       // now waiting for their subframe (filled by counters())
   uint64_t subframes_forgotten = 0;    // ping poses dropped beyond max_stored_subframes
   uint64_t odometer_resets = 0;        // INS odometer went backwards (see addSubframe)
+  uint64_t odometry_drift_updates = 0; // the odometry's drift fraction taken from the INS (addNavAccuracy)
+  double odometry_drift_fraction = 0.0; // the one in use (filled by counters())
 };
 
 // A stamped pose (per-ping trajectories).
@@ -100,9 +103,16 @@ class OptimiserEngine {
   // (SlidingWindowPoseGraph::setFirstNodeHorizontalSigma): how well the INS knew where the survey
   // started. Reports without a value are ignored; before the first node one per second is kept.
   void addNavAccuracy(const NavAccuracy& accuracy);
+  // Every report also feeds the INS's drift rate (InsDriftEstimator): with
+  // odometry_drift_from_ins, the graph's odometry takes it once it qualifies and whenever it
+  // moves by more than kDriftUpdateRatio (OptimiserEngineCounters::odometry_drift_updates).
   static constexpr double kAnchorAccuracyMaxGapS = 30.0;
-  // True once the first node's anchor is decided (further reports are ignored).
+  static constexpr double kDriftUpdateRatio = 0.1;
+  // True once the first node's anchor is decided (further reports only feed the drift rate).
   bool anchorDecided() const { return anchor_decided_; }
+  // The odometry's drift fraction as the graph holds it, and whether it came from the INS.
+  double odometryDriftFraction() const { return graph_.odometryDriftFraction(); }
+  bool odometryDriftFromIns() const { return counters_.odometry_drift_updates > 0; }
 
   // Decides pending closures and solves the window (see SlidingWindowPoseGraph::optimize).
   UpdateReport update();
@@ -141,6 +151,7 @@ class OptimiserEngine {
   OptimiserEngineCounters counters() const {
     OptimiserEngineCounters counters = counters_;
     counters.closures_waiting = waiting_.size();
+    counters.odometry_drift_fraction = graph_.odometryDriftFraction();
     return counters;
   }
   const OptimiserEngineOptions& options() const { return options_; }
@@ -182,6 +193,7 @@ class OptimiserEngine {
   std::map<std::pair<int64_t, int64_t>, StoredCorrespondences> correspondences_;
   std::deque<sss::core::LoopClosure> waiting_;
   std::deque<NavAccuracy> start_accuracy_;  // INS accuracy reports until the anchor is decided
+  InsDriftEstimator ins_drift_;             // the INS's drift rate from every report (odometry_drift_from_ins)
   bool anchor_decided_ = false;
   int64_t newest_subframe_id_ = -1;
   bool new_input_ = false;

@@ -25,6 +25,9 @@ void setStatusCounters(const OptimiserWorkerStatus& status, sss::core::HealthMon
   health.setCounter("closures_waiting", static_cast<double>(engine.closures_waiting));
   health.setCounter("subframes_refused", static_cast<double>(engine.subframes_refused));
   health.setCounter("odometer_resets", static_cast<double>(engine.odometer_resets));
+  // The odometry's drift per metre, per axis: the INS's reported one once it qualified (updates > 0).
+  health.setCounter("odometry_drift_fraction", engine.odometry_drift_fraction);
+  health.setCounter("odometry_drift_updates", static_cast<double>(engine.odometry_drift_updates));
   health.setCounter("fixes_received", static_cast<double>(fixes.received));
   health.setCounter("fixes_accepted", static_cast<double>(fixes.accepted));
   health.setCounter("fixes_rejected", static_cast<double>(fixes.rejected_gate + fixes.refused));
@@ -88,7 +91,7 @@ void OptimiserWorker::addFix(AbsoluteFix fix) {
 
 void OptimiserWorker::addNavAccuracy(const NavAccuracy& accuracy) {
   std::lock_guard<std::mutex> lock(mutex_);
-  if (anchor_decided_ || (last_nav_accuracy_us_ >= 0 && accuracy.utime_us < last_nav_accuracy_us_ + 1'000'000)) return;
+  if (last_nav_accuracy_us_ >= 0 && accuracy.utime_us < last_nav_accuracy_us_ + 1'000'000) return;
   last_nav_accuracy_us_ = accuracy.utime_us;
   queued_.nav_accuracy.push_back(accuracy);  // no wake: it waits for the next subframe or closure
 }
@@ -197,10 +200,6 @@ void OptimiserWorker::run() {
     }
     std::vector<std::string> messages;
     take(batch, messages);
-    if (engine_.anchorDecided()) {
-      std::lock_guard<std::mutex> lock(mutex_);
-      anchor_decided_ = true;
-    }
     const double now_s = 1e-6 * static_cast<double>(sss::core::monotonicUtime());
     bool updated = false;
     if (batch.products) {

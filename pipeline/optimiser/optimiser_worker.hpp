@@ -83,7 +83,7 @@ class OptimiserWorker {
   void addLoopClosure(sss::core::LoopClosure closure);
   void addFix(AbsoluteFix fix);
   // The INS's reported accuracy (OptimiserEngine::addNavAccuracy); nav comes at up to 200 Hz, so at
-  // most one per second is queued, and none once the engine has decided the first node's anchor.
+  // most one per second is queued (the anchor, then the INS's drift rate).
   void addNavAccuracy(const NavAccuracy& accuracy);
   void requestProducts();
   // The navigation's origin (SSS_NAV), which geo-references the products.
@@ -124,7 +124,6 @@ class OptimiserWorker {
   bool stop_ = false;
   std::optional<sss::core::MissionOrigin> origin_;
   int64_t last_nav_accuracy_us_ = -1;  // of the last one queued
-  bool anchor_decided_ = false;        // the engine's, as of its last batch
   std::shared_ptr<const SlidingWindowPoseGraph> snapshot_;
   OptimiserWorkerResults results_;
   std::thread thread_;

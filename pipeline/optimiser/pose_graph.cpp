@@ -212,6 +212,15 @@ Status SlidingWindowPoseGraph::setFirstNodeHorizontalSigma(double north_m, doubl
   return Status::success();
 }
 
+Status SlidingWindowPoseGraph::setOdometryDriftFraction(double fraction) {
+  if (!(std::isfinite(fraction) && fraction >= 0.0))
+    return Status::error("odometry drift fraction must be finite and >= 0 (" + std::to_string(fraction) +
+                         "); the odometry keeps " + std::to_string(options_.odometry_drift_fraction));
+  options_.odometry_drift_fraction = fraction;
+  for (size_t k = 1; k < nodes_.size(); ++k) setupDerived(nodes_[k], &nodes_[k - 1]);
+  return Status::success();
+}
+
 Status SlidingWindowPoseGraph::addLoopClosure(const LoopClosure& closure) {
   ++counters_.closures_received;
   const std::string name =

@@ -48,6 +48,14 @@ struct PoseGraphOptions {
   double odometry_heading_random_walk_rad_per_sqrt_m = 2e-4;  // 0.002 rad (0.11 deg) per 100 m
   double odometry_min_heading_sigma_rad = 1e-4;
   double odometry_attitude_sigma_rad = 0.002;
+  // The drift fraction from the INS's own reported position accuracy: its growth per metre travelled
+  // since its last aiding (InsDriftEstimator, fed by OptimiserEngine::addNavAccuracy), once it has
+  // grown over ins_drift_min_distance_m; odometry_drift_fraction until then, and for navigation
+  // that reports no accuracy (files with the position in the ping headers). Clamped to the range.
+  bool odometry_drift_from_ins = true;
+  double ins_drift_min_distance_m = 300.0;
+  double ins_drift_min_fraction = 0.0005;
+  double ins_drift_max_fraction = 0.02;
 
   // ---- absolute INS measurements of every node (0 switches one off) -------------------------------
   // Depth, roll, pitch and heading are measured against absolute references (pressure, gravity,
@@ -201,6 +209,7 @@ struct NavAccuracy {
   int64_t utime_us = 0;
   double north_std_m = 0.0;
   double east_std_m = 0.0;
+  double distance_travelled_m = std::numeric_limits<double>::quiet_NaN();  // the INS odometer (NaN: unknown)
 };
 
 // An absolute horizontal position fix in the local NED world (GNSS at the surface, USBL).
@@ -383,6 +392,12 @@ class SlidingWindowPoseGraph {
   // The anchor's 1-sigma north and east as held: first_node_sigma_m, or the INS's sigma where wider
   // and first_node_sigma_from_ins is on.
   Eigen::Vector2d firstNodeHorizontalSigma() const;
+  // The odometry's drift fraction (per axis, of the distance between nodes) from now on, e.g. the
+  // INS's reported drift (odometry_drift_from_ins). Every stored edge's odometry information is
+  // rebuilt with it; a marginalisation prior already formed keeps what it was built with. Refused
+  // unless finite and >= 0.
+  Status setOdometryDriftFraction(double fraction);
+  double odometryDriftFraction() const { return options_.odometry_drift_fraction; }
   // Queues a closure for the next optimize(); refused (with the reason) when an id is unknown, the
   // input is not finite, the covariance is not positive definite or it has too few inliers. A
   // closure to a marginalised node acts through that node held constant (see pose_graph.cpp); one

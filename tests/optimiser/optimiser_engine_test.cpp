@@ -452,5 +452,45 @@ TEST(OptimiserEngineAnchor, TheInsAccuracyNearestTheFirstNodeWidensItsAnchor) {
   }
 }
 
+// ---- the odometry's drift from the INS's reported accuracy ----------------------------------------
+
+// An INS whose reported sigma grows by 0.08 % of the distance (a better one than the configured
+// 0.5 %): the graph's odometry takes its rate once 300 m are behind it, and holds it while the
+// rate stays within 10 %; a jittery report that moves it by less is not an update. Off, or with
+// reports that carry no distance, the configured fraction stays.
+TEST(OptimiserEngineInsDrift, TheOdometryTakesTheDriftTheInsReports) {
+  const double configured = engineOptions().graph.odometry_drift_fraction;
+  {
+    OptimiserEngine engine(engineOptions());
+    int64_t t_us = 1'000'000'000'000;
+    for (double d = 0.0; d <= 250.0; d += 2.0, t_us += 1'000'000)
+      engine.addNavAccuracy({t_us, 0.5 + 0.0008 * d, 0.5 + 0.0008 * d, d});
+    EXPECT_DOUBLE_EQ(engine.odometryDriftFraction(), configured);
+    EXPECT_FALSE(engine.odometryDriftFromIns());
+    for (double d = 252.0; d <= 1200.0; d += 2.0, t_us += 1'000'000) {
+      const double jitter_m = (static_cast<int>(d) % 4 == 0 ? 0.01 : -0.01);
+      engine.addNavAccuracy({t_us, 0.5 + 0.0008 * d + jitter_m, 0.5 + 0.0008 * d + jitter_m, d});
+    }
+    EXPECT_TRUE(engine.odometryDriftFromIns());
+    EXPECT_NEAR(engine.odometryDriftFraction(), 0.0008, 0.0001);
+    EXPECT_EQ(engine.counters().odometry_drift_updates, 1u);
+    EXPECT_DOUBLE_EQ(engine.counters().odometry_drift_fraction, engine.odometryDriftFraction());
+  }
+  {
+    OptimiserEngineOptions options = engineOptions();
+    options.graph.odometry_drift_from_ins = false;
+    OptimiserEngine engine(options);
+    OptimiserEngine without_distance(engineOptions());
+    int64_t t_us = 1'000'000'000'000;
+    for (double d = 0.0; d <= 1200.0; d += 2.0, t_us += 1'000'000) {
+      engine.addNavAccuracy({t_us, 0.5 + 0.0008 * d, 0.5 + 0.0008 * d, d});
+      without_distance.addNavAccuracy({t_us, 0.5 + 0.0008 * d, 0.5 + 0.0008 * d});
+    }
+    EXPECT_DOUBLE_EQ(engine.odometryDriftFraction(), configured);
+    EXPECT_DOUBLE_EQ(without_distance.odometryDriftFraction(), configured);
+    EXPECT_FALSE(without_distance.odometryDriftFromIns());
+  }
+}
+
 }  // namespace
 }  // namespace sss::optimiser

@@ -9,6 +9,8 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <unistd.h>
@@ -35,6 +37,57 @@ TEST(PoseGraphOdometryModel, GrowsWithDistanceInTheHorizontalAndHeadingOnly) {
   EXPECT_DOUBLE_EQ(c100(3, 3), c400(3, 3));  // roll and pitch: absolute against gravity
   EXPECT_NEAR(c400(5, 5) / c100(5, 5), 4.0, 0.01);  // heading random walk
   EXPECT_TRUE(c100.isDiagonal());
+}
+
+// The drift fraction set on a graph that already holds its nodes (the INS's reported drift arrives
+// after the first few hundred metres) rebuilds every edge: the same estimates as a graph
+// configured with it from the start. And it is what decides how far closures bend DR: the same
+// closures, 2 m off across track, move the nodes less against a DR of 0.05 % than of 0.2 %.
+TEST(PoseGraphOdometryModel, DriftFractionSetLaterRebuildsTheEdgesAndWeighsDrAgainstClosures) {
+  const synthetic::Mission mission = synthetic::makeLawnmowerMission(missionOptions(2));
+  auto solve = [&](double configured, std::optional<double> later) {
+    PoseGraphOptions options = graphOptions(40);  // the whole mission in the window
+    options.odometry_drift_fraction = configured;
+    options.odometry_random_walk_m_per_sqrt_m = 0.002;  // the drift fraction dominates the turns' edges
+    SlidingWindowPoseGraph graph(options);
+    for (const synthetic::Node& n : mission.nodes) EXPECT_TRUE(graph.addNode(n.subframe_id, n.utime_us, n.dr, n.distance_m).ok);
+    if (later) {
+      EXPECT_TRUE(graph.setOdometryDriftFraction(*later).ok);
+      EXPECT_DOUBLE_EQ(graph.odometryDriftFraction(), *later);
+    }
+    for (const synthetic::Closure& c : mission.closures) {
+      LoopClosure closure = c.closure;
+      // DR's own relative pose, shifted 2 m across track: a closure set that disagrees with DR.
+      auto node = [&](int64_t id) {
+        return *std::find_if(mission.nodes.begin(), mission.nodes.end(),
+                             [&](const synthetic::Node& n) { return n.subframe_id == id; });
+      };
+      const synthetic::Node a = node(closure.subframe_id_a);
+      const synthetic::Node b = node(closure.subframe_id_b);
+      closure.T_a_b = sss::core::between(a.dr, b.dr);
+      closure.T_a_b.translation.y() += 2.0;
+      closure.covariance = Matrix6d::Identity();
+      closure.covariance.bottomRightCorner<3, 3>() = 1e-4 * Eigen::Matrix3d::Identity();
+      EXPECT_TRUE(graph.addLoopClosure(closure).ok);
+    }
+    EXPECT_TRUE(graph.optimize().ok);
+    double moved_m = 0.0;
+    for (size_t i = 0; i < mission.nodes.size(); ++i)
+      moved_m = std::max(moved_m, (graph.nodes()[i].T_world_body.translation - mission.nodes[i].dr.translation).norm());
+    return std::make_pair(estimates(graph), moved_m);
+  };
+  const auto [set_later, moved_tight] = solve(0.002, 0.0005);
+  const auto [configured, moved_configured] = solve(0.0005, std::nullopt);
+  ASSERT_EQ(set_later.size(), configured.size());
+  for (size_t i = 0; i < set_later.size(); ++i)
+    EXPECT_NEAR((set_later[i].translation - configured[i].translation).norm(), 0.0, 1e-6) << i;
+  const auto [unused, moved_loose] = solve(0.002, std::nullopt);
+  std::printf("largest move of a node from DR under closures 2 m off: %.2f m (drift 0.05 %%), %.2f m (0.2 %%)\n",
+              moved_tight, moved_loose);
+  EXPECT_LT(moved_tight, 0.6 * moved_loose);
+  SlidingWindowPoseGraph graph(graphOptions());
+  EXPECT_FALSE(graph.setOdometryDriftFraction(-0.001).ok);
+  EXPECT_FALSE(graph.setOdometryDriftFraction(std::numeric_limits<double>::quiet_NaN()).ok);
 }
 
 TEST(PoseGraph, WithoutClosuresTheEstimateIsDr) {

@@ -520,11 +520,17 @@ TEST_F(OfflineRunnerTest, GnssAndUsblFixesBoundTheDriftAndNoOutlierIsAccepted) {
   ASSERT_TRUE(result.ok) << result.error;
   const sss::offline::FixSummary& f = result.summary.fixes;
   // The survey's anchor is as loose as the INS said its position was at the first subframe's centre
-  // (the simulated INS reports 0.5 m + 0.3 % of the distance run), so the fixes may move the start.
+  // (the simulated INS reports 0.5 m + 0.2 % x drift scale of the distance run), so the fixes may
+  // move the start.
   EXPECT_GT(result.summary.anchor_ins_sigma_ne_m.x(), 0.5);
   EXPECT_LT(result.summary.anchor_ins_sigma_ne_m.x(), 1.5);
   EXPECT_EQ(result.summary.anchor_ins_sigma_ne_m.x(), result.summary.anchor_ins_sigma_ne_m.y());
   EXPECT_EQ(result.summary.anchor_sigma_ne_m, result.summary.anchor_ins_sigma_ne_m);  // wider than 0.1 m
+  // The odometry drifts as fast as that INS says (0.6 % of the distance: through STDPOS in
+  // ins.nmea, the INS bridge's parser and the odometer), not the configured fraction.
+  EXPECT_GE(result.summary.odometry_drift_updates, 1u);
+  EXPECT_NEAR(result.summary.odometry_drift_fraction, 0.006, 0.0002);
+  EXPECT_NE(result.summary.odometry_drift_fraction_configured, result.summary.odometry_drift_fraction);
   EXPECT_EQ(f.files, 1u);
   EXPECT_GE(f.gnss, 6u);   // 20 s at the surface at either end, one every 5 s
   EXPECT_GE(f.usbl, 10u);  // ~25 of 30 s over a ~15 min dive

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 namespace sss::sim {
 namespace {
@@ -104,6 +105,37 @@ TEST(DeadReckoning, DriftScaleMultipliesTheError) {
   const double ratio = finalError(scaled, line.trajectory, duration) / finalError(base, line.trajectory, duration);
   // Linear in the error constants; the random walk and white noise add a few percent.
   EXPECT_NEAR(ratio, 3.0, 0.3);
+}
+
+// The INS reports its class, not the errors it drew: its position sigma grows by
+// reported_drift_fraction x drift_scale per metre, and over many seeds that is the rms error per
+// axis per metre the drawn scale factors and heading errors give (so a graph that takes the INS's
+// word is neither too stiff nor too loose on average).
+TEST(DeadReckoning, ReportedAccuracyIsTheRmsOfTheDrawnErrors) {
+  const StraightLine line;
+  const double duration = line.trajectory.durationS();
+  for (const double drift_scale : {1.0, 3.0}) {
+    double sum_squared = 0.0;
+    const int seeds = 40;
+    double reported_growth = 0.0;
+    for (int seed = 1; seed <= seeds; ++seed) {
+      DeadReckoningOptions options;
+      options.seed = static_cast<uint64_t>(seed);
+      options.drift_scale = drift_scale;
+      const DeadReckoning dr(options, line.trajectory, duration);
+      const double ratio = finalError(dr, line.trajectory, duration) / dr.distanceTravelledM();
+      sum_squared += 0.5 * ratio * ratio;  // per axis
+      const auto& samples = dr.samples();
+      reported_growth = (samples.back().position_std_m - samples.front().position_std_m) / dr.distanceTravelledM();
+      EXPECT_DOUBLE_EQ(samples.front().position_std_m, options.reported_start_std_m);
+    }
+    const double rms_per_axis = std::sqrt(sum_squared / seeds);
+    std::printf("drift_scale %.0f: rms error per axis %.5f of the distance, reported %.5f\n", drift_scale, rms_per_axis,
+                reported_growth);
+    EXPECT_NEAR(reported_growth, drift_scale * DeadReckoningOptions{}.reported_drift_fraction, 1e-6);
+    EXPECT_GT(rms_per_axis, 0.7 * reported_growth);
+    EXPECT_LT(rms_per_axis, 1.3 * reported_growth);
+  }
 }
 
 TEST(DeadReckoning, HeadingNoiseErrorGrowsWithItsStd) {

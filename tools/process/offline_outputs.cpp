@@ -41,8 +41,9 @@ Status Runner::writeFixOutputs(const std::string& dir) {
   if (std::fclose(f) != 0) return Status::error("cannot write " + csv_path);
 
   sss::optimiser::SlidingWindowPoseGraph fixed(options_.optimiser.graph);
-  // The same anchor as the SLAM graph (the INS's accuracy at the first node), so the baseline
-  // differs from SLAM by the closures alone.
+  // The same odometry as the SLAM graph (the INS's drift when it reported one), the same anchor
+  // (the INS's accuracy at the first node): the baseline differs from SLAM by the closures alone.
+  if (const Status drift = fixed.setOdometryDriftFraction(graph.odometryDriftFraction()); !drift) return drift;
   const Eigen::Vector2d& anchor_ins_sigma_ne_m = graph.firstNodeInsSigma();
   // The SLAM graph took this anchor, nodes and fixes, so a refusal here is a bug, not bad input.
   if (anchor_ins_sigma_ne_m.x() > 0.0 || anchor_ins_sigma_ne_m.y() > 0.0) {
@@ -230,6 +231,9 @@ Status Runner::writeOutputs() {
   summary_.calibration = optimiser_.graph().calibration();
   summary_.anchor_ins_sigma_ne_m = optimiser_.graph().firstNodeInsSigma();
   summary_.anchor_sigma_ne_m = optimiser_.graph().firstNodeHorizontalSigma();
+  summary_.odometry_drift_fraction = optimiser_.odometryDriftFraction();
+  summary_.odometry_drift_fraction_configured = options_.optimiser.graph.odometry_drift_fraction;
+  summary_.odometry_drift_updates = optimiser_.counters().odometry_drift_updates;
 
   // Bathymetry: SLAM poses (the product) and DR poses (the baseline the map error is compared to).
   const auto& bathymetry = options_.optimiser.bathymetry;

@@ -102,6 +102,11 @@ struct OfflineSummary {
   // The anchor's 1-sigma north and east as the graph held it (first_node_sigma_m, or the INS's
   // accuracy where wider and first_node_sigma_from_ins is on).
   Eigen::Vector2d anchor_sigma_ne_m = Eigen::Vector2d::Zero();
+  // The odometry's drift fraction the graph ended with (per axis, of the distance between nodes):
+  // the INS's own reported drift when odometry_drift_updates > 0, else the configured one.
+  double odometry_drift_fraction = 0.0;
+  double odometry_drift_fraction_configured = 0.0;
+  uint64_t odometry_drift_updates = 0;
   // Seabed seen by the subframes under the SLAM poses (coverage.yaml), and by two lines or more.
   double coverage_covered_m2 = 0.0;
   double coverage_seen_twice_m2 = 0.0;

@@ -329,6 +329,13 @@ sss::core::Status writeSummaryJson(const std::string& path, const OfflineRequest
   anchor_json["ins_position_sigma_east_m"] = jsonValue(s.anchor_ins_sigma_ne_m(1), 4);
   anchor_json["sigma_north_m"] = jsonValue(s.anchor_sigma_ne_m(0), 4);
   anchor_json["sigma_east_m"] = jsonValue(s.anchor_sigma_ne_m(1), 4);
+  // The odometry's drift per metre travelled: the INS's own (from the growth of its reported
+  // position accuracy) when it reported one, else the configured odometry_drift_fraction.
+  Json& odometry_json = (json["odometry"] = Json::object());
+  odometry_json["drift_fraction"] = jsonValue(s.odometry_drift_fraction, 6);
+  odometry_json["drift_from_ins"] = s.odometry_drift_updates > 0;
+  odometry_json["drift_updates"] = jsonValue(s.odometry_drift_updates);
+  odometry_json["configured_drift_fraction"] = jsonValue(s.odometry_drift_fraction_configured, 6);
   Json& lines_json = (json["lines"] = Json::object());
   lines_json["survey_lines"] = jsonValue(s.survey_lines);
   lines_json["short_lines"] = jsonValue(s.short_lines);

@@ -78,7 +78,7 @@ DeadReckoning::DeadReckoning(const DeadReckoningOptions& options, const Trajecto
       nav.velocity_world_m_s = velocity_world;
       distance_m_ += truth.velocity_world_m_s.head<2>().norm() * dt;
     }
-    nav.position_std_m = 0.5 + 0.003 * distance_m_;
+    nav.position_std_m = options.reported_start_std_m + k * options.reported_drift_fraction * distance_m_;
     samples_.push_back(nav);
     heading_walk += k * options.heading_random_walk_rad_per_sqrt_s * std::sqrt(dt) * gauss(rng);
   }

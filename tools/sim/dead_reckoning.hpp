@@ -36,6 +36,14 @@ struct DeadReckoningOptions {
   // drift_scale.
   double heading_noise_rad = 0.0;
   double heading_noise_interval_s = 0.25;      // one ping at 4 Hz, as the paper's per-ping DR
+  // The accuracy the INS reports (STDPOS, STDHRP): its specification for the error ranges above,
+  // scaled like them by drift_scale (an INS knows its own class, not the errors it drew): the
+  // start's reported_start_std_m (the GNSS it was initialised from) growing per axis by
+  // reported_drift_fraction of the distance travelled (the rms of the scale factor and heading
+  // errors drawn above, ~0.002), and reported_heading_std_rad.
+  double reported_start_std_m = 0.5;
+  double reported_drift_fraction = 0.002;
+  double reported_heading_std_rad = 0.002;
 };
 
 struct NavSample {

@@ -198,7 +198,8 @@ std::string insNmeaStream(const Mission& mission) {
     state.depth_std_m = 0.05;
     state.roll_std_rad = 0.0003;
     state.pitch_std_rad = 0.0003;
-    state.heading_std_rad = 0.002;
+    const DeadReckoningOptions& dr = mission.options().dead_reckoning;
+    state.heading_std_rad = dr.drift_scale * dr.reported_heading_std_rad;
     state.velocity_north_std_m_s = 0.01;
     state.velocity_east_std_m_s = 0.01;
     state.velocity_down_std_m_s = 0.01;

@@ -126,6 +126,9 @@ void readSimOptions(sss::core::ConfigSection section, SimOptions& o) {
   dr.optional("depth_noise_m", d.depth_noise_m, {inRange(0.0, 10.0)});
   dr.optional("heading_noise_rad", d.heading_noise_rad, {inRange(0.0, 1.0)});
   dr.optional("heading_noise_interval_s", d.heading_noise_interval_s, {inRange(0.01, 100.0)});
+  dr.optional("reported_start_std_m", d.reported_start_std_m, {inRange(0.0, 1000.0)});
+  dr.optional("reported_drift_fraction", d.reported_drift_fraction, {inRange(0.0, 1.0)});
+  dr.optional("reported_heading_std_rad", d.reported_heading_std_rad, {inRange(0.0, 1.0)});
   dr.rejectUnknownKeys();
 
   sss::core::ConfigSection sonar = subsection(section, "sonar");
@@ -294,7 +297,9 @@ std::string simOptionsYaml(const SimOptions& o) {
       << "attitude_noise_rad" << YAML::Value << d.attitude_noise_rad << YAML::Key << "attitude_bias_rad" << YAML::Value
       << d.attitude_bias_rad << YAML::Key << "depth_noise_m" << YAML::Value << d.depth_noise_m << YAML::Key
       << "heading_noise_rad" << YAML::Value << d.heading_noise_rad << YAML::Key << "heading_noise_interval_s" << YAML::Value
-      << d.heading_noise_interval_s;
+      << d.heading_noise_interval_s << YAML::Key << "reported_start_std_m" << YAML::Value << d.reported_start_std_m
+      << YAML::Key << "reported_drift_fraction" << YAML::Value << d.reported_drift_fraction << YAML::Key
+      << "reported_heading_std_rad" << YAML::Value << d.reported_heading_std_rad;
   out << YAML::EndMap;
   const SonarOptions& n = o.sonar;
   out << YAML::Key << "sonar" << YAML::Value << YAML::BeginMap;
