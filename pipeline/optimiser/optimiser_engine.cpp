@@ -78,8 +78,7 @@ Status writeTum(const std::string& path, const std::vector<StampedPose>& poses, 
 OptimiserEngine::OptimiserEngine(const OptimiserEngineOptions& options)
     : options_(options),
       graph_(options.graph),
-      ins_drift_(InsDriftEstimatorOptions{options.graph.ins_drift_min_distance_m, InsDriftEstimatorOptions{}.min_growth_m,
-                                          options.graph.ins_drift_min_fraction, options.graph.ins_drift_max_fraction}) {}
+      ins_drift_(options.graph.ins_drift) {}
 
 Status OptimiserEngine::addSubframe(const sss::core::Subframe& subframe) {
   ++counters_.subframes_in;

@@ -19,7 +19,6 @@
 #include "pipeline/core/pose.hpp"
 #include "pipeline/core/closure_types.hpp"
 #include "pipeline/optimiser/bathymetry.hpp"
-#include "pipeline/optimiser/ins_drift_estimator.hpp"
 #include "pipeline/optimiser/pose_graph.hpp"
 #include "pipeline/core/subframe_types.hpp"
 

@@ -83,7 +83,7 @@ std::optional<CorrectedPose> OptimiserService::addNav(const sss_msgs::nav_t& mes
                                                       sss::core::ServiceLog& log) {
   const sss::core::NavSample nav = sss::messages::fromNavMessage(message);
   const NavCorrection answer = corrector_.correct(nav, *worker_.snapshot());
-  if (nav.position_valid) worker_.addNavAccuracy({nav.utime_us, nav.position_std_north_m, nav.position_std_east_m, nav.distance_travelled_m});
+  if (nav.position_valid) worker_.addNavAccuracy(navAccuracyOf(nav));
   if (answer.verdict == NavVerdict::kBadSample) {
     if (health.recordError("bad_nav", "nav sample with non-finite pose or no time", sss::core::nowUtime()))
       log.warnings.push_back("nav sample rejected (non-finite pose or no time); further ones are counted in SSS_STATUS");

@@ -18,7 +18,9 @@
 
 #include "pipeline/core/config.hpp"
 #include "pipeline/core/pose.hpp"
+#include "pipeline/core/sensor_types.hpp"
 #include "pipeline/core/status.hpp"
+#include "pipeline/optimiser/ins_drift_estimator.hpp"
 
 namespace ceres {
 class CostFunction;
@@ -49,13 +51,11 @@ struct PoseGraphOptions {
   double odometry_min_heading_sigma_rad = 1e-4;
   double odometry_attitude_sigma_rad = 0.002;
   // The drift fraction from the INS's own reported position accuracy: its growth per metre travelled
-  // since its last aiding (InsDriftEstimator, fed by OptimiserEngine::addNavAccuracy), once it has
-  // grown over ins_drift_min_distance_m; odometry_drift_fraction until then, and for navigation
-  // that reports no accuracy (files with the position in the ping headers). Clamped to the range.
+  // since its last aiding (InsDriftEstimator, fed by OptimiserEngine::addNavAccuracy), once it
+  // qualifies (ins_drift); odometry_drift_fraction until then, and for navigation that reports no
+  // accuracy (files with the position in the ping headers).
   bool odometry_drift_from_ins = true;
-  double ins_drift_min_distance_m = 300.0;
-  double ins_drift_min_fraction = 0.0005;
-  double ins_drift_max_fraction = 0.02;
+  InsDriftEstimatorOptions ins_drift;
 
   // ---- absolute INS measurements of every node (0 switches one off) -------------------------------
   // Depth, roll, pitch and heading are measured against absolute references (pressure, gravity,
@@ -211,6 +211,10 @@ struct NavAccuracy {
   double east_std_m = 0.0;
   double distance_travelled_m = std::numeric_limits<double>::quiet_NaN();  // the INS odometer (NaN: unknown)
 };
+// What a navigation sample reports of its accuracy.
+inline NavAccuracy navAccuracyOf(const sss::core::NavSample& nav) {
+  return {nav.utime_us, nav.position_std_north_m, nav.position_std_east_m, nav.distance_travelled_m};
+}
 
 // An absolute horizontal position fix in the local NED world (GNSS at the surface, USBL).
 struct AbsoluteFix {

@@ -84,12 +84,13 @@ void readPoseGraphOptions(sss::core::ConfigSection& section, PoseGraphOptions& o
   section.optional("odometry_min_heading_sigma_rad", options.odometry_min_heading_sigma_rad, {greaterThan(0.0)});
   section.optional("odometry_attitude_sigma_rad", options.odometry_attitude_sigma_rad, {greaterThan(0.0)});
   section.optional("odometry_drift_from_ins", options.odometry_drift_from_ins);
-  section.optional("ins_drift_min_distance_m", options.ins_drift_min_distance_m, {inRange(1.0, 1e6)});
-  section.optional("ins_drift_min_fraction", options.ins_drift_min_fraction, {inRange(0.0, 1.0)});
-  section.optional("ins_drift_max_fraction", options.ins_drift_max_fraction, {inRange(0.0, 1.0)});
-  if (options.ins_drift_min_fraction > options.ins_drift_max_fraction)
-    section.addProblem("ins_drift_min_fraction", std::to_string(options.ins_drift_min_fraction),
-                       "must not exceed ins_drift_max_fraction (" + std::to_string(options.ins_drift_max_fraction) + ")");
+  InsDriftEstimatorOptions& drift = options.ins_drift;
+  section.optional("ins_drift_min_distance_m", drift.min_distance_m, {inRange(1.0, 1e6)});
+  section.optional("ins_drift_min_fraction", drift.min_fraction, {inRange(0.0, 1.0)});
+  section.optional("ins_drift_max_fraction", drift.max_fraction, {inRange(0.0, 1.0)});
+  if (drift.min_fraction > drift.max_fraction)
+    section.addProblem("ins_drift_min_fraction", std::to_string(drift.min_fraction),
+                       "must not exceed ins_drift_max_fraction (" + std::to_string(drift.max_fraction) + ")");
   section.optional("absolute_depth_sigma_m", options.absolute_depth_sigma_m, {atLeast(0.0)});
   section.optional("absolute_roll_pitch_sigma_rad", options.absolute_roll_pitch_sigma_rad, {atLeast(0.0)});
   section.optional("absolute_heading_sigma_rad", options.absolute_heading_sigma_rad, {atLeast(0.0)});

@@ -50,7 +50,8 @@ TEST(PoseGraphOdometryModel, DriftFractionSetLaterRebuildsTheEdgesAndWeighsDrAga
     options.odometry_drift_fraction = configured;
     options.odometry_random_walk_m_per_sqrt_m = 0.002;  // the drift fraction dominates the turns' edges
     SlidingWindowPoseGraph graph(options);
-    for (const synthetic::Node& n : mission.nodes) EXPECT_TRUE(graph.addNode(n.subframe_id, n.utime_us, n.dr, n.distance_m).ok);
+    for (const synthetic::Node& n : mission.nodes)
+      EXPECT_TRUE(graph.addNode(n.subframe_id, n.utime_us, n.dr, n.distance_m).ok);
     if (later) {
       EXPECT_TRUE(graph.setOdometryDriftFraction(*later).ok);
       EXPECT_DOUBLE_EQ(graph.odometryDriftFraction(), *later);

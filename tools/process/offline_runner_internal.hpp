@@ -83,7 +83,7 @@ class Runner {
     buffer_.addNav(nav, subframes_);
     handleSubframes();
     if (nav.position_valid) fix_aligner_.addNav(nav.utime_us, nav.position_ned_m, nav.distance_travelled_m, nav.origin);
-    if (nav.position_valid) optimiser_.addNavAccuracy({nav.utime_us, nav.position_std_north_m, nav.position_std_east_m, nav.distance_travelled_m});
+    if (nav.position_valid) optimiser_.addNavAccuracy(sss::optimiser::navAccuracyOf(nav));
     feedFixes(false);
   }
 
