@@ -23,6 +23,17 @@ struct InsDriftEstimatorOptions {
   double max_fraction = 0.02;
 };
 
+// What the estimator has learnt, as a checkpoint keeps it (the engine's checkpoint stores it, so a
+// restarted optimiser does not wait for another 300 m of drift).
+struct InsDriftState {
+  bool started = false;
+  double min_distance_m = 0.0;  // odometer and sigma at the stretch's start (the sigma's minimum)
+  double min_sigma_m = 0.0;
+  double last_distance_m = 0.0;
+  std::optional<double> estimate;
+  int reports = 0;
+};
+
 // Feed it the INS's reports in time order; it tracks the sigma's growth since its last minimum.
 class InsDriftEstimator {
  public:
@@ -34,17 +45,17 @@ class InsDriftEstimator {
 
   // The drift fraction: the newest stretch's growth over its distance, once one qualified (then
   // kept until a newer stretch qualifies: after an aiding the INS first has to drift again).
-  std::optional<double> driftFraction() const { return estimate_; }
-  int reports() const { return reports_; }
+  std::optional<double> driftFraction() const { return state_.estimate; }
+  int reports() const { return state_.reports; }
+
+  const InsDriftState& state() const { return state_; }
+  // From a checkpoint: false (and nothing changed) when a value is not finite or negative; the
+  // estimate is clamped to this estimator's range (the configuration may have changed since).
+  bool restore(const InsDriftState& state);
 
  private:
   InsDriftEstimatorOptions options_;
-  bool started_ = false;
-  double min_distance_m_ = 0.0;  // odometer and sigma at the stretch's start (the sigma's minimum)
-  double min_sigma_m_ = 0.0;
-  double last_distance_m_ = 0.0;
-  std::optional<double> estimate_;
-  int reports_ = 0;
+  InsDriftState state_;
 };
 
 }  // namespace sss::optimiser

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -36,8 +37,10 @@ namespace {
 
 constexpr const char* kMagic = "sss-optimiser-checkpoint";
 // 1 was the pose graph's checkpoint alone ("sss-pose-graph-checkpoint 1"), without ping poses and
-// correspondences; 2 adds them (journal), the waiting closures, the odometer and the engine counters.
-constexpr int kVersion = 2;
+// correspondences; 2 adds them (journal), the waiting closures, the odometer and the engine counters;
+// 3 adds the INS's drift rate (InsDriftEstimator) and the odometry drift fraction the graph took from
+// it. A version 2 file restores with the configured fraction (the rate is learnt again).
+constexpr int kVersion = 3;
 constexpr const char* kGraphOnlyMagic = "sss-pose-graph-checkpoint";
 constexpr size_t kMaxFileBytes = size_t{1} << 31;  // 2 GiB: far above any mission
 
@@ -229,6 +232,17 @@ Status OptimiserEngine::saveCheckpoint(const std::string& path) {
   w.real(odometer_offset_m_);
   w.real(last_input_distance_m_);
   w.endLine();
+  const InsDriftState& drift = ins_drift_.state();
+  w.word("ins_drift");
+  w.integer(drift.started ? 1 : 0);
+  w.real(drift.min_distance_m);
+  w.real(drift.min_sigma_m);
+  w.real(drift.last_distance_m);
+  w.real(drift.estimate.value_or(std::numeric_limits<double>::quiet_NaN()));
+  w.integer(drift.reports);
+  w.unsignedInteger(k.odometry_drift_updates);
+  w.real(graph_.odometryDriftFraction());
+  w.endLine();
   w.word("journal");
   w.unsignedInteger(journal.id);
   w.unsignedInteger(journal.bytes);
@@ -290,9 +304,9 @@ Status OptimiserEngine::loadCheckpoint(const std::string& path) {
                 "version " + std::to_string(kVersion) + " is needed to restore the ping poses and correspondences");
   if (magic != kMagic) return fail("not an sss-optimiser checkpoint");
   if (!r.integer(version)) return fail("bad version field");
-  if (version != kVersion)
-    return fail("format version " + std::to_string(version) + " not supported (expected " + std::to_string(kVersion) +
-                ")");
+  if (version < 2 || version > kVersion)
+    return fail("format version " + std::to_string(version) + " not supported (expected 2 to " +
+                std::to_string(kVersion) + ")");
 
   // Everything goes into locals first: *this changes only when all of it is sound.
   OptimiserEngineCounters counters;
@@ -306,6 +320,22 @@ Status OptimiserEngine::loadCheckpoint(const std::string& path) {
   double odometer_offset_m = 0.0, last_input_distance_m = 0.0;
   if (!r.expect("odometer") || !r.finite(odometer_offset_m) || !r.finite(last_input_distance_m))
     return fail("bad odometer record");
+  InsDriftState drift;
+  double drift_estimate = std::numeric_limits<double>::quiet_NaN();
+  double graph_drift_fraction = options_.graph.odometry_drift_fraction;
+  int drift_started = 0;
+  if (version >= 3) {
+    if (!r.expect("ins_drift") || !r.boundedInt(drift_started, 0, 1) || !r.finite(drift.min_distance_m) ||
+        !r.finite(drift.min_sigma_m) || !r.finite(drift.last_distance_m) || !r.real(drift_estimate) ||
+        !r.boundedInt(drift.reports, 0, std::numeric_limits<int>::max()) ||
+        !r.unsignedInteger(counters.odometry_drift_updates) || !r.finite(graph_drift_fraction) ||
+        graph_drift_fraction < 0.0)
+      return fail("bad ins_drift record");
+    drift.started = drift_started == 1;
+    if (std::isfinite(drift_estimate)) drift.estimate = drift_estimate;
+  }
+  InsDriftEstimator ins_drift(options_.graph.ins_drift);
+  if (!ins_drift.restore(drift)) return fail("bad ins_drift record (negative or NaN values)");
   Journal journal;
   journal.path = path + ".journal";
   if (!r.expect("journal") || !r.unsignedInteger(journal.id) || !r.unsignedInteger(journal.bytes) ||
@@ -357,6 +387,14 @@ Status OptimiserEngine::loadCheckpoint(const std::string& path) {
   SlidingWindowPoseGraph graph(options_.graph);
   const Status restored = graph.restoreCheckpointText(graph_text);
   if (!restored.ok) return fail("graph section: " + restored.message);
+  // The odometry drifted as the INS reported when the checkpoint was written: its edges again so.
+  // (Configured off since: the configured fraction, and no update to report.)
+  if (!options_.graph.odometry_drift_from_ins) {
+    counters.odometry_drift_updates = 0;
+  } else if (counters.odometry_drift_updates > 0) {
+    const Status drift_set = graph.setOdometryDriftFraction(graph_drift_fraction);
+    if (!drift_set.ok) return fail("ins_drift record: " + drift_set.message);
+  }
 
   // The journal, record by record up to the committed length.
   auto journalFail = [&](const std::string& why) { return fail("journal " + journal.path + ": " + why); };
@@ -448,6 +486,7 @@ Status OptimiserEngine::loadCheckpoint(const std::string& path) {
   newest_subframe_id_ = newest_subframe_id;
   new_input_ = new_input == 1;
   counters_ = counters;
+  ins_drift_ = ins_drift;
   odometer_offset_m_ = odometer_offset_m;
   last_input_distance_m_ = last_input_distance_m;
   journal_ = journal;

@@ -67,5 +67,37 @@ TEST(InsDriftEstimator, ClampsToTheConfiguredRange) {
   EXPECT_DOUBLE_EQ(*slow.driftFraction(), 0.0005);
 }
 
+// Restored into an estimator with another range (the configuration changed since the checkpoint),
+// the rate is clamped to the new range; a NaN or negative value is refused and changes nothing.
+TEST(InsDriftEstimator, RestoresItsStateClampedAndRefusesBadValues) {
+  InsDriftEstimator learnt;
+  for (double d = 0.0; d <= 600.0; d += 2.0) learnt.add(d, 0.5 + 0.003 * d);
+  InsDriftEstimatorOptions narrow;
+  narrow.max_fraction = 0.002;
+  InsDriftEstimator restored(narrow);
+  ASSERT_TRUE(restored.restore(learnt.state()));
+  EXPECT_DOUBLE_EQ(*restored.driftFraction(), 0.002);
+  EXPECT_EQ(restored.reports(), learnt.reports());
+  // The stretch goes on from where it was.
+  InsDriftEstimator same;
+  ASSERT_TRUE(same.restore(learnt.state()));
+  for (double d = 602.0; d <= 900.0; d += 2.0) {
+    learnt.add(d, 0.5 + 0.003 * d);
+    same.add(d, 0.5 + 0.003 * d);
+  }
+  EXPECT_DOUBLE_EQ(*same.driftFraction(), *learnt.driftFraction());
+
+  InsDriftState bad = learnt.state();
+  bad.min_sigma_m = -0.1;
+  EXPECT_FALSE(restored.restore(bad));
+  bad = learnt.state();
+  bad.estimate = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(restored.restore(bad));
+  bad = learnt.state();
+  bad.last_distance_m = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(restored.restore(bad));
+  EXPECT_DOUBLE_EQ(*restored.driftFraction(), 0.002);
+}
+
 }  // namespace
 }  // namespace sss::optimiser

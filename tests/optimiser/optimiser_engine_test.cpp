@@ -12,6 +12,7 @@
 #include <fstream>
 #include <iterator>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -250,10 +251,23 @@ TEST(OptimiserEngineCheckpoint, OldVersionTruncatedOrCorruptCheckpointsAreRefuse
   ASSERT_TRUE(graph_only.saveCheckpoint(bad).ok);
   expectRefused(target.loadCheckpoint(bad), "format version 1");
   // A newer version with a sound checksum.
-  std::string v3 = good.substr(0, good.rfind("checksum "));
-  v3.replace(v3.find(" 2\n"), 3, " 3\n");
-  checkpoint::appendChecksum(v3);
-  expectRefused(tryLoad(v3, good_journal), "format version 3 not supported");
+  std::string v4 = good.substr(0, good.rfind("checksum "));
+  v4.replace(v4.find(" 3\n"), 3, " 4\n");
+  checkpoint::appendChecksum(v4);
+  expectRefused(tryLoad(v4, good_journal), "format version 4 not supported");
+  // A negative sigma in the INS drift record (ins_drift started distance sigma ...).
+  std::string negative = good.substr(0, good.rfind("checksum "));
+  const size_t line_at = negative.find("\nins_drift ") + 1, line_end = negative.find('\n', line_at);
+  ASSERT_NE(line_at, std::string::npos + 1);
+  std::istringstream fields(negative.substr(line_at, line_end - line_at));
+  std::vector<std::string> record{std::istream_iterator<std::string>(fields), {}};
+  ASSERT_EQ(record.size(), 9u);
+  record[3] = "-1";
+  std::string line;
+  for (const std::string& field : record) line += (line.empty() ? "" : " ") + field;
+  negative.replace(line_at, line_end - line_at, line);
+  checkpoint::appendChecksum(negative);
+  expectRefused(tryLoad(negative, good_journal), "ins_drift");
   // The rewritten file truncated or with a bit flipped.
   expectRefused(tryLoad(good.substr(0, good.size() / 2), good_journal), "checksum");
   std::string flipped = good;
@@ -490,6 +504,72 @@ TEST(OptimiserEngineInsDrift, TheOdometryTakesTheDriftTheInsReports) {
     EXPECT_DOUBLE_EQ(without_distance.odometryDriftFraction(), configured);
     EXPECT_FALSE(without_distance.odometryDriftFromIns());
   }
+}
+
+// Reports of an INS whose sigma grows by rate x distance from 0.5 m, at every 2 m of odometer
+// from from_m to to_m (times far from the scenario's: they do not set its anchor).
+void feedInsAccuracy(OptimiserEngine& engine, double from_m, double to_m, double rate, double base_m = 0.5) {
+  for (double d = from_m; d <= to_m; d += 2.0) {
+    const int64_t t_us = 1'000'000'000'000 + static_cast<int64_t>(d * 1e6);
+    engine.addNavAccuracy({t_us, base_m + rate * d, base_m + rate * d, d});
+  }
+}
+
+// Killed and restarted from a checkpoint, the optimiser keeps the drift it took from the INS (not
+// the configured one for the next 300 m) and carries on the same stretch of the INS's drift; a
+// version 2 checkpoint, written before the rate was kept, restores with the configured fraction.
+TEST(OptimiserEngineInsDrift, ARestartFromACheckpointKeepsTheDriftTheInsReported) {
+  const Scenario s = makeScenario(-1);
+  const size_t n = s.subframes.size(), stop = 10;
+  const double configured = engineOptions().graph.odometry_drift_fraction;
+  OptimiserEngine uninterrupted(engineOptions());
+  feedInsAccuracy(uninterrupted, 0.0, 1200.0, 0.0008);
+  runSteps(uninterrupted, s, 0, stop);
+  ASSERT_TRUE(uninterrupted.odometryDriftFromIns());
+  ASSERT_NEAR(uninterrupted.odometryDriftFraction(), 0.0008, 1e-9);
+
+  const std::string path = temporaryPath("drift.checkpoint");
+  ASSERT_TRUE(uninterrupted.saveCheckpoint(path).ok);
+  OptimiserEngine restarted(engineOptions());
+  const Status loaded = restarted.loadCheckpoint(path);
+  ASSERT_TRUE(loaded.ok) << loaded.message;
+  EXPECT_TRUE(restarted.odometryDriftFromIns());
+  EXPECT_DOUBLE_EQ(restarted.odometryDriftFraction(), uninterrupted.odometryDriftFraction());
+  EXPECT_EQ(restarted.counters().odometry_drift_updates, 1u);
+
+  // The same stretch goes on: the sigma now grows at 0.0024 per metre, so the rate over the whole
+  // stretch from 0 m reaches 0.0016 at 2400 m (a new stretch from 1202 m would give 0.0024); the
+  // graph takes it whenever it has moved by 10 %.
+  for (OptimiserEngine* engine : {&uninterrupted, &restarted}) {
+    runSteps(*engine, s, stop, n);
+    for (double d = 1202.0; d <= 2400.0; d += 2.0) {
+      const double sigma_m = 0.5 + 0.0008 * 1200.0 + 0.0024 * (d - 1200.0);
+      engine->addNavAccuracy({1'000'000'000'000 + static_cast<int64_t>(d * 1e6), sigma_m, sigma_m, d});
+    }
+  }
+  EXPECT_NEAR(restarted.odometryDriftFraction(), 0.0016, 0.1 * 0.0016);
+  EXPECT_DOUBLE_EQ(restarted.odometryDriftFraction(), uninterrupted.odometryDriftFraction());
+  EXPECT_EQ(restarted.counters().odometry_drift_updates, uninterrupted.counters().odometry_drift_updates);
+  const std::vector<NodeState> expected = uninterrupted.graph().nodes(), nodes = restarted.graph().nodes();
+  ASSERT_EQ(nodes.size(), expected.size());
+  for (size_t i = 0; i < nodes.size(); ++i)
+    EXPECT_NEAR((nodes[i].T_world_body.translation - expected[i].T_world_body.translation).norm(), 0.0, 1e-9) << i;
+
+  // Version 2: no ins_drift record.
+  std::string text = readBytes(path);
+  text = text.substr(0, text.rfind("checksum "));
+  text.replace(text.find(" 3\n"), 3, " 2\n");
+  const size_t drift_at = text.find("ins_drift ");
+  ASSERT_NE(drift_at, std::string::npos);
+  text.erase(drift_at, text.find('\n', drift_at) + 1 - drift_at);
+  checkpoint::appendChecksum(text);
+  writeBytes(path, text);
+  OptimiserEngine from_version_2(engineOptions());
+  const Status loaded_v2 = from_version_2.loadCheckpoint(path);
+  ASSERT_TRUE(loaded_v2.ok) << loaded_v2.message;
+  EXPECT_FALSE(from_version_2.odometryDriftFromIns());
+  EXPECT_DOUBLE_EQ(from_version_2.odometryDriftFraction(), configured);
+  removeCheckpoint(path);
 }
 
 }  // namespace
