@@ -217,16 +217,8 @@ Status SlidingWindowPoseGraph::setOdometryDriftFraction(double fraction) {
     return Status::error("odometry drift fraction must be finite and >= 0 (" + std::to_string(fraction) +
                          "); the odometry keeps " + std::to_string(options_.odometry_drift_fraction));
   options_.odometry_drift_fraction = fraction;
-  odometry_drift_reported_ = true;
   for (size_t k = 1; k < nodes_.size(); ++k) setupDerived(nodes_[k], &nodes_[k - 1]);
   return Status::success();
-}
-
-bool SlidingWindowPoseGraph::separationBiasWanted() const {
-  // "auto" leaves missions with accepted fixes to separation_bias_widen_with_fixes (measured better
-  // there than correcting: README).
-  return options_.separation_bias_apply == "always" || options_.separation_bias_apply == "true" ||
-         (options_.separation_bias_apply == "auto" && odometry_drift_reported_ && fix_counters_.accepted == 0);
 }
 
 Status SlidingWindowPoseGraph::addLoopClosure(const LoopClosure& closure) {

@@ -119,25 +119,19 @@ struct PoseGraphOptions {
   // covariance nor their consistency can. At full smoothing one bias for the whole survey is
   // estimated against DR with a zero-mean prior of this sigma; closures between parallel or
   // anti-parallel lines (relative heading within 30 deg) more than separation_bias_min_lateral_m
-  // apart are corrected by it (window updates use the last estimate) when separation_bias_apply says
-  // so; otherwise it is only measured (a diagnostic solve whose estimate is discarded), so a run
+  // apart are corrected by it (window updates use the last estimate) when separation_bias_apply is
+  // set; otherwise it is only measured (a diagnostic solve whose estimate is discarded), so a run
   // can say that its closures and DR disagree on the lines' separation. 0: neither.
   // The bias is applied only when the data say it is there: |estimate| at least
   // separation_bias_significance of its own sigma. Estimating it costs lateral accuracy (the
   // survey's width then rests on DR alone): on the synthetic lawnmower with truthful closures a
   // free bias of 0.1-0.4 +- 0.3 m per pair spreads the lines and doubles the ATE.
-  // On a lawnmower it is confounded with DR: a DVL scale factor lengthens every turn between lines
-  // alike, which moves DR's line separations by the same amount (0.6 % of a 157 m turn: 0.9 m). The
-  // significance test can tell the two apart only when the odometry's drift is the DR's own: with
-  // the configured guess of 0.2 % it took high-drift's DR error for the closures' (README, measured:
-  // 1.72 -> 3.31 m); with the drift the INS reports (odometry_drift_from_ins) DR's turns are as loose
-  // as they are and the same mission's bias is not significant. So:
-  //   "auto": applied when significant and the odometry drifts at the INS's reported rate
-  //     (setOdometryDriftFraction), measured only otherwise (navigation without an accuracy); with
-  //     accepted fixes separation_bias_widen_with_fixes decides instead (measured better there);
-  //   "always" (also true): applied when significant; "never" (also false): measured only.
+  // Not applied by default because on a lawnmower it is confounded with DR: a DVL scale factor lengthens
+  // every turn between lines alike, which moves DR's line separations by the same amount (0.6 % of
+  // a 157 m turn: 0.9 m), and the test then takes DR's error for the closures' (README, measured:
+  // high-drift 1.72 -> 3.31 m). Absolute fixes or cross lines would tell the two apart.
   double separation_bias_sigma_m = 2.0;
-  std::string separation_bias_apply = "auto";
+  bool separation_bias_apply = false;
   // When the bias is significant, not applied and a shortening (what feature faces do), the closures
   // and DR disagree on the lines' separation and nothing tells which is wrong: widen the lateral
   // variance of the opposite-side closures by the disputed amount (estimate^2 + sigma^2), so they
@@ -345,7 +339,7 @@ struct SeparationBias {
   double tested_m = 0.0;    // the last full smoothing's estimate, applied or not
   double sigma_m = std::numeric_limits<double>::quiet_NaN();  // of tested_m; NaN until estimated
   bool significant = false; // |tested_m| >= separation_bias_significance x sigma_m
-  bool applied = false;     // significant and separation_bias_apply wants it (separationBiasWanted())
+  bool applied = false;     // significant and separation_bias_apply
   int closures = 0;         // accepted opposite-side closures at the last estimate
 };
 
@@ -408,11 +402,6 @@ class SlidingWindowPoseGraph {
   // unless finite and >= 0.
   Status setOdometryDriftFraction(double fraction);
   double odometryDriftFraction() const { return options_.odometry_drift_fraction; }
-  // True once setOdometryDriftFraction gave the odometry a drift (the INS's reported one).
-  bool odometryDriftReported() const { return odometry_drift_reported_; }
-  // Whether a significant separation bias is applied (separation_bias_apply, and for "auto" whether
-  // the odometry drifts as the INS reports).
-  bool separationBiasWanted() const;
   // Queues a closure for the next optimize(); refused (with the reason) when an id is unknown, the
   // input is not finite, the covariance is not positive definite or it has too few inliers. A
   // closure to a marginalised node acts through that node held constant (see pose_graph.cpp); one
@@ -621,7 +610,6 @@ class SlidingWindowPoseGraph {
   WindowStats window_stats_;
   VarianceFactors variance_factors_;
   SeparationBias separation_bias_;
-  bool odometry_drift_reported_ = false;  // setOdometryDriftFraction was given a drift
   DrCalibration calibration_;
   int64_t update_utime_us_ = 0;
   // Newest node time of an accepted closure that left the PCM horizon (its decision is final).

@@ -51,10 +51,6 @@ std::vector<std::string> validatePoseGraphOptions(const PoseGraphOptions& o) {
   if (o.variance_component_iterations < 1) problems.push_back("variance_component_iterations must be >= 1");
   if (!(o.separation_bias_sigma_m >= 0.0)) problems.push_back("separation_bias_sigma_m must be >= 0 (0: off)");
   if (!(o.separation_bias_min_lateral_m >= 0.0)) problems.push_back("separation_bias_min_lateral_m must be >= 0");
-  if (o.separation_bias_apply != "auto" && o.separation_bias_apply != "always" && o.separation_bias_apply != "never" &&
-      o.separation_bias_apply != "true" && o.separation_bias_apply != "false")
-    problems.push_back("separation_bias_apply must be one of auto, always, never (true, false) (got '" +
-                       o.separation_bias_apply + "')");
   if (!(o.separation_bias_significance >= 0.0))
     problems.push_back("separation_bias_significance must be >= 0 (sigmas; 0: always significant)");
   positive(o.fix_gate_chi2, "fix_gate_chi2");
@@ -117,8 +113,7 @@ void readPoseGraphOptions(sss::core::ConfigSection& section, PoseGraphOptions& o
   section.optional("variance_component_iterations", options.variance_component_iterations, {inRange(1, 100)});
   section.optional("separation_bias_sigma_m", options.separation_bias_sigma_m, {inRange(0.0, 100.0)});
   section.optional("separation_bias_min_lateral_m", options.separation_bias_min_lateral_m, {inRange(0.0, 10000.0)});
-  section.optional("separation_bias_apply", options.separation_bias_apply,
-                   {sss::core::oneOf({"auto", "always", "never", "true", "false"})});
+  section.optional("separation_bias_apply", options.separation_bias_apply);
   section.optional("separation_bias_widen", options.separation_bias_widen);
   section.optional("separation_bias_widen_with_fixes", options.separation_bias_widen_with_fixes);
   section.optional("separation_bias_significance", options.separation_bias_significance, {inRange(0.0, 100.0)});

@@ -524,7 +524,7 @@ UpdateReport SlidingWindowPoseGraph::smoothAll(bool mission_ended) {
     // sigma_m is NaN when no opposite-side closure was accepted or the covariance failed.
     separation_bias_.significant =
         estimated && std::abs(separation_bias_.tested_m) >= options_.separation_bias_significance * separation_bias_.sigma_m;
-    separation_bias_.applied = separation_bias_.significant && separationBiasWanted();
+    separation_bias_.applied = separation_bias_.significant && options_.separation_bias_apply;
     if (!separation_bias_.applied) {
       for (size_t i = 0; i < nodes_.size(); ++i) nodes_[i].estimate = start[i];
       separation_bias_.estimate_m = 0.0;

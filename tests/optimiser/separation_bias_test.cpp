@@ -34,7 +34,7 @@ PoseGraphOptions withBias(PoseGraphOptions options) {
   options.odometry_random_walk_m_per_sqrt_m = 0.01;
   options.odometry_drift_fraction = 0.002;
   options.separation_bias_sigma_m = 2.0;
-  options.separation_bias_apply = "always";
+  options.separation_bias_apply = true;
   return options;
 }
 
@@ -94,42 +94,24 @@ TEST(SeparationBias, ACommonShorteningOfOppositeSideClosuresIsEstimatedAndUndone
   }
 }
 
-// "never", and the default "auto" while the odometry drifts at a configured guess (navigation
-// without an accuracy), measure it and apply nothing: the bias is found significant, and the
-// trajectory is the one the graph gives without it, bit for bit. Once the odometry drifts as the
-// INS reports (setOdometryDriftFraction, here the same 0.2 %), "auto" applies it as "always" does.
-TEST(SeparationBias, AutoAppliesItOnlyWhenTheOdometryDriftsAsTheInsReports) {
+// The default measures it and applies nothing: the bias is found significant, and the trajectory
+// is the one the graph gives without it, bit for bit.
+TEST(SeparationBias, ByDefaultItIsMeasuredNotApplied) {
   const PoseGraphOptions defaults;
   EXPECT_GT(defaults.separation_bias_sigma_m, 0.0);
-  EXPECT_EQ(defaults.separation_bias_apply, "auto");
+  EXPECT_FALSE(defaults.separation_bias_apply);
   PoseGraphOptions off = withBias(graphOptions());
   off.separation_bias_sigma_m = 0.0;
   PoseGraphOptions measured = withBias(graphOptions());
-  measured.separation_bias_apply = "never";
-  PoseGraphOptions automatic = withBias(graphOptions());
-  automatic.separation_bias_apply = "auto";
+  measured.separation_bias_apply = false;
   const synthetic::Mission biased = shortened(synthetic::makeLawnmowerMission(goodInsMission(3)), 1.5);
   const Solved plain = smooth(biased, off);
-  for (const PoseGraphOptions& options : {measured, automatic}) {
-    const Solved diagnosed = smooth(biased, options);
-    EXPECT_TRUE(diagnosed.bias.significant) << options.separation_bias_apply;
-    EXPECT_FALSE(diagnosed.bias.applied) << options.separation_bias_apply;
-    EXPECT_EQ(diagnosed.bias.estimate_m, 0.0) << options.separation_bias_apply;
-    EXPECT_NEAR(diagnosed.bias.tested_m, 1.5, 2.0 * diagnosed.bias.sigma_m) << options.separation_bias_apply;
-    EXPECT_EQ(diagnosed.ate_m, plain.ate_m) << options.separation_bias_apply;
-  }
-
-  const Solved always = smooth(biased, withBias(graphOptions()));
-  ASSERT_TRUE(always.bias.applied);
-  SlidingWindowPoseGraph reported(automatic);
-  ASSERT_TRUE(reported.setOdometryDriftFraction(automatic.odometry_drift_fraction).ok);
-  EXPECT_TRUE(reported.odometryDriftReported());
-  feed(reported, biased, 0, biased.nodes.size());
-  ASSERT_TRUE(reported.fullSmoothing().ok);
-  EXPECT_TRUE(reported.separationBias().applied);
-  EXPECT_DOUBLE_EQ(reported.separationBias().estimate_m, always.bias.estimate_m);
-  EXPECT_DOUBLE_EQ(synthetic::translationRmse(estimates(reported), biased.nodes), always.ate_m);
-  EXPECT_LT(always.ate_m, 0.5 * plain.ate_m);
+  const Solved diagnosed = smooth(biased, measured);
+  EXPECT_TRUE(diagnosed.bias.significant);
+  EXPECT_FALSE(diagnosed.bias.applied);
+  EXPECT_EQ(diagnosed.bias.estimate_m, 0.0);
+  EXPECT_NEAR(diagnosed.bias.tested_m, 1.5, 2.0 * diagnosed.bias.sigma_m);
+  EXPECT_EQ(diagnosed.ate_m, plain.ate_m);
 }
 
 // Truthful closures: the estimate is within 2 sigma of 0, is not significant and so is not applied:
@@ -161,7 +143,7 @@ TEST(SeparationBias, TruthfulClosuresGiveNoBias) {
 // nothing is widened and the trajectory is the plain one.
 TEST(SeparationBias, WideningTheDisputedSeparationStopsBiasedClosuresPullingTheLines) {
   PoseGraphOptions plain_options = withBias(graphOptions());
-  plain_options.separation_bias_apply = "never";
+  plain_options.separation_bias_apply = false;
   PoseGraphOptions widen_options = plain_options;
   widen_options.separation_bias_widen = true;
   for (uint64_t seed = 1; seed <= 4; ++seed) {
@@ -200,7 +182,7 @@ TEST(SeparationBias, WideningTheDisputedSeparationStopsBiasedClosuresPullingTheL
 // drift term, left the bias at 1.4-1.7 +- 0.54 m, significant on 1 seed of 4.)
 TEST(SeparationBias, WithAcceptedFixesTheDisputedSeparationIsWidenedByDefault) {
   PoseGraphOptions options = withBias(graphOptions());
-  options.separation_bias_apply = "never";
+  options.separation_bias_apply = false;
   ASSERT_FALSE(options.separation_bias_widen);
   ASSERT_TRUE(options.separation_bias_widen_with_fixes);
   PoseGraphOptions off = options;
@@ -307,15 +289,6 @@ TEST(SeparationBias, BadOptionsAreNamed) {
   problems = validatePoseGraphOptions(options);
   ASSERT_EQ(problems.size(), 1u);
   EXPECT_NE(problems[0].find("separation_bias_significance"), std::string::npos);
-  options = PoseGraphOptions();
-  options.separation_bias_apply = "sometimes";
-  problems = validatePoseGraphOptions(options);
-  ASSERT_EQ(problems.size(), 1u);
-  EXPECT_NE(problems[0].find("separation_bias_apply"), std::string::npos);
-  for (const char* accepted : {"auto", "always", "never", "true", "false"}) {
-    options.separation_bias_apply = accepted;
-    EXPECT_TRUE(validatePoseGraphOptions(options).empty()) << accepted;
-  }
 }
 
 }  // namespace

@@ -156,14 +156,13 @@ std::vector<std::string> explainRun(const OfflineSummary& s, const Options& opti
   // Opposite-side closures and DR disagree on how far apart the lines run, all pairs alike.
   const sss::optimiser::SeparationBias& bias = s.separation_bias;
   if (bias.significant && !bias.applied) {
-    char text[800];
+    char text[640];
     std::snprintf(text, sizeof(text),
                   "the closures between lines that look at their overlap from opposite sides put the lines %.2f m "
                   "%s together than dead reckoning does (+- %.2f m, over %d closures, every pair alike): either raised "
                   "features (rocks, boulders) show each line their near face and bias the matches, or dead reckoning's "
                   "turns between lines are off (a DVL scale factor); cross lines or fixes tell the two apart. "
-                  "optimiser.graph.separation_bias_apply: always corrects the closures by it (auto does once the INS "
-                  "reports its drift, so that dead reckoning's own error is known)",
+                  "optimiser.graph.separation_bias_apply: true corrects the closures by it",
                   std::abs(bias.tested_m), bias.tested_m > 0.0 ? "closer" : "further", bias.sigma_m, bias.closures);
     findings.push_back(text);
   }
