@@ -508,10 +508,10 @@ TEST(OptimiserEngineInsDrift, TheOdometryTakesTheDriftTheInsReports) {
 
 // Reports of an INS whose sigma grows by rate x distance from 0.5 m, at every 2 m of odometer
 // from from_m to to_m (times far from the scenario's: they do not set its anchor).
-void feedInsAccuracy(OptimiserEngine& engine, double from_m, double to_m, double rate, double base_m = 0.5) {
+void feedInsAccuracy(OptimiserEngine& engine, double from_m, double to_m, double rate) {
   for (double d = from_m; d <= to_m; d += 2.0) {
     const int64_t t_us = 1'000'000'000'000 + static_cast<int64_t>(d * 1e6);
-    engine.addNavAccuracy({t_us, base_m + rate * d, base_m + rate * d, d});
+    engine.addNavAccuracy({t_us, 0.5 + rate * d, 0.5 + rate * d, d});
   }
 }
 
