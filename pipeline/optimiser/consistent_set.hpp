@@ -3,6 +3,7 @@
 // builds the graph from its closures' cycles with DR and applies the decision.
 #pragma once
 
+#include <utility>
 #include <vector>
 
 namespace sss::optimiser {
@@ -16,5 +17,20 @@ namespace sss::optimiser {
 // order they were added (seed first); empty for an empty graph.
 std::vector<int> largestConsistentSet(const std::vector<std::vector<char>>& consistent,
                                       const std::vector<char>& previously_accepted);
+
+// The same search, its sets ranked by independent evidence: subframes_of[p] holds closure p's two
+// subframes (node indices), and a set's worth is independentClosures() of its members, then its
+// size, then its previously accepted members. Closures through one subframe share that image's
+// errors (a wrong along-track shift, relief misread as offset), so they agree with each other
+// whatever the error is: a set held together only by them is one piece of evidence, not several.
+std::vector<int> mostIndependentConsistentSet(const std::vector<std::vector<char>>& consistent,
+                                              const std::vector<char>& previously_accepted,
+                                              const std::vector<std::pair<int, int>>& subframes_of);
+
+// How many of the given closures share no subframe with one another: a matching of the graph whose
+// vertices are subframes and whose edges are closures, found greedily, the closures whose
+// subframes carry the fewest other closures first. Exact up to 2 (a star of closures through one
+// subframe gives 1); a lower bound of the largest such matching above.
+int independentClosures(const std::vector<std::pair<int, int>>& subframes_of_closures);
 
 }  // namespace sss::optimiser

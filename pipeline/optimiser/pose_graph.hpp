@@ -86,10 +86,17 @@ struct PoseGraphOptions {
   int gate_min_accepted_closures = 5;
   // Pairwise consistency (PCM): cycle closure_i * DR chain * closure_j^-1 * DR chain within this
   // chi-square (6 dof: 16.81 = 99 %); the largest mutually consistent set among the newest
-  // pcm_max_closures closures is accepted when it has at least min_consistent_closures members.
+  // pcm_max_closures closures is accepted when it has at least min_consistent_closures members
+  // (counted as below).
   double pcm_chi2 = 16.81;
   int pcm_max_closures = 100;
   int min_consistent_closures = 2;
+  // Count only closures that share no subframe, both for min_consistent_closures and to choose
+  // between consistent sets: closures through one subframe share the errors of its image, so they
+  // agree with each other whatever those are (a subframe matched 1.2 m off along track to two
+  // neighbouring subframes of another line gives two closures that pass the pairwise test together).
+  // false: every closure counts, as PCM assumes independent closures.
+  bool pcm_count_independent_subframes = true;
 
   // ---- solver -------------------------------------------------------------------------------------
   int max_iterations = 10;            // per window update; deterministic bound

@@ -1,5 +1,6 @@
 // Closure decisions of the sliding-window pose graph: chi-square gate against the current
-// estimate, pairwise consistency on DR cycles and the largest consistent set (consistent_set.hpp).
+// estimate, pairwise consistency on DR cycles and the consistent set with the most independent
+// closures (consistent_set.hpp).
 #include "pipeline/optimiser/pose_graph.hpp"
 
 #include <Eigen/Cholesky>
@@ -137,8 +138,20 @@ void SlidingWindowPoseGraph::decideClosures(UpdateReport& report) {
   }
   std::vector<char> accepted(n, 0);
   for (int p = 0; p < n; ++p) accepted[p] = closures_[candidates[p]].record.status == ClosureStatus::kAccepted ? 1 : 0;
-  const std::vector<int> best = largestConsistentSet(consistent, accepted);
-  const bool enough = static_cast<int>(best.size()) >= options_.min_consistent_closures;
+  std::vector<int> best;
+  int support = 0;  // the evidence behind the best set: its closures, or those sharing no subframe
+  if (options_.pcm_count_independent_subframes) {
+    std::vector<std::pair<int, int>> subframes_of(n);
+    for (int p = 0; p < n; ++p) subframes_of[p] = {closures_[candidates[p]].a, closures_[candidates[p]].b};
+    best = mostIndependentConsistentSet(consistent, accepted, subframes_of);
+    std::vector<std::pair<int, int>> best_subframes;
+    for (int p : best) best_subframes.push_back(subframes_of[p]);
+    support = independentClosures(best_subframes);
+  } else {
+    best = largestConsistentSet(consistent, accepted);
+    support = static_cast<int>(best.size());
+  }
+  const bool enough = support >= options_.min_consistent_closures;
   std::vector<char> in_best(n, 0);
   if (enough)
     for (int p : best) in_best[p] = 1;

@@ -105,6 +105,7 @@ void readPoseGraphOptions(sss::core::ConfigSection& section, PoseGraphOptions& o
   section.optional("pcm_chi2", options.pcm_chi2, {greaterThan(0.0)});
   section.optional("pcm_max_closures", options.pcm_max_closures, {inRange(1, 10000)});
   section.optional("min_consistent_closures", options.min_consistent_closures, {atLeast(1)});
+  section.optional("pcm_count_independent_subframes", options.pcm_count_independent_subframes);
   section.optional("max_iterations", options.max_iterations, {inRange(1, 1000)});
   section.optional("max_solver_time_s", options.max_solver_time_s, {atLeast(0.0)});
   section.optional("full_smoothing_max_iterations", options.full_smoothing_max_iterations, {inRange(1, 10000)});

@@ -70,7 +70,7 @@ TEST(ConsistentSet, OnATieTheSetAcceptedBeforeIsKept) {
 }
 
 // On random graphs the answer is always mutually consistent, and it is maximal: no closure
-// outside it agrees with all its members.
+// outside it agrees with all its members (ranked by size or by independent closures).
 TEST(ConsistentSet, ResultIsAlwaysAMaximalClique) {
   std::mt19937_64 rng(42);
   std::bernoulli_distribution edge(0.4);
@@ -80,16 +80,88 @@ TEST(ConsistentSet, ResultIsAlwaysAMaximalClique) {
     for (int p = 0; p < n; ++p)
       for (int q = p + 1; q < n; ++q)
         if (edge(rng)) connect(g, p, q);
-    const std::vector<int> best = largestConsistentSet(g, std::vector<char>(n, 0));
-    ASSERT_FALSE(best.empty());
-    EXPECT_TRUE(mutuallyConsistent(g, best)) << "trial " << trial;
-    for (int v = 0; v < n; ++v) {
-      if (std::find(best.begin(), best.end(), v) != best.end()) continue;
-      std::vector<int> grown = best;
-      grown.push_back(v);
-      EXPECT_FALSE(mutuallyConsistent(g, grown)) << "trial " << trial << ": " << v << " could join";
+    std::uniform_int_distribution<int> subframe(0, n);
+    std::vector<std::pair<int, int>> subframes_of(n);
+    for (auto& ends : subframes_of) ends = {subframe(rng), n + 1 + subframe(rng)};
+    for (const std::vector<int>& best : {largestConsistentSet(g, std::vector<char>(n, 0)),
+                                         mostIndependentConsistentSet(g, std::vector<char>(n, 0), subframes_of)}) {
+      ASSERT_FALSE(best.empty());
+      EXPECT_TRUE(mutuallyConsistent(g, best)) << "trial " << trial;
+      for (int v = 0; v < n; ++v) {
+        if (std::find(best.begin(), best.end(), v) != best.end()) continue;
+        std::vector<int> grown = best;
+        grown.push_back(v);
+        EXPECT_FALSE(mutuallyConsistent(g, grown)) << "trial " << trial << ": " << v << " could join";
+      }
     }
   }
+}
+
+// Closures sharing a subframe count once: a star through one subframe is 1, two closures with four
+// different subframes 2, a path of three closures 2 (greedy must not take the middle one first).
+TEST(IndependentClosures, ClosuresThroughOneSubframeCountOnce) {
+  EXPECT_EQ(independentClosures({}), 0);
+  EXPECT_EQ(independentClosures({{24, 3}}), 1);
+  EXPECT_EQ(independentClosures({{24, 3}, {24, 4}, {24, 5}}), 1);
+  EXPECT_EQ(independentClosures({{3, 24}, {24, 4}}), 1);  // the shared subframe on either side
+  EXPECT_EQ(independentClosures({{1, 10}, {2, 11}}), 2);
+  EXPECT_EQ(independentClosures({{2, 3}, {1, 2}, {3, 4}}), 2);
+  EXPECT_EQ(independentClosures({{1, 2}, {2, 3}, {1, 3}}), 1);  // a triangle of subframes
+  EXPECT_EQ(independentClosures({{24, 3}, {24, 4}, {24, 5}, {30, 6}}), 2);
+}
+
+// On random small graphs the greedy count is a matching (never more than the true maximum, found
+// here by brute force) and reaches the maximum whenever that is 2 or less.
+TEST(IndependentClosures, IsAMatchingAndExactUpToTwo) {
+  std::mt19937_64 rng(7);
+  for (int trial = 0; trial < 300; ++trial) {
+    const int subframes = 3 + trial % 6, closures = 1 + trial % 7;
+    std::uniform_int_distribution<int> pick(0, subframes - 1);
+    std::vector<std::pair<int, int>> ends;
+    while (static_cast<int>(ends.size()) < closures) {
+      const int a = pick(rng), b = pick(rng);
+      if (a != b) ends.emplace_back(a, b);
+    }
+    int maximum = 0;
+    for (int mask = 0; mask < (1 << closures); ++mask) {
+      std::vector<int> seen;
+      bool disjoint = true;
+      for (int p = 0; p < closures; ++p) {
+        if (!(mask & (1 << p))) continue;
+        for (int v : {ends[p].first, ends[p].second}) {
+          disjoint = disjoint && std::find(seen.begin(), seen.end(), v) == seen.end();
+          seen.push_back(v);
+        }
+      }
+      if (disjoint) maximum = std::max(maximum, __builtin_popcount(mask));
+    }
+    const int greedy = independentClosures(ends);
+    EXPECT_LE(greedy, maximum) << "trial " << trial;
+    EXPECT_GE(greedy, std::min(maximum, 2)) << "trial " << trial;
+  }
+}
+
+// Four closures through subframe 24 agree with each other (they share its error); two closures of
+// other subframes agree with each other but not with them. By size the four win; by independent
+// evidence (1 against 2) the two do. Without the subframes both rankings are the same.
+TEST(ConsistentSet, ASetHeldTogetherByOneSubframeLosesToIndependentClosures) {
+  Graph g = emptyGraph(6);
+  for (int p = 0; p < 4; ++p)
+    for (int q = p + 1; q < 4; ++q) connect(g, p, q);
+  connect(g, 4, 5);
+  const std::vector<std::pair<int, int>> subframes_of{{24, 3}, {24, 4}, {24, 5}, {24, 6}, {30, 7}, {31, 8}};
+  const std::vector<char> none(6, 0);
+  EXPECT_EQ(sorted(largestConsistentSet(g, none)), (std::vector<int>{0, 1, 2, 3}));
+  EXPECT_EQ(sorted(mostIndependentConsistentSet(g, none, subframes_of)), (std::vector<int>{4, 5}));
+  // Equal independent evidence: the larger set wins, even over a set accepted before.
+  const std::vector<std::pair<int, int>> all_distinct{{1, 11}, {2, 12}, {3, 13}, {4, 14}, {5, 15}, {6, 16}};
+  EXPECT_EQ(sorted(mostIndependentConsistentSet(g, none, all_distinct)), (std::vector<int>{0, 1, 2, 3}));
+  const std::vector<std::pair<int, int>> two_each{{24, 3}, {25, 4}, {24, 5}, {25, 6}, {30, 7}, {31, 8}};
+  EXPECT_EQ(sorted(mostIndependentConsistentSet(g, none, two_each)), (std::vector<int>{0, 1, 2, 3}));
+  std::vector<char> accepted(6, 0);
+  accepted[5] = 1;
+  const std::vector<std::pair<int, int>> one_each{{24, 3}, {24, 4}, {24, 5}, {24, 6}, {30, 7}, {30, 8}};
+  EXPECT_EQ(sorted(mostIndependentConsistentSet(g, accepted, one_each)), (std::vector<int>{0, 1, 2, 3}));
 }
 
 }  // namespace

@@ -342,6 +342,67 @@ TEST(PoseGraphCorrection, IsExactAtNodesInterpolatedBetweenAndHeldOutside) {
                SlidingWindowPoseGraph::odometryCovariance(options, 0.0)).norm(), 0.0, 1e-9);
 }
 
+// Two lines 50 m apart (ids 1-10 east, 11-20 back west, DR exact). Subframe 15 is matched 3 m
+// off along track to its two neighbours 5 and 7 on the first line: both closures carry that one
+// error, so their cycle with DR closes and PCM finds them consistent. Counted by independent
+// subframes they are one piece of evidence and wait; two right closures of other subframes then
+// win over them. Counting closures, the pair is accepted at once and, once accepted, keeps the tie
+// against the two right ones.
+TEST(PoseGraph, ClosuresSharingOneSubframeCountOnce) {
+  auto nodePose = [](int id) {
+    const bool east = id <= 10;
+    const double x_m = east ? 20.0 * (id - 1) : 180.0 - 20.0 * (id - 11);
+    const Eigen::Quaterniond q(Eigen::AngleAxisd(east ? 0.0 : M_PI, Eigen::Vector3d::UnitZ()));
+    return Pose(q, Eigen::Vector3d(x_m, east ? 0.0 : 50.0, 20.0));
+  };
+  auto closure = [&](int a, int b, double along_error_m) {
+    LoopClosure c;
+    c.subframe_id_a = a;
+    c.subframe_id_b = b;
+    const Pose error(Eigen::Quaterniond::Identity(), Eigen::Vector3d(along_error_m, 0.0, 0.0));
+    c.T_a_b = nodePose(a).inverse() * (nodePose(b) * error);
+    c.covariance = 0.01 * Matrix6d::Identity();
+    return c;
+  };
+  auto statusOf = [](const SlidingWindowPoseGraph& graph, int a, int b) {
+    for (const ClosureRecord& r : graph.closures())
+      if (r.closure.subframe_id_a == a && r.closure.subframe_id_b == b) return r.status;
+    return ClosureStatus::kSuperseded;
+  };
+  for (const bool count_independent : {true, false}) {
+    SCOPED_TRACE(count_independent ? "independent subframes" : "every closure");
+    PoseGraphOptions options = graphOptions();
+    options.pcm_count_independent_subframes = count_independent;
+    SlidingWindowPoseGraph graph(options);
+    double distance_m = 0.0;
+    for (int id = 1; id <= 20; ++id) {
+      if (id > 1) distance_m += (nodePose(id).translation - nodePose(id - 1).translation).norm();
+      ASSERT_TRUE(graph.addNode(id, 1000000LL * id * 10, nodePose(id), distance_m).ok);
+      graph.optimize();
+    }
+    ASSERT_TRUE(graph.addLoopClosure(closure(5, 15, 3.0)).ok);
+    ASSERT_TRUE(graph.addLoopClosure(closure(7, 15, 3.0)).ok);
+    graph.optimize();
+    const ClosureStatus shared = count_independent ? ClosureStatus::kPending : ClosureStatus::kAccepted;
+    EXPECT_EQ(statusOf(graph, 5, 15), shared);
+    EXPECT_EQ(statusOf(graph, 7, 15), shared);
+
+    ASSERT_TRUE(graph.addLoopClosure(closure(3, 18, 0.0)).ok);
+    ASSERT_TRUE(graph.addLoopClosure(closure(9, 12, 0.0)).ok);
+    graph.optimize();
+    const ClosureStatus right = count_independent ? ClosureStatus::kAccepted : ClosureStatus::kRejected;
+    EXPECT_EQ(statusOf(graph, 3, 18), right);
+    EXPECT_EQ(statusOf(graph, 9, 12), right);
+    const ClosureStatus wrong = count_independent ? ClosureStatus::kRejected : ClosureStatus::kAccepted;
+    EXPECT_EQ(statusOf(graph, 5, 15), wrong);
+    EXPECT_EQ(statusOf(graph, 7, 15), wrong);
+    if (count_independent) {
+      const Pose estimate = *graph.estimate(15);
+      EXPECT_LT((estimate.translation - nodePose(15).translation).norm(), 0.05);
+    }
+  }
+}
+
 TEST(PoseGraphInput, RefusesBadNodesAndClosuresWithAReason) {
   SlidingWindowPoseGraph graph(graphOptions());
   ASSERT_TRUE(graph.addNode(10, 1000000, Pose::identity(), 0.0).ok);
