@@ -66,11 +66,15 @@ std::vector<int> mostIndependentConsistentSet(const std::vector<std::vector<char
                                               const std::vector<char>& previously_accepted,
                                               const std::vector<std::pair<int, int>>& subframes_of) {
   return greedyClique(consistent, previously_accepted, [&](const std::vector<int>& set) {
-    std::vector<std::pair<int, int>> ends;
-    for (int p : set)
-      if (p < static_cast<int>(subframes_of.size())) ends.push_back(subframes_of[p]);
-    return std::pair<int, int>(independentClosures(ends), static_cast<int>(set.size()));
+    return std::pair<int, int>(independentClosures(set, subframes_of), static_cast<int>(set.size()));
   });
+}
+
+int independentClosures(const std::vector<int>& members, const std::vector<std::pair<int, int>>& subframes_of) {
+  std::vector<std::pair<int, int>> ends;
+  for (int p : members)
+    if (p >= 0 && p < static_cast<int>(subframes_of.size())) ends.push_back(subframes_of[p]);
+  return independentClosures(ends);
 }
 
 int independentClosures(const std::vector<std::pair<int, int>>& subframes_of_closures) {

@@ -32,5 +32,7 @@ std::vector<int> mostIndependentConsistentSet(const std::vector<std::vector<char
 // subframes carry the fewest other closures first. Exact up to 2 (a star of closures through one
 // subframe gives 1); a lower bound of the largest such matching above.
 int independentClosures(const std::vector<std::pair<int, int>>& subframes_of_closures);
+// The same count for the members of a set, subframes_of holding every closure's two subframes.
+int independentClosures(const std::vector<int>& members, const std::vector<std::pair<int, int>>& subframes_of);
 
 }  // namespace sss::optimiser

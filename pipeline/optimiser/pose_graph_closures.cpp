@@ -144,9 +144,7 @@ void SlidingWindowPoseGraph::decideClosures(UpdateReport& report) {
     std::vector<std::pair<int, int>> subframes_of(n);
     for (int p = 0; p < n; ++p) subframes_of[p] = {closures_[candidates[p]].a, closures_[candidates[p]].b};
     best = mostIndependentConsistentSet(consistent, accepted, subframes_of);
-    std::vector<std::pair<int, int>> best_subframes;
-    for (int p : best) best_subframes.push_back(subframes_of[p]);
-    support = independentClosures(best_subframes);
+    support = independentClosures(best, subframes_of);
   } else {
     best = largestConsistentSet(consistent, accepted);
     support = static_cast<int>(best.size());
