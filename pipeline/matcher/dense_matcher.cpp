@@ -506,9 +506,10 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
   }
   grid_b.value = cv::Mat1f::zeros(grid_rows, grid_cols);
   grid_b.weight = cv::Mat1f::zeros(grid_rows, grid_cols);
-  // Raised features' pixels on the grid (reject_shadowed_relief), B's where any of the four pixels
-  // of its bilinear sample is one.
-  const bool test_relief = o.reject_shadowed_relief && !a.relief.empty() && !b.relief.empty();
+  // Raised features' pixels on the grid (reject_shadowed_relief, mark_shadowed_relief), B's where
+  // any of the four pixels of its bilinear sample is one.
+  const bool test_relief =
+      (o.reject_shadowed_relief || o.mark_shadowed_relief) && !a.relief.empty() && !b.relief.empty();
   cv::Mat1b relief_a, relief_b;
   if (test_relief) {
     relief_a = cv::Mat1b::zeros(grid_rows, grid_cols);
@@ -739,11 +740,13 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
       }
       // A feature's face or shadow in either patch: its contrast outweighs the seabed's and moves
       // the peak towards the side it is seen from.
-      if (opposed && test_relief &&
-          (patchHasRelief(relief_a, sr, sc, half) || patchHasRelief(relief_b, tr, tc, half))) {
+      const bool on_relief = opposed && test_relief &&
+                             (patchHasRelief(relief_a, sr, sc, half) || patchHasRelief(relief_b, tr, tc, half));
+      if (on_relief && o.reject_shadowed_relief) {
         ++t.shadowed_relief_rejected;
         continue;
       }
+      if (on_relief) ++t.shadowed_relief_marked;
       Correspondence match;
       match.row_a = static_cast<float>(sr - pad_r);
       match.col_a = static_cast<float>(sc - pad_c);
@@ -751,6 +754,7 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
       match.col_b = m[1];
       match.zncc = forward.score[k];
       match.peak_curvature_col = curvature_col;
+      match.opposed_relief = on_relief;
       matches.push_back(match);
     }
   }

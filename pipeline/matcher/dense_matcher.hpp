@@ -71,6 +71,10 @@ struct DenseMatcherOptions {
   // match between views whose look directions are more than 135 deg apart is dropped when a
   // feature pixel lies in A's patch or in B's. Needs GeoImage::relief; views from one side keep all.
   bool reject_shadowed_relief = false;
+  // The same matches kept but marked (Correspondence::opposed_relief), so that the pair matcher
+  // can test them against the rest (PairMatcherOptions::test_opposed_relief). Needs
+  // GeoImage::relief; ignored when reject_shadowed_relief drops them.
+  bool mark_shadowed_relief = false;
   // Relief seen from opposite sides at low grazing is contrast-inverted: the slope lit for one line
   // is the one in shadow for the other. On periodic relief (sand waves, megaripples) the inverted
   // pattern correlates best half a wavelength off the truth, with a ZNCC as high as a true match's,
@@ -99,6 +103,10 @@ struct Correspondence {
   // A sharp peak locates the match in range better than a flat one (measured on simulated
   // missions: the median range error halves from the flattest to the sharpest quarter).
   float peak_curvature_col = 0.0f;
+  // Seen from opposite sides with a raised feature's face or shadow in either patch (only set with
+  // DenseMatcherOptions::mark_shadowed_relief): the match may be biased towards the side each
+  // line sees the feature from.
+  bool opposed_relief = false;
 };
 
 // Wall-clock seconds of each stage of one match() call and the pixel counts behind them.
@@ -112,6 +120,7 @@ struct MatchTimings {
   long matches = 0;
   long mirrored_relief_rejected = 0;  // matches dropped by reject_mirrored_relief
   long shadowed_relief_rejected = 0;  // matches dropped by reject_shadowed_relief
+  long shadowed_relief_marked = 0;    // matches marked by mark_shadowed_relief (before the later checks)
   long inverted_relief_rejected = 0;  // matches dropped by reject_inverted_relief
 };
 

@@ -47,7 +47,7 @@ std::vector<std::string> validateMatcherEngineOptions(const MatcherEngineOptions
   return problems;
 }
 
-MatcherEngine::MatcherEngine(const MatcherEngineOptions& options) : options_(options), dense_(options.pair.dense) {
+MatcherEngine::MatcherEngine(const MatcherEngineOptions& options) : options_(options), dense_(pairDenseOptions(options.pair)) {
   const std::vector<std::string> problems = validateMatcherEngineOptions(options_);
   if (!problems.empty()) throw std::invalid_argument("MatcherEngineOptions: " + problems.front());
 }
@@ -92,6 +92,8 @@ PairOutcome MatcherEngine::matchStored(const PairKey& key, int round) {
     return outcome;
   }
   ++counters_.closures_accepted;
+  if (match.opposed_relief_replaced) ++counters_.closures_without_opposed_relief;
+  if (match.pass_disagreement_widened) ++counters_.closures_widened_by_passes;
   LoopClosure& c = outcome.closure;
   c.subframe_id_a = key.first;
   c.subframe_id_b = key.second;

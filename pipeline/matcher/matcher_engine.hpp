@@ -74,6 +74,8 @@ struct MatcherEngineCounters {
   uint64_t closures_accepted = 0;
   uint64_t pairs_rejected = 0;
   uint64_t rematches = 0;           // attempts with optimised poses (round >= 1)
+  uint64_t closures_without_opposed_relief = 0;  // accepted with the pose test_opposed_relief re-estimated
+  uint64_t closures_widened_by_passes = 0;       // accepted with the covariance test_pass_agreement widened
   double pair_seconds_total = 0.0;
   // State directory (restore()).
   uint64_t subframes_restored = 0;

@@ -138,6 +138,8 @@ void MatcherService::reportHealth(sss::core::HealthMonitor& health, const std::s
   set("closures_accepted", static_cast<double>(c.closures_accepted));
   set("pairs_rejected", static_cast<double>(c.pairs_rejected));
   set("rematches", static_cast<double>(c.rematches));
+  set("closures_without_opposed_relief", static_cast<double>(c.closures_without_opposed_relief));
+  set("closures_widened_by_passes", static_cast<double>(c.closures_widened_by_passes));
   set("subframes_restored", static_cast<double>(c.subframes_restored));
   set("pairs_restored", static_cast<double>(c.pairs_restored));
   set("state_files_corrupt", static_cast<double>(c.state_files_corrupt));

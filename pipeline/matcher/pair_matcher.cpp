@@ -1,6 +1,8 @@
 // One subframe pair from images to relative pose.
 #include "pipeline/matcher/pair_matcher.hpp"
 
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -41,6 +43,16 @@ void readPairMatcherOptions(sss::core::ConfigSection& section, PairMatcherOption
   section.optional("covariance_scale", options.covariance_scale, {inRange(1e-3, 1e6)});
   section.optional("min_translation_sigma_m", options.min_translation_sigma_m, {inRange(0.0, 100.0)});
   section.optional("min_rotation_sigma_rad", options.min_rotation_sigma_rad, {inRange(0.0, 1.0)});
+  section.optional("test_opposed_relief", options.test_opposed_relief);
+  section.optional("opposed_relief_chi2", options.opposed_relief_chi2, {inRange(0.0, 1e6)});
+  section.optional("test_pass_agreement", options.test_pass_agreement);
+  section.optional("pass_agreement_chi2", options.pass_agreement_chi2, {inRange(0.0, 1e6)});
+}
+
+DenseMatcherOptions pairDenseOptions(const PairMatcherOptions& options) {
+  DenseMatcherOptions dense = options.dense;
+  dense.mark_shadowed_relief = dense.mark_shadowed_relief || options.test_opposed_relief;
+  return dense;
 }
 
 std::vector<std::string> validatePairMatcherOptions(const PairMatcherOptions& o) {
@@ -85,6 +97,30 @@ double fullResolutionColumn(const sss::core::SubframeGeometry& geometry, int dec
   return geometry.bins_per_side + (k - per) * decimation + centre;
 }
 
+double hausmanStatistic(const sss::core::Vector6d& d, const sss::core::Matrix6d& c_subset,
+                        const sss::core::Matrix6d& c_all) {
+  constexpr int kPlanar[3] = {0, 1, 5};  // horizontal position and heading of [dt, dr]
+  Eigen::Vector3d dp;
+  Eigen::Matrix3d cs, ca;
+  for (int i = 0; i < 3; ++i) {
+    dp(i) = d(kPlanar[i]);
+    for (int j = 0; j < 3; ++j) {
+      cs(i, j) = c_subset(kPlanar[i], kPlanar[j]);
+      ca(i, j) = c_all(kPlanar[i], kPlanar[j]);
+    }
+  }
+  // Whitened by C_subset first, so that the floor is the same in every unit (m, rad).
+  const Eigen::LLT<Eigen::Matrix3d> chol(cs);
+  if (chol.info() != Eigen::Success) return -1.0;
+  const Eigen::Matrix3d l_inv = chol.matrixL().solve(Eigen::Matrix3d::Identity());
+  const Eigen::Matrix3d difference = Eigen::Matrix3d::Identity() - l_inv * ca * l_inv.transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(0.5 * (difference + difference.transpose()));
+  const Eigen::Vector3d z = eigen.eigenvectors().transpose() * (l_inv * dp);
+  double statistic = 0.0;
+  for (int i = 0; i < 3; ++i) statistic += z(i) * z(i) / std::max(eigen.eigenvalues()(i), 0.1);
+  return statistic;
+}
+
 namespace {
 
 // Gaussian of the valid pixels only (normalised convolution: smoothed intensity x mask over the
@@ -108,6 +144,74 @@ void addTimings(MatchTimings& total, const MatchTimings& pass) {
   total.mirrored_relief_rejected += pass.mirrored_relief_rejected;
   total.shadowed_relief_rejected += pass.shadowed_relief_rejected;
   total.inverted_relief_rejected += pass.inverted_relief_rejected;
+  total.shadowed_relief_marked += pass.shadowed_relief_marked;
+}
+
+// The covariance a closure publishes: the matches' model scaled (covariance_scale), the relief
+// term as it is, floored.
+void publishedCovariance(RelativePoseResult& pose, const PairMatcherOptions& options) {
+  sss::core::Matrix6d& covariance = pose.covariance;
+  // The scale calibrates the matches' model; the relief term is already a physical size.
+  covariance = options.covariance_scale * (covariance - pose.relief_covariance) + pose.relief_covariance;
+  for (int i = 0; i < 6; ++i) {
+    const double floor = i < 3 ? options.min_translation_sigma_m : options.min_rotation_sigma_rad;
+    covariance(i, i) = std::max(covariance(i, i), floor * floor);
+  }
+}
+
+// test_opposed_relief (see PairMatcherOptions): the pose again without the matches over opposed
+// relief; published instead when the two differ beyond what the fewer matches explain.
+void testOpposedRelief(const RelativePoseInput& input, const PairMatcherOptions& options, PairMatch& result) {
+  for (int i : result.pose.all_inlier_indices) result.opposed_relief_inliers += input.matches[i].opposed_relief;
+  if (result.opposed_relief_inliers == 0) return;
+  RelativePoseInput without = input;
+  without.matches.clear();
+  std::vector<int> index_in_all;
+  for (size_t i = 0; i < input.matches.size(); ++i) {
+    if (input.matches[i].opposed_relief) continue;
+    without.matches.push_back(input.matches[i]);
+    index_in_all.push_back(static_cast<int>(i));
+  }
+  if (static_cast<int>(without.matches.size()) < options.min_matches) return;
+  RelativePoseResult pose = estimateRelativePose(without, options.pose);
+  if (!pose.accepted) return;
+  publishedCovariance(pose, options);
+  const sss::core::Vector6d d = sss::core::boxMinus(pose.T_a_b, result.pose.T_a_b);
+  result.opposed_relief_statistic = hausmanStatistic(d, pose.covariance, result.pose.covariance);
+  if (!(result.opposed_relief_statistic > options.opposed_relief_chi2)) return;
+  // The indices of the pose's inliers are into the matches it was given: map them back.
+  for (int& i : pose.inlier_indices) i = index_in_all[i];
+  for (int& i : pose.all_inlier_indices) i = index_in_all[i];
+  pose.seconds += result.pose.seconds;
+  result.pose = std::move(pose);
+  result.opposed_relief_replaced = true;
+}
+
+// test_pass_agreement (see PairMatcherOptions): the pose from the raw-intensity matches alone and
+// from the rectified-contrast matches alone; where they differ beyond both their spreads, the
+// published covariance widens by their difference.
+void testPassAgreement(const RelativePoseInput& input, const std::vector<Correspondence>& raw,
+                       const std::vector<Correspondence>& rectified, const PairMatcherOptions& options,
+                       PairMatch& result) {
+  RelativePoseInput one = input;
+  one.matches = raw;
+  RelativePoseResult raw_pose = estimateRelativePose(one, options.pose);
+  one.matches = rectified;
+  RelativePoseResult rectified_pose = estimateRelativePose(one, options.pose);
+  result.pose.seconds += raw_pose.seconds + rectified_pose.seconds;
+  if (!raw_pose.accepted || !rectified_pose.accepted) return;
+  publishedCovariance(raw_pose, options);
+  publishedCovariance(rectified_pose, options);
+  sss::core::Vector6d d = sss::core::boxMinus(rectified_pose.T_a_b, raw_pose.T_a_b);
+  d(2) = d(3) = d(4) = 0.0;  // depth, roll and pitch: the pressure sensor and the INS, not the passes
+  // Two estimates from (mostly) different pixels: d' (C_raw + C_rectified)^-1 d; hausmanStatistic
+  // with a zero C_all is that.
+  result.pass_agreement_statistic =
+      hausmanStatistic(d, raw_pose.covariance + rectified_pose.covariance, sss::core::Matrix6d::Zero());
+  result.pass_disagreement_m = d.head<2>().norm();
+  if (!(result.pass_agreement_statistic > options.pass_agreement_chi2)) return;
+  result.pose.covariance += d * d.transpose();
+  result.pass_disagreement_widened = true;
 }
 
 }  // namespace
@@ -203,24 +307,31 @@ PairMatch matchPair(const sss::core::Subframe& a, const std::vector<sss::core::P
   result.decimation = columnDecimation(a.geometry, options);
   GeoImage image_a = toGeoImage(a, poses_a, result.decimation, options.smoothing_sigma_px);
   GeoImage image_b = toGeoImage(b, poses_b, result.decimation, options.smoothing_sigma_px);
-  if (dense.options().reject_shadowed_relief) {  // on the smoothed intensity, for both passes
+  if (dense.options().reject_shadowed_relief || dense.options().mark_shadowed_relief) {  // smoothed, both passes
     image_a.relief = findReliefFeatures(image_a);
     image_b.relief = findReliefFeatures(image_b);
   }
   result.georeference_s = secondsSince(start);
   result.matches = dense.match(image_a, image_b, &result.dense_timings);
+  std::vector<Correspondence> raw_matches, rectified_matches;  // each pass alone, for test_pass_agreement
   if (options.rectify_sigma_px > 0.0) {
     MatchTimings rectified_timings;
     const std::vector<Correspondence> rectified =
         dense.match(rectifiedContrast(image_a, options.rectify_sigma_px),
                     rectifiedContrast(image_b, options.rectify_sigma_px), &rectified_timings);
     addTimings(result.dense_timings, rectified_timings);
+    if (options.test_pass_agreement) {
+      raw_matches = result.matches;
+      rectified_matches = rectified;
+    }
     result.matches = mergeMatches(result.matches, rectified);
     result.dense_timings.matches = static_cast<long>(result.matches.size());
   }
-  for (Correspondence& m : result.matches) {
-    m.col_a = static_cast<float>(fullResolutionColumn(a.geometry, result.decimation, m.col_a));
-    m.col_b = static_cast<float>(fullResolutionColumn(b.geometry, result.decimation, m.col_b));
+  for (std::vector<Correspondence>* list : {&result.matches, &raw_matches, &rectified_matches}) {
+    for (Correspondence& m : *list) {
+      m.col_a = static_cast<float>(fullResolutionColumn(a.geometry, result.decimation, m.col_a));
+      m.col_b = static_cast<float>(fullResolutionColumn(b.geometry, result.decimation, m.col_b));
+    }
   }
   double zncc_sum = 0.0;
   for (const Correspondence& m : result.matches) zncc_sum += m.zncc;
@@ -246,14 +357,10 @@ PairMatch matchPair(const sss::core::Subframe& a, const std::vector<sss::core::P
   input.dr_covariance_ab =
       drRelativeCovariance(b.centre().distance_travelled_m - a.centre().distance_travelled_m, options);
   result.pose = estimateRelativePose(input, options.pose);
-  if (result.pose.accepted) {
-    sss::core::Matrix6d& covariance = result.pose.covariance;
-    // The scale calibrates the matches' model; the relief term is already a physical size.
-    covariance = options.covariance_scale * (covariance - result.pose.relief_covariance) + result.pose.relief_covariance;
-    for (int i = 0; i < 6; ++i) {
-      const double floor = i < 3 ? options.min_translation_sigma_m : options.min_rotation_sigma_rad;
-      covariance(i, i) = std::max(covariance(i, i), floor * floor);
-    }
+  if (result.pose.accepted) publishedCovariance(result.pose, options);
+  if (result.pose.accepted && options.test_opposed_relief) testOpposedRelief(input, options, result);
+  if (result.pose.accepted && options.test_pass_agreement && !rectified_matches.empty()) {
+    testPassAgreement(input, raw_matches, rectified_matches, options, result);
   }
   result.accepted = result.pose.accepted;
   result.reason = result.pose.reason;

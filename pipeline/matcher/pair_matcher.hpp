@@ -87,10 +87,52 @@ struct PairMatcherOptions {
   double covariance_scale = 30.0;
   double min_translation_sigma_m = 0.05;
   double min_rotation_sigma_rad = 0.001;
+  // Matches over a raised feature seen from opposite sides (Correspondence::opposed_relief) pair
+  // the faces, or the shadows, each line sees: far out, where a shadow is many times the feature's
+  // width, that moves the two lines closer together or apart by about a feature's width, and every
+  // such match of the pair alike. Seabed texture around the features looks the same from both
+  // sides. With this on (pairDenseOptions sets DenseMatcherOptions::mark_shadowed_relief) a pair whose inliers
+  // include such matches is estimated again without them, and the two poses are compared
+  // (Hausman): d = pose without - pose with, over the horizontal position and heading, against
+  // C_without - C_with, the extra spread of an estimate from fewer matches. Beyond the chi-square
+  // quantile below (3 degrees of freedom) the features biased the pose: the one without them is
+  // published. Within it both agree and the pose from all the matches is kept; so it is where the
+  // matches without features are too few to be estimated alone.
+  bool test_opposed_relief = true;
+  double opposed_relief_chi2 = 11.34;  // 3 degrees of freedom, 99 %
+  // Relief seen from opposite sides at low grazing biases the two passes opposite ways: raw
+  // intensity pairs each line's lit face and shadow with the other's, so the feature appears
+  // nearer to each line and the lines come out closer; rectified contrast pairs each line's
+  // highlight-and-shadow blob, which lies beyond the feature as seen from each line, so they come
+  // out further apart. Measured on far-range boulder fields (lines 184 m apart): raw 1.0-1.4 m
+  // short, rectified 0.6-1.3 m long, on the same pair. With this on, an accepted pair is estimated
+  // from each pass's matches alone; where the two differ beyond their own spreads (chi-square,
+  // 3 degrees of freedom over horizontal position and heading), the truth lies between them
+  // somewhere the data cannot say, and the published covariance grows by d d' (d: their
+  // difference), so that the graph takes the closure's lateral word for what it is worth.
+  // Off by default: on boulder_field-3815565661 it widened 9 far-range closures and SLAM went from
+  // 2.02 to 2.66 m (DR 1.73 m; publishing the two passes' midpoint instead: 2.58 m), the survey
+  // stretched further (scale 1.0034 -> 1.0045): those closures' shortening was offsetting a
+  // lengthening elsewhere (README, "Raw and rectified passes").
+  bool test_pass_agreement = false;
+  double pass_agreement_chi2 = 11.34;
 };
 
 void readPairMatcherOptions(sss::core::ConfigSection& section, PairMatcherOptions& options);
+
+// The options of the DenseMatcher that matchPair is given: `dense` with what the pair matcher's
+// own tests need from it (mark_shadowed_relief for test_opposed_relief).
+DenseMatcherOptions pairDenseOptions(const PairMatcherOptions& options);
 std::vector<std::string> validatePairMatcherOptions(const PairMatcherOptions& options);
+
+// The Hausman statistic of test_opposed_relief: d' D^-1 d over the horizontal position and heading
+// of d (a [dt, dr] tangent vector: the estimate from a subset of the matches minus the one from
+// all), D = C_subset - C_all, the spread the subset's estimate adds. D is floored at a tenth of
+// C_subset (in C_subset's whitened frame): the difference of two finite-sample covariances need not
+// be positive definite. Chi-square with 3 degrees of freedom when the subset and the rest agree;
+// -1 when C_subset is not positive definite.
+double hausmanStatistic(const sss::core::Vector6d& d, const sss::core::Matrix6d& c_subset,
+                        const sss::core::Matrix6d& c_all);
 
 // Covariance of the DR relative pose after `distance_m` of travel, tangent [dt, dr].
 sss::core::Matrix6d drRelativeCovariance(double distance_m, const PairMatcherOptions& options);
@@ -124,6 +166,17 @@ struct PairMatch {
   MatchTimings dense_timings;          // both dense passes (raw and rectified contrast) summed
   RelativePoseResult pose;             // T_a_b between the centre pings, covariance, inliers
   double mean_zncc = 0.0;
+  // test_opposed_relief: inliers over opposed relief, and the test (negative: not run, because
+  // no inlier is over such relief, or the rest could not be estimated alone).
+  int opposed_relief_inliers = 0;
+  double opposed_relief_statistic = -1.0;
+  bool opposed_relief_replaced = false;   // the pose published is the one without them
+  // test_pass_agreement: the test (negative: not run, because the rectified pass is off or either
+  // pass alone could not be estimated), the horizontal distance between the two passes' poses, and
+  // whether the published covariance was widened by it.
+  double pass_agreement_statistic = -1.0;
+  double pass_disagreement_m = 0.0;
+  bool pass_disagreement_widened = false;
   double georeference_s = 0.0;
   double seconds = 0.0;                // the whole pair
 };

@@ -422,6 +422,47 @@ TEST(DenseMatcher, FarRangeBouldersSeenFromOppositeSidesAreNotMatchedOnTheirShad
   EXPECT_GE(static_cast<double>(tested.size()), 0.97 * static_cast<double>(plain.size()));
 }
 
+TEST(DenseMatcher, MarkingShadowedReliefKeepsEveryMatchAndFlagsExactlyThoseTheRejectTestDrops) {
+  // mark_shadowed_relief is for the pair matcher's Hausman test: the same matches as without it,
+  // the ones over a feature's face or shadow flagged, and those carry the bias the reject test removes.
+  DenseMatcherOptions options;
+  options.patch_size = 13;
+  options.reject_mirrored_relief = true;
+  Pair pair = farRangeBoulderPair();
+  const std::vector<Correspondence> plain = DenseMatcher(options).match(pair.a, pair.b);
+  pair.a.relief = findReliefFeatures(pair.a);
+  pair.b.relief = findReliefFeatures(pair.b);
+  options.mark_shadowed_relief = true;
+  MatchTimings marked_timings;
+  const std::vector<Correspondence> marked = DenseMatcher(options).match(pair.a, pair.b, &marked_timings);
+  options.mark_shadowed_relief = false;
+  options.reject_shadowed_relief = true;
+  MatchTimings rejected_timings;
+  const std::vector<Correspondence> rejected = DenseMatcher(options).match(pair.a, pair.b, &rejected_timings);
+
+  ASSERT_EQ(marked.size(), plain.size());
+  std::vector<Correspondence> flagged, unflagged;
+  for (size_t i = 0; i < marked.size(); ++i) {
+    EXPECT_EQ(marked[i].row_a, plain[i].row_a);
+    EXPECT_EQ(marked[i].col_b, plain[i].col_b);
+    EXPECT_FALSE(plain[i].opposed_relief);
+    (marked[i].opposed_relief ? flagged : unflagged).push_back(marked[i]);
+  }
+  // Counted where the reject test would drop them, before the later checks (the neighbours'
+  // coherence) take some of them out: the same count as the reject test's, at least the flagged.
+  EXPECT_EQ(marked_timings.shadowed_relief_marked, rejected_timings.shadowed_relief_rejected);
+  EXPECT_LE(static_cast<long>(flagged.size()), marked_timings.shadowed_relief_marked);
+  EXPECT_EQ(marked_timings.shadowed_relief_rejected, 0);
+  EXPECT_EQ(unflagged.size(), rejected.size());
+  ASSERT_GT(flagged.size(), 10u);
+  const double flagged_bias_m = meanAcrossTrackError(flagged, pair);
+  const double unflagged_bias_m = meanAcrossTrackError(unflagged, pair);
+  std::printf("far-range boulder field: %zu marked (bias %+.3f m), %zu unmarked (bias %+.3f m)\n", flagged.size(),
+              flagged_bias_m, unflagged.size(), unflagged_bias_m);
+  EXPECT_GT(flagged_bias_m, 0.2);  // faces paired: the lines come out closer
+  EXPECT_LT(std::abs(unflagged_bias_m), 0.05);
+}
+
 TEST(DenseMatcher, ImagesWithMismatchedMatricesAreRejected) {
   Pair pair = makePair(Direction::kParallel, 0.0, seabed(3), seabed(3));
   pair.b.valid = cv::Mat1b(10, 10, 255);

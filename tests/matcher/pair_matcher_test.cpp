@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <random>
 
 #include "pipeline/core/georeference.hpp"
 #include "tests/matcher/matcher_test_survey.hpp"
@@ -31,7 +32,7 @@ void expectPairRecoversDrError(const PairCase& pair_case) {
   ASSERT_NE(a, nullptr);
   ASSERT_NE(b, nullptr);
   PairMatcherOptions options;
-  const DenseMatcher dense(options.dense);
+  const DenseMatcher dense(pairDenseOptions(options));  // as the matcher engine builds it
   const PairMatch match =
       matchPair(*a, sss::core::drPoses(*a), *b, sss::sim::posesWithDrError(*a, *b, pair_case.dr_along_m, pair_case.dr_lateral_m), dense, options);
   const test::MatchEvaluation e = test::evaluateMatches(survey, *a, *b, match.matches, options.dense.stride, match.decimation);
@@ -48,6 +49,15 @@ void expectPairRecoversDrError(const PairCase& pair_case) {
               std::sqrt(match.pose.covariance(1, 1)), match.pose.num_inliers,
               match.accepted ? "accepted" : match.reason.c_str(), match.seconds, match.georeference_s,
               match.dense_timings.total_s, match.pose.seconds);
+  std::printf("  opposed relief: %ld matches marked, %d inliers, statistic %.2f, %s\n",
+              match.dense_timings.shadowed_relief_marked, match.opposed_relief_inliers, match.opposed_relief_statistic,
+              match.opposed_relief_replaced ? "pose without them published" : "pose from all kept");
+  // Both pairs see the strip between their lines from opposite sides (parallel lines too: one
+  // looks to starboard, the other to port), so features are marked on both; at 20-40 m out their
+  // matches are not biased, and the test must keep the pose from all the matches.
+  EXPECT_GT(match.opposed_relief_inliers, 0);
+  EXPECT_GE(match.opposed_relief_statistic, 0.0);
+  EXPECT_FALSE(match.opposed_relief_replaced);
   // The matcher's acceptance: >= 80 % of the returned matches within 2 px of the true match.
   // The pairs overlap by 50 m along track; at stride 2 on 0.5 m pixels a few hundred matches is
   // what a textured stretch gives: 474 anti-parallel, 1576 parallel (recall 0.16-0.31) before the
@@ -88,6 +98,33 @@ TEST(PairMatcher, ParallelSimulatedPairRecovers3mAlongAnd2mLateralDrError) {
 // The correspondence precision holds with DR error up to 5 m between the lines.
 TEST(PairMatcher, ParallelSimulatedPairRecovers5mOfDrError) {
   expectPairRecoversDrError({"parallel (lines 0-2, 80 m), 5 m DR error", 0, 2, 4.0, 3.0});
+}
+
+TEST(PairMatcher, PassAgreementTestLeavesAPairWhosePassesAgreeAsItIs) {
+  // test_pass_agreement (off by default): at 20 m out over the default seabed the raw and the
+  // rectified pass see the same seabed and agree; the published pose and covariance stay those
+  // of all the matches.
+  const auto& survey = test::threeLineSurvey();
+  const auto* a = test::fullSubframeOfLine(survey, 0);
+  const auto* b = test::fullSubframeOfLine(survey, 1);
+  ASSERT_NE(a, nullptr);
+  ASSERT_NE(b, nullptr);
+  PairMatcherOptions options;
+  const DenseMatcher dense(pairDenseOptions(options));
+  const std::vector<Pose> poses_b = sss::sim::posesWithDrError(*a, *b, 3.0, 2.0);
+  const PairMatch plain = matchPair(*a, sss::core::drPoses(*a), *b, poses_b, dense, options);
+  options.test_pass_agreement = true;
+  const PairMatch tested = matchPair(*a, sss::core::drPoses(*a), *b, poses_b, dense, options);
+  std::printf("anti-parallel (lines 0-1): passes %.2f m apart, statistic %.2f\n", tested.pass_disagreement_m,
+              tested.pass_agreement_statistic);
+  ASSERT_TRUE(plain.accepted);
+  ASSERT_TRUE(tested.accepted);
+  EXPECT_LT(plain.pass_agreement_statistic, 0.0);  // not run when off
+  EXPECT_GE(tested.pass_agreement_statistic, 0.0);
+  EXPECT_LT(tested.pass_agreement_statistic, options.pass_agreement_chi2);
+  EXPECT_FALSE(tested.pass_disagreement_widened);
+  EXPECT_LT((tested.pose.covariance - plain.pose.covariance).norm(), 1e-12);
+  EXPECT_LT((tested.pose.T_a_b.translation - plain.pose.T_a_b.translation).norm(), 1e-12);
 }
 
 TEST(PairMatcher, ImagesOfDifferentSeabedClaimedToOverlapAreRejected) {
@@ -176,6 +213,51 @@ TEST(PairMatcher, RectifiedContrastIsTheSameForReliefSeenFromEitherSide) {
   EXPECT_LT(rect_a.intensity(20, 5), 0.01);
   EXPECT_EQ(rect_a.intensity(20, 59), 1.0f);
   EXPECT_EQ(cv::countNonZero(rect_a.valid != from_a.valid), 0);
+}
+
+TEST(PairMatcher, HausmanStatisticWeighsTheDifferenceByTheSpreadTheSubsetAdds) {
+  // A subset of half the matches: C_all = C_subset / 2, so D = C_subset / 2.
+  sss::core::Matrix6d c_subset = sss::core::Matrix6d::Identity() * 0.01;
+  c_subset(0, 0) = 0.04;   // along, m^2
+  c_subset(1, 1) = 0.09;   // lateral
+  c_subset(0, 1) = c_subset(1, 0) = 0.02;
+  c_subset(5, 5) = 1e-4;   // heading, rad^2
+  const sss::core::Matrix6d c_all = 0.5 * c_subset;
+  sss::core::Vector6d d = sss::core::Vector6d::Zero();
+  d(5) = 0.01;  // heading alone: d^2 / D = 1e-4 / 5e-5
+  EXPECT_NEAR(hausmanStatistic(d, c_subset, c_all), 2.0, 1e-9);
+  d(2) = 5.0;  // depth and roll/pitch are not in the test
+  d(3) = 0.3;
+  EXPECT_NEAR(hausmanStatistic(d, c_subset, c_all), 2.0, 1e-9);
+
+  // Drawn from N(0, D) the statistic is chi-square with 3 degrees of freedom: mean 3, 99 % under 11.34.
+  const Eigen::Matrix3d d_planar = 0.5 * (Eigen::Matrix3d() << 0.04, 0.02, 0.0, 0.02, 0.09, 0.0, 0.0, 0.0, 1e-4).finished();
+  const Eigen::Matrix3d l = d_planar.llt().matrixL();
+  std::mt19937 rng(7);
+  std::normal_distribution<double> normal;
+  double sum = 0.0;
+  int over = 0;
+  const int draws = 20000;
+  for (int k = 0; k < draws; ++k) {
+    const Eigen::Vector3d z = l * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+    sss::core::Vector6d sample = sss::core::Vector6d::Zero();
+    sample(0) = z(0);
+    sample(1) = z(1);
+    sample(5) = z(2);
+    const double statistic = hausmanStatistic(sample, c_subset, c_all);
+    sum += statistic;
+    over += statistic > PairMatcherOptions{}.opposed_relief_chi2;
+  }
+  EXPECT_NEAR(sum / draws, 3.0, 0.1);
+  EXPECT_NEAR(static_cast<double>(over) / draws, 0.01, 0.003);
+
+  // A subset almost as good as all (or, by noise, better): D is floored at a tenth of C_subset.
+  d = sss::core::Vector6d::Zero();
+  d(0) = 0.2;
+  EXPECT_NEAR(hausmanStatistic(d, c_subset, c_subset), 10.0 * 0.2 * 0.2 * 0.09 / (0.04 * 0.09 - 0.02 * 0.02), 1e-6);  // 10 d' C^-1 d
+  EXPECT_NEAR(hausmanStatistic(d, c_subset, 1.5 * c_subset), hausmanStatistic(d, c_subset, c_subset), 1e-9);
+  // No spread to weigh by: not tested.
+  EXPECT_LT(hausmanStatistic(d, sss::core::Matrix6d::Zero(), c_all), 0.0);
 }
 
 TEST(PairMatcher, MalformedInputIsRejectedWithAReason) {
