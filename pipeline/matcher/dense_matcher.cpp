@@ -506,10 +506,9 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
   }
   grid_b.value = cv::Mat1f::zeros(grid_rows, grid_cols);
   grid_b.weight = cv::Mat1f::zeros(grid_rows, grid_cols);
-  // Raised features' pixels on the grid (reject_shadowed_relief, mark_shadowed_relief), B's where
-  // any of the four pixels of its bilinear sample is one.
-  const bool test_relief =
-      (o.reject_shadowed_relief || o.mark_shadowed_relief) && !a.relief.empty() && !b.relief.empty();
+  // Raised features' pixels on the grid (marked, or dropped with reject_shadowed_relief), B's
+  // where any of the four pixels of its bilinear sample is one.
+  const bool test_relief = !a.relief.empty() && !b.relief.empty();
   cv::Mat1b relief_a, relief_b;
   if (test_relief) {
     relief_a = cv::Mat1b::zeros(grid_rows, grid_cols);

@@ -21,7 +21,9 @@ struct GeoImage {
   cv::Mat1f heading_rad;    // per-row vehicle heading (rows x 1), clockwise from north; unused here
   cv::Mat1f side;           // optional, unused
   // Optional (empty: none): 255 where a raised feature shows its lit face or its shadow
-  // (findReliefFeatures), both of which depend on the side the feature is seen from.
+  // (findReliefFeatures), both of which depend on the side the feature is seen from. Given for
+  // both images, the matches between opposed views over such a pixel are marked
+  // (Correspondence::opposed_relief), or dropped with reject_shadowed_relief.
   cv::Mat1b relief;
 };
 
@@ -71,10 +73,6 @@ struct DenseMatcherOptions {
   // match between views whose look directions are more than 135 deg apart is dropped when a
   // feature pixel lies in A's patch or in B's. Needs GeoImage::relief; views from one side keep all.
   bool reject_shadowed_relief = false;
-  // The same matches kept but marked (Correspondence::opposed_relief), so that the pair matcher
-  // can test them against the rest (PairMatcherOptions::test_opposed_relief). Needs
-  // GeoImage::relief; ignored when reject_shadowed_relief drops them.
-  bool mark_shadowed_relief = false;
   // Relief seen from opposite sides at low grazing is contrast-inverted: the slope lit for one line
   // is the one in shadow for the other. On periodic relief (sand waves, megaripples) the inverted
   // pattern correlates best half a wavelength off the truth, with a ZNCC as high as a true match's,
@@ -103,9 +101,9 @@ struct Correspondence {
   // A sharp peak locates the match in range better than a flat one (measured on simulated
   // missions: the median range error halves from the flattest to the sharpest quarter).
   float peak_curvature_col = 0.0f;
-  // Seen from opposite sides with a raised feature's face or shadow in either patch (only set with
-  // DenseMatcherOptions::mark_shadowed_relief): the match may be biased towards the side each
-  // line sees the feature from.
+  // Seen from opposite sides with a raised feature's face or shadow in either patch (only set when
+  // both images carry GeoImage::relief): the match may be biased towards the side each line sees
+  // the feature from (PairMatcherOptions::test_opposed_relief tests it against the rest).
   bool opposed_relief = false;
 };
 
@@ -120,7 +118,7 @@ struct MatchTimings {
   long matches = 0;
   long mirrored_relief_rejected = 0;  // matches dropped by reject_mirrored_relief
   long shadowed_relief_rejected = 0;  // matches dropped by reject_shadowed_relief
-  long shadowed_relief_marked = 0;    // matches marked by mark_shadowed_relief (before the later checks)
+  long shadowed_relief_marked = 0;    // matches marked as opposed_relief (before the later checks)
   long inverted_relief_rejected = 0;  // matches dropped by reject_inverted_relief
 };
 

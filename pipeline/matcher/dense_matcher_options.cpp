@@ -53,7 +53,6 @@ void readDenseMatcherOptions(sss::core::ConfigSection& section, DenseMatcherOpti
   section.optional("subpixel", options.subpixel);
   section.optional("reject_mirrored_relief", options.reject_mirrored_relief);
   section.optional("reject_shadowed_relief", options.reject_shadowed_relief);
-  section.optional("mark_shadowed_relief", options.mark_shadowed_relief);
   section.optional("reject_inverted_relief", options.reject_inverted_relief);
   section.optional("min_coherent_neighbours", options.min_coherent_neighbours, {inRange(0, 8)});
   section.optional("min_structure_ratio", options.min_structure_ratio, {inRange(0.0, 1.0)});

@@ -47,7 +47,7 @@ std::vector<std::string> validateMatcherEngineOptions(const MatcherEngineOptions
   return problems;
 }
 
-MatcherEngine::MatcherEngine(const MatcherEngineOptions& options) : options_(options), dense_(pairDenseOptions(options.pair)) {
+MatcherEngine::MatcherEngine(const MatcherEngineOptions& options) : options_(options), dense_(options.pair.dense) {
   const std::vector<std::string> problems = validateMatcherEngineOptions(options_);
   if (!problems.empty()) throw std::invalid_argument("MatcherEngineOptions: " + problems.front());
 }

@@ -49,12 +49,6 @@ void readPairMatcherOptions(sss::core::ConfigSection& section, PairMatcherOption
   section.optional("pass_agreement_chi2", options.pass_agreement_chi2, {inRange(0.0, 1e6)});
 }
 
-DenseMatcherOptions pairDenseOptions(const PairMatcherOptions& options) {
-  DenseMatcherOptions dense = options.dense;
-  dense.mark_shadowed_relief = dense.mark_shadowed_relief || options.test_opposed_relief;
-  return dense;
-}
-
 std::vector<std::string> validatePairMatcherOptions(const PairMatcherOptions& o) {
   std::vector<std::string> problems = validateDenseMatcherOptions(o.dense);
   for (const std::string& p : validateRelativePoseOptions(o.pose)) problems.push_back(p);
@@ -307,7 +301,7 @@ PairMatch matchPair(const sss::core::Subframe& a, const std::vector<sss::core::P
   result.decimation = columnDecimation(a.geometry, options);
   GeoImage image_a = toGeoImage(a, poses_a, result.decimation, options.smoothing_sigma_px);
   GeoImage image_b = toGeoImage(b, poses_b, result.decimation, options.smoothing_sigma_px);
-  if (dense.options().reject_shadowed_relief || dense.options().mark_shadowed_relief) {  // smoothed, both passes
+  if (dense.options().reject_shadowed_relief || options.test_opposed_relief) {  // smoothed, both passes
     image_a.relief = findReliefFeatures(image_a);
     image_b.relief = findReliefFeatures(image_b);
   }

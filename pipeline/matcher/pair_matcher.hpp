@@ -91,7 +91,7 @@ struct PairMatcherOptions {
   // the faces, or the shadows, each line sees: far out, where a shadow is many times the feature's
   // width, that moves the two lines closer together or apart by about a feature's width, and every
   // such match of the pair alike. Seabed texture around the features looks the same from both
-  // sides. With this on (pairDenseOptions sets DenseMatcherOptions::mark_shadowed_relief) a pair whose inliers
+  // sides. With this on (matchPair gives the dense matcher GeoImage::relief to mark them) a pair whose inliers
   // include such matches is estimated again without them, and the two poses are compared
   // (Hausman): d = pose without - pose with, over the horizontal position and heading, against
   // C_without - C_with, the extra spread of an estimate from fewer matches. Beyond the chi-square
@@ -120,9 +120,6 @@ struct PairMatcherOptions {
 
 void readPairMatcherOptions(sss::core::ConfigSection& section, PairMatcherOptions& options);
 
-// The options of the DenseMatcher that matchPair is given: `dense` with what the pair matcher's
-// own tests need from it (mark_shadowed_relief for test_opposed_relief).
-DenseMatcherOptions pairDenseOptions(const PairMatcherOptions& options);
 std::vector<std::string> validatePairMatcherOptions(const PairMatcherOptions& options);
 
 // The Hausman statistic of test_opposed_relief: d' D^-1 d over the horizontal position and heading

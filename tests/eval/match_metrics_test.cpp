@@ -74,7 +74,7 @@ TEST(MatchFile, EvaluationFromTheFileEqualsTheInProcessOne) {
     for (std::string line; std::getline(sim_yaml, line);) yaml << "  " << line << "\n";
   }
   const sss::matcher::PairMatcherOptions options;
-  const sss::matcher::DenseMatcher dense(sss::matcher::pairDenseOptions(options));
+  const sss::matcher::DenseMatcher dense(options.dense);
   sss::offline::MatchCsvWriter writer;
   ASSERT_OK(writer.open((dir / "matches.csv").string(), options.dense.stride, 4));
   std::vector<MatchEvaluation> in_process;

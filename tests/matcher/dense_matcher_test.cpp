@@ -423,8 +423,9 @@ TEST(DenseMatcher, FarRangeBouldersSeenFromOppositeSidesAreNotMatchedOnTheirShad
 }
 
 TEST(DenseMatcher, MarkingShadowedReliefKeepsEveryMatchAndFlagsExactlyThoseTheRejectTestDrops) {
-  // mark_shadowed_relief is for the pair matcher's Hausman test: the same matches as without it,
-  // the ones over a feature's face or shadow flagged, and those carry the bias the reject test removes.
+  // Relief masks without the reject test, for the pair matcher's Hausman test: the same matches as
+  // without them, the ones over a feature's face or shadow flagged, and those carry the bias the
+  // reject test removes.
   DenseMatcherOptions options;
   options.patch_size = 13;
   options.reject_mirrored_relief = true;
@@ -432,10 +433,8 @@ TEST(DenseMatcher, MarkingShadowedReliefKeepsEveryMatchAndFlagsExactlyThoseTheRe
   const std::vector<Correspondence> plain = DenseMatcher(options).match(pair.a, pair.b);
   pair.a.relief = findReliefFeatures(pair.a);
   pair.b.relief = findReliefFeatures(pair.b);
-  options.mark_shadowed_relief = true;
   MatchTimings marked_timings;
   const std::vector<Correspondence> marked = DenseMatcher(options).match(pair.a, pair.b, &marked_timings);
-  options.mark_shadowed_relief = false;
   options.reject_shadowed_relief = true;
   MatchTimings rejected_timings;
   const std::vector<Correspondence> rejected = DenseMatcher(options).match(pair.a, pair.b, &rejected_timings);

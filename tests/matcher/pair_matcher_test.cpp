@@ -32,7 +32,7 @@ void expectPairRecoversDrError(const PairCase& pair_case) {
   ASSERT_NE(a, nullptr);
   ASSERT_NE(b, nullptr);
   PairMatcherOptions options;
-  const DenseMatcher dense(pairDenseOptions(options));  // as the matcher engine builds it
+  const DenseMatcher dense(options.dense);
   const PairMatch match =
       matchPair(*a, sss::core::drPoses(*a), *b, sss::sim::posesWithDrError(*a, *b, pair_case.dr_along_m, pair_case.dr_lateral_m), dense, options);
   const test::MatchEvaluation e = test::evaluateMatches(survey, *a, *b, match.matches, options.dense.stride, match.decimation);
@@ -110,7 +110,7 @@ TEST(PairMatcher, PassAgreementTestLeavesAPairWhosePassesAgreeAsItIs) {
   ASSERT_NE(a, nullptr);
   ASSERT_NE(b, nullptr);
   PairMatcherOptions options;
-  const DenseMatcher dense(pairDenseOptions(options));
+  const DenseMatcher dense(options.dense);
   const std::vector<Pose> poses_b = sss::sim::posesWithDrError(*a, *b, 3.0, 2.0);
   const PairMatch plain = matchPair(*a, sss::core::drPoses(*a), *b, poses_b, dense, options);
   options.test_pass_agreement = true;

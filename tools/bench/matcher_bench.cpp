@@ -93,7 +93,7 @@ int main(int argc, char** argv) {
     }
     options = engine.pair;
   }
-  const sss::matcher::DenseMatcher dense(sss::matcher::pairDenseOptions(options));
+  const sss::matcher::DenseMatcher dense(options.dense);
   const sss::matcher::OverlapOptions overlap;
   const sss::eval::SurveyFootprints candidates = sss::eval::fullSubframeFootprints(survey, overlap);
   const std::vector<const sss::core::Subframe*>& full = candidates.subframes;
