@@ -190,6 +190,7 @@ struct Solved {
   std::optional<sss::core::Matrix6d> robust_covariance; // cluster-robust sandwich (from residuals)
   sss::core::Vector6d per_seabed_offset = sss::core::Vector6d::Zero();
   sss::core::Vector6d per_seabed_tilt = sss::core::Vector6d::Zero();
+  sss::core::Vector6d per_range_bias = sss::core::Vector6d::Zero();
   int clusters = 0;
 };
 
@@ -211,6 +212,9 @@ struct ClusterRobust {
   sss::core::Vector6d per_seabed_offset = sss::core::Vector6d::Zero();
   // The same per unit slope of the seabed along A's track (offset (x - mean x) per landmark).
   sss::core::Vector6d per_seabed_tilt = sss::core::Vector6d::Zero();
+  // How far the pose moves per metre every matched pixel lies nearer both sonars than the landmark
+  // (a common relief range bias, RelativePoseOptions::range_bias_sigma_m).
+  sss::core::Vector6d per_range_bias = sss::core::Vector6d::Zero();
   int clusters = 0;
   bool ok = false;
 };
@@ -228,6 +232,7 @@ ClusterRobust clusterRobustCovariance(const std::vector<Measurement>& measuremen
   Matrix6d information = Matrix6d::Zero();
   Vector6d seabed_offset_gradient = Vector6d::Zero();  // d (reduced gradient) / d (prior depth offset)
   Vector6d seabed_tilt_gradient = Vector6d::Zero();    // d (reduced gradient) / d (prior slope along x)
+  Vector6d range_bias_gradient = Vector6d::Zero();     // d (reduced gradient) / d (common range bias)
   double mean_along_m = 0.0;
   for (size_t i = 0; i < subset.size(); ++i) mean_along_m += landmarks[i].x() / static_cast<double>(subset.size());
   std::unique_ptr<ceres::LossFunction> loss;
@@ -247,6 +252,8 @@ ClusterRobust clusterRobustCovariance(const std::vector<Measurement>& measuremen
     Eigen::Matrix<double, 5, 1> r = Eigen::Matrix<double, 5, 1>::Zero();
     Eigen::Matrix<double, 5, 6> J_pose = Eigen::Matrix<double, 5, 6>::Zero();
     Eigen::Matrix<double, 5, 3> J_landmark = Eigen::Matrix<double, 5, 3>::Zero();
+    // d r / d bias: both range rows are (|p| - (range + bias)) / sigma, times their robust weight.
+    Eigen::Matrix<double, 5, 1> J_bias = Eigen::Matrix<double, 5, 1>::Zero();
     const double* x = landmarks[i].data();
     {
       ceres::AutoDiffCostFunction<BinResidualA, 2, 3> cost(
@@ -258,6 +265,7 @@ ClusterRobust clusterRobustCovariance(const std::vector<Measurement>& measuremen
       const double w = weight(r.data(), 2);
       r.segment<2>(0) *= w;
       J_landmark.block<2, 3>(0, 0) = w * J_l;
+      J_bias(0) = -w / m.range_sigma_m;
     }
     {
       ceres::AutoDiffCostFunction<BinResidualB, 2, 6, 3> cost(
@@ -271,6 +279,7 @@ ClusterRobust clusterRobustCovariance(const std::vector<Measurement>& measuremen
       r.segment<2>(2) *= w;
       J_pose.block<2, 6>(2, 0) = w * J_p;
       J_landmark.block<2, 3>(2, 0) = w * J_l;
+      J_bias(2) = -w / m.range_sigma_m;
     }
     if (options.use_seabed_prior) {
       const SeabedResidual seabed{m.down_a, m.seabed_depth_a_m, options.seabed_sigma_m};
@@ -285,6 +294,7 @@ ClusterRobust clusterRobustCovariance(const std::vector<Measurement>& measuremen
     const Eigen::Matrix<double, 6, 3> A_pl = J_pose.transpose() * J_landmark;
     information += J_pose.transpose() * J_pose - A_pl * ldlt.solve(A_pl.transpose());
     const Vector6d gradient = J_pose.transpose() * r - A_pl * ldlt.solve(J_landmark.transpose() * r);
+    range_bias_gradient += J_pose.transpose() * J_bias - A_pl * ldlt.solve(J_landmark.transpose() * J_bias);
     // The seabed row is (down . x - depth - offset) / sigma and does not involve the pose.
     if (options.use_seabed_prior) {
       const Vector6d per_offset = A_pl * ldlt.solve(m.down_a) / (options.seabed_sigma_m * options.seabed_sigma_m);
@@ -315,6 +325,7 @@ ClusterRobust clusterRobustCovariance(const std::vector<Measurement>& measuremen
   if (bread.info() != Eigen::Success) return out;
   out.per_seabed_offset = -bread.solve(seabed_offset_gradient);
   out.per_seabed_tilt = -bread.solve(seabed_tilt_gradient);
+  out.per_range_bias = -bread.solve(range_bias_gradient);
   out.clusters = static_cast<int>(gradient_by_cluster.size());
   if (out.clusters < 2) return out;
   Matrix6d meat = Matrix6d::Zero();
@@ -426,13 +437,15 @@ Solved solve(const std::vector<Measurement>& measurements, const std::vector<int
       covariance.GetCovarianceBlock(delta, delta, c.data());  // row-major; symmetric anyway
       out.covariance = 0.5 * (c + c.transpose());
     }
-    // The sandwich when asked for; the pose's sensitivity to a common seabed offset whenever the
-    // relief term will use it (whichever covariance it is added to).
-    if (options.covariance_cluster_m > 0.0 || (options.use_seabed_prior && options.seabed_relief_covariance)) {
+    // The sandwich when asked for; the pose's sensitivity to a common seabed offset and to a common
+    // range bias whenever the relief terms will use them (whichever covariance they are added to).
+    if (options.covariance_cluster_m > 0.0 || (options.use_seabed_prior && options.seabed_relief_covariance) ||
+        options.range_bias_covariance) {
       const ClusterRobust cluster_robust =
           clusterRobustCovariance(measurements, subset, landmarks, &anchor, dr, sqrt_information, options, robust);
       out.per_seabed_offset = cluster_robust.per_seabed_offset;
       out.per_seabed_tilt = cluster_robust.per_seabed_tilt;
+      out.per_range_bias = cluster_robust.per_range_bias;
       if (options.covariance_cluster_m > 0.0) {
         out.clusters = cluster_robust.clusters;
         if (cluster_robust.ok) out.robust_covariance = cluster_robust.covariance;
@@ -763,8 +776,17 @@ RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const Re
       const double tilt = result.seabed_tilt_sigma;
       result.relief_covariance += tilt * tilt * refined.per_seabed_tilt * refined.per_seabed_tilt.transpose();
     }
-    result.covariance += result.relief_covariance;
   }
+  // Raised features' faces: every matched pixel nearer both sonars than the point both lines see
+  // moves the pose along per_range_bias, and no residual shows it either.
+  if (refined.robust_covariance || refined.covariance) {
+    result.range_bias_sensitivity = refined.per_range_bias;
+    if (options.range_bias_covariance) {
+      const double b = options.range_bias_sigma_m;
+      result.relief_covariance += b * b * refined.per_range_bias * refined.per_range_bias.transpose();
+    }
+  }
+  result.covariance += result.relief_covariance;
 
   std::ostringstream text;
   if (!refined.usable || !refined.covariance) {

@@ -82,6 +82,15 @@ struct RelativePoseOptions {
   // the altimetry shows (as above) taken as a ramp over the subframe's length L: slope
   // sigma sqrt(12) / L. Not scaled by covariance_scale either.
   bool seabed_tilt_covariance = true;
+  // Relief range bias: a raised feature (boulder, rock) shows each line the face turned towards it,
+  // so the pixels a match pairs lie nearer each sonar than one point both lines see; their mean over
+  // the pair's matches is a range bias common to the pair. Where the lines look at their overlap
+  // from opposite sides it is a lateral offset (parallel lines come out closer together), and
+  // nothing in the residuals shows it; between crossing lines it shortens the closure too. The
+  // covariance gets the pose's sensitivity to such a bias times range_bias_sigma_m (not scaled by
+  // PairMatcherOptions::covariance_scale: a physical size, like the seabed relief terms).
+  bool range_bias_covariance = true;
+  double range_bias_sigma_m = 0.3;
 };
 
 // Everything the estimator needs from the two subframes, in each subframe's own DR frame.
@@ -116,6 +125,9 @@ struct RelativePoseResult {
   int num_inliers = 0;                      // among all matches, scored with the final pose
   double range_cost = 0.0;                  // mean squared whitened range residual (refinement)
   double plane_cost = 0.0;                  // mean squared whitened plane residual (refinement)
+  // d T_a_b / d bias, tangent [dt, dr]: how far the pose moves when every matched pixel lies one
+  // metre nearer both sonars (range_bias_covariance uses it; computed with the relief terms).
+  sss::core::Vector6d range_bias_sensitivity = sss::core::Vector6d::Zero();
   double total_cost = 0.0;                  // Ceres final cost of the refinement (0.5 sum r^2)
   std::vector<int> inlier_indices;          // into matches: the refined ones (<= max_correspondences)
   std::vector<Eigen::Vector3d> landmarks_a; // parallel to inlier_indices, in A's centre body frame

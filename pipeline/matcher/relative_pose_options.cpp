@@ -26,6 +26,7 @@ std::vector<std::string> validateRelativePoseOptions(const RelativePoseOptions& 
   if (!(o.time_limit_s >= 0.0)) problems.push_back("time_limit_s must be >= 0 (0: no wall-clock cap)");
   if (!(o.covariance_cluster_m >= 0.0))
     problems.push_back("covariance_cluster_m must be >= 0 (0: Ceres' covariance with the assumed sigmas)");
+  if (!(o.range_bias_sigma_m > 0.0)) problems.push_back("range_bias_sigma_m must be > 0");
   if (o.min_covariance_clusters < 2) problems.push_back("min_covariance_clusters must be >= 2");
   return problems;
 }
@@ -60,6 +61,8 @@ void readRelativePoseOptions(sss::core::ConfigSection& section, RelativePoseOpti
   section.optional("min_covariance_clusters", options.min_covariance_clusters, {inRange(2, 100000)});
   section.optional("seabed_relief_covariance", options.seabed_relief_covariance);
   section.optional("seabed_tilt_covariance", options.seabed_tilt_covariance);
+  section.optional("range_bias_covariance", options.range_bias_covariance);
+  section.optional("range_bias_sigma_m", options.range_bias_sigma_m, {greaterThan(0.0)});
   if (options.max_correspondences < options.ransac_subset)
     section.addProblem("max_correspondences", std::to_string(options.max_correspondences),
                        "must be >= ransac_subset (" + std::to_string(options.ransac_subset) + ")");

@@ -54,6 +54,9 @@ struct PatchErrors {
   double east_min_m = 20.0;     // the overlap strip the matches are drawn from (A's starboard)
   double east_max_m = 40.0;
   double strip_slope = 0.0;     // the seabed under the matches rises this much per metre north
+  // Every matched pixel lies this much nearer each sonar (slant range) than the seabed point both
+  // lines see: a raised feature's face turned towards each line.
+  double relief_range_bias_m = 0.0;
 };
 
 SyntheticPair makePair(bool anti_parallel, std::uint64_t seed, int num_matches = 1000, double outlier_fraction = 0.2,
@@ -109,7 +112,8 @@ SyntheticPair makePair(bool anti_parallel, std::uint64_t seed, int num_matches =
     const double height_m = kAltitudeM + relief(rng) - patch_errors.strip_slope * north;
     // The canonical image's column is the flat-seabed ground range of the true slant range.
     auto canonicalGroundRange = [&](double across_m) {
-      return std::sqrt(across_m * across_m + height_m * height_m - kAltitudeM * kAltitudeM);
+      const double slant_m = std::sqrt(across_m * across_m + height_m * height_m) - patch_errors.relief_range_bias_m;
+      return std::sqrt(slant_m * slant_m - kAltitudeM * kAltitudeM);
     };
     Correspondence c;
     c.row_a = static_cast<float>((north + 50.0) / kPingSpacingM + pixel_noise(rng));
@@ -137,6 +141,10 @@ RelativePoseOptions testOptions() {
   EXPECT_EQ(options.covariance_cluster_m, 0.0);  // Ceres' covariance unless asked
   options.range_sigma_m = 0.05;  // the simulated column noise: 0.5 bin of 0.1 m
   options.seabed_sigma_m = kReliefSigmaM;
+  // The synthetic seabed has no raised features: the range-bias term (on by default) is tested on
+  // its own (ReliefRangeBiasIsPredictedAndCoveredByItsCovarianceTerm).
+  EXPECT_TRUE(options.range_bias_covariance);
+  options.range_bias_covariance = false;
   // No wall-clock cap (the default): the full RANSAC budget (200 hypotheses) whatever the machine
   // speed, so the test checks the estimator, not the machine.
   EXPECT_EQ(options.time_limit_s, 0.0);
@@ -423,6 +431,57 @@ TEST(RelativePose, SeabedRisingAlongTheStripWidensTheHeadingSigma) {
   EXPECT_GT(std::abs(heading_error_rad), 3.0 * std::sqrt(without.covariance(5, 5)));  // overconfident without
   EXPECT_LT(std::abs(heading_error_rad), 2.0 * std::sqrt(with.covariance(5, 5)));     // covered with it
   EXPECT_NEAR(std::sqrt(with.relief_covariance(5, 5)), expected_heading_rad, 0.3 * expected_heading_rad);
+}
+
+// Raised features show each line the face turned towards it: every matched pixel lies nearer both
+// sonars than the point the two lines share. Between parallel lines looking at the strip between
+// them that is a lateral offset (the lines come out closer together) and no residual shows it. The
+// estimator reports the pose's sensitivity to such a bias, which predicts the shift it causes, and
+// range_bias_covariance adds it to the covariance so that the biased closure is covered.
+TEST(RelativePose, ReliefRangeBiasIsPredictedAndCoveredByItsCovarianceTerm) {
+  PatchErrors faces;
+  faces.relief_range_bias_m = 0.3;
+  const SyntheticPair clean = makePair(false, 13);
+  const SyntheticPair biased = makePair(false, 13, 1000, 0.2, false, faces);  // the same draws
+  RelativePoseOptions options = testOptions();  // without the term
+  const RelativePoseResult clean_result = estimateRelativePose(clean.input, options);
+  const RelativePoseResult biased_without = estimateRelativePose(biased.input, options);
+  options.range_bias_covariance = true;
+  options.range_bias_sigma_m = faces.relief_range_bias_m;
+  const RelativePoseResult biased_with = estimateRelativePose(biased.input, options);
+  const RelativePoseResult clean_with = estimateRelativePose(clean.input, options);
+  for (const RelativePoseResult* r : {&clean_result, &biased_without, &biased_with, &clean_with})
+    ASSERT_TRUE(r->accepted) << r->reason;
+
+  // A slant range short by b at ground range g is a ground range short by b r / g; both lines see
+  // the strip 20-40 m out, so B comes b (r_a / g_a + r_b / g_b) nearer: the sensitivity is that mean.
+  double expected_sensitivity = 0.0;
+  const int steps = 200;
+  for (int i = 0; i < steps; ++i) {
+    const double g = 20.0 + 20.0 * (i + 0.5) / steps;
+    expected_sensitivity += 2.0 * std::hypot(g, kAltitudeM) / g / steps;
+  }
+  const double sensitivity = biased_with.range_bias_sensitivity(1);
+  const double shift_m = biased_without.T_a_b.translation.y() - clean_result.T_a_b.translation.y();
+  const Errors with = errorsOf(biased, biased_with);
+  const Errors without = errorsOf(biased, biased_without);
+  std::printf("relief range bias 0.3 m: lateral shift %.3f m, predicted %.3f m (sensitivity %.3f, geometry %.3f); "
+              "lateral sigma %.3f -> %.3f m, translation NEES %.1f -> %.1f; clean pair's lateral sigma %.3f -> %.3f m\n",
+              shift_m, -faces.relief_range_bias_m * sensitivity, sensitivity, expected_sensitivity,
+              std::sqrt(biased_without.covariance(1, 1)), std::sqrt(biased_with.covariance(1, 1)),
+              without.nees_translation, with.nees_translation, std::sqrt(clean_result.covariance(1, 1)),
+              std::sqrt(clean_with.covariance(1, 1)));
+  EXPECT_NEAR(sensitivity, expected_sensitivity, 0.15 * expected_sensitivity);
+  EXPECT_NEAR(shift_m, -faces.relief_range_bias_m * sensitivity, 0.15 * faces.relief_range_bias_m * sensitivity);
+  // Without the term the closure is many sigmas off; with it, covered (chi-square 3 dof, 99 %).
+  EXPECT_GT(without.nees_translation, 30.0);
+  EXPECT_LT(with.nees_translation, 11.34);
+  EXPECT_LT(std::abs(with.translation_m.y()), 2.0 * std::sqrt(biased_with.covariance(1, 1)));
+  // The term is the sensitivity times the sigma, added whatever the matches (its price on a clean pair).
+  const double added_m = faces.relief_range_bias_m * sensitivity;
+  EXPECT_NEAR(clean_with.covariance(1, 1) - clean_result.covariance(1, 1), added_m * added_m, 0.05 * added_m * added_m);
+  // Along track and heading it costs next to nothing: the bias moves the lines apart, not along.
+  EXPECT_LT(std::abs(biased_with.range_bias_sensitivity(0)), 0.1 * sensitivity);
 }
 
 // Matches located by ZNCC peaks of varied sharpness: each match's range error grows as its peak
