@@ -190,7 +190,7 @@ struct Solved {
   std::optional<sss::core::Matrix6d> robust_covariance; // cluster-robust sandwich (from residuals)
   sss::core::Vector6d per_seabed_offset = sss::core::Vector6d::Zero();
   sss::core::Vector6d per_seabed_tilt = sss::core::Vector6d::Zero();
-  sss::core::Vector6d per_range_bias = sss::core::Vector6d::Zero();
+  sss::core::Vector6d per_range_bias = sss::core::Vector6d::Zero();  // see ClusterRobust
   int clusters = 0;
 };
 
@@ -778,13 +778,11 @@ RelativePoseResult estimateRelativePose(const RelativePoseInput& input, const Re
     }
   }
   // Raised features' faces: every matched pixel nearer both sonars than the point both lines see
-  // moves the pose along per_range_bias, and no residual shows it either.
-  if (refined.robust_covariance || refined.covariance) {
-    result.range_bias_sensitivity = refined.per_range_bias;
-    if (options.range_bias_covariance) {
-      const double b = options.range_bias_sigma_m;
-      result.relief_covariance += b * b * refined.per_range_bias * refined.per_range_bias.transpose();
-    }
+  // moves the pose along per_range_bias, and no residual shows it either (zero without a covariance).
+  result.range_bias_sensitivity = refined.per_range_bias;
+  if (options.range_bias_covariance) {
+    const double b = options.range_bias_sigma_m;
+    result.relief_covariance += b * b * refined.per_range_bias * refined.per_range_bias.transpose();
   }
   result.covariance += result.relief_covariance;
 

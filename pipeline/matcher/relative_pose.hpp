@@ -126,7 +126,8 @@ struct RelativePoseResult {
   double range_cost = 0.0;                  // mean squared whitened range residual (refinement)
   double plane_cost = 0.0;                  // mean squared whitened plane residual (refinement)
   // d T_a_b / d bias, tangent [dt, dr]: how far the pose moves when every matched pixel lies one
-  // metre nearer both sonars (range_bias_covariance uses it; computed with the relief terms).
+  // metre nearer both sonars (range_bias_covariance uses it). Zero when no covariance term needs
+  // it (range_bias_covariance, seabed_relief_covariance and covariance_cluster_m all off).
   sss::core::Vector6d range_bias_sensitivity = sss::core::Vector6d::Zero();
   double total_cost = 0.0;                  // Ceres final cost of the refinement (0.5 sum r^2)
   std::vector<int> inlier_indices;          // into matches: the refined ones (<= max_correspondences)

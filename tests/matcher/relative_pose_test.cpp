@@ -480,7 +480,7 @@ TEST(RelativePose, ReliefRangeBiasIsPredictedAndCoveredByItsCovarianceTerm) {
   // The term is the sensitivity times the sigma, added whatever the matches (its price on a clean pair).
   const double added_m = faces.relief_range_bias_m * sensitivity;
   EXPECT_NEAR(clean_with.covariance(1, 1) - clean_result.covariance(1, 1), added_m * added_m, 0.05 * added_m * added_m);
-  // Along track and heading it costs next to nothing: the bias moves the lines apart, not along.
+  // Along track it costs next to nothing: the bias moves the lines apart, not along.
   EXPECT_LT(std::abs(biased_with.range_bias_sensitivity(0)), 0.1 * sensitivity);
 }
 
