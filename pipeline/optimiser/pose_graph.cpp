@@ -594,6 +594,7 @@ bool SlidingWindowPoseGraph::linearise(const Factor& f, LinearisedFactor& out) c
     out.jacobian.middleCols<6>(6 * static_cast<int>(k)) = weight * ambient[i] * plusJacobian(parameters[i].data());
   }
   out.residual = weight * residual;
+  out.robust_weight = weight;
   return out.jacobian.allFinite() && out.residual.allFinite();
 }
 

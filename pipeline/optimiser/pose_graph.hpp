@@ -84,6 +84,16 @@ struct PoseGraphOptions {
   // than the pairwise test).
   double gate_chi2 = 22.46;
   int gate_min_accepted_closures = 5;
+  // The same test once more at full smoothing, against the smoothed survey. PCM compares closures
+  // two at a time through DR chains whose drift model is wide, so a closure can pass it and still
+  // lie many sigmas from the solution everything else agrees on (measured: a far-range pair on a
+  // rippled seabed matched 6.9 m off, 9 sigma, as the first closure, when the gate above was not
+  // yet active). Each closure's chi-square is its leave-one-out innovation: its residual against
+  // the survey the other factors give, under the covariance of both (linearised at the solution; an
+  // outlier bends the graph towards itself, so its residual under the solution alone says little).
+  // The worst closure beyond this is rejected (kChiSquareGate) and the graph solved again, until
+  // none is left. 0: off.
+  double smoothed_gate_chi2 = 22.46;
   // Pairwise consistency (PCM): cycle closure_i * DR chain * closure_j^-1 * DR chain within this
   // chi-square (6 dof: 16.81 = 99 %); the largest mutually consistent set among the newest
   // pcm_max_closures closures is accepted when it has at least min_consistent_closures members
@@ -256,7 +266,8 @@ struct FixCounters {
 enum class ClosureStatus { kPending, kAccepted, kRejected, kSuperseded };
 enum class ClosureRejection {
   kNone,
-  kChiSquareGate,    // innovation against the current estimate beyond gate_chi2
+  kChiSquareGate,    // innovation against the current estimate beyond gate_chi2, or its residual
+                     // under the smoothed survey beyond smoothed_gate_chi2
   kInconsistent,     // outside the largest pairwise-consistent set
   kNoSupport,        // left the PCM horizon without ever being in a large enough consistent set
 };
@@ -523,6 +534,7 @@ class SlidingWindowPoseGraph {
     std::vector<int> nodes;  // variable nodes only
     Eigen::MatrixXd jacobian;  // rows x 6 * nodes.size(), tangent space
     Eigen::VectorXd residual;
+    double robust_weight = 1.0;  // sqrt(rho') of the robust loss: jacobian and residual are scaled by it
   };
 
   // Factors of the current window: nodes >= first_active_ are variables, older ones constants.
@@ -585,6 +597,14 @@ class SlidingWindowPoseGraph {
   // Variance components of closures and odometry at the current estimate, solving again with the
   // new factors until they settle (full smoothing, every node active).
   void reweighFromResiduals(const std::vector<Factor>& factors, UpdateReport& report, bool estimate_calibration);
+  // smoothed_gate_chi2 at full smoothing: rejects the worst closure beyond it and solves again
+  // (factors follow), until every accepted closure holds. False when a solve failed.
+  bool rejectClosuresTheSurveyDoesNotHold(std::vector<Factor>& factors, UpdateReport& report,
+                                          bool estimate_calibration);
+  // The leave-one-out chi-square of every closure among the factors (NaN for other factors and when
+  // it cannot be computed), linearised at the current estimate with every node a variable: the
+  // closure's innovation against the solution the other factors give, under the covariance of both.
+  std::vector<double> closureLeaveOneOutChi2(const std::vector<Factor>& factors) const;
   void marginaliseOldest();
   // marginaliseOldest() until the window holds window_size nodes.
   void marginaliseBeyondWindow();

@@ -36,6 +36,7 @@ std::vector<std::string> validatePoseGraphOptions(const PoseGraphOptions& o) {
   if (o.min_closure_inliers < 0) problems.push_back("min_closure_inliers must be >= 0");
   positive(o.gate_chi2, "gate_chi2");
   if (o.gate_min_accepted_closures < 0) problems.push_back("gate_min_accepted_closures must be >= 0");
+  if (!(o.smoothed_gate_chi2 >= 0.0)) problems.push_back("smoothed_gate_chi2 must be >= 0 (0: off)");
   positive(o.pcm_chi2, "pcm_chi2");
   if (o.pcm_max_closures < 1) problems.push_back("pcm_max_closures must be >= 1");
   if (o.min_consistent_closures < 1) problems.push_back("min_consistent_closures must be >= 1");
@@ -102,6 +103,7 @@ void readPoseGraphOptions(sss::core::ConfigSection& section, PoseGraphOptions& o
   section.optional("min_closure_inliers", options.min_closure_inliers, {atLeast(0)});
   section.optional("gate_chi2", options.gate_chi2, {greaterThan(0.0)});
   section.optional("gate_min_accepted_closures", options.gate_min_accepted_closures, {atLeast(0)});
+  section.optional("smoothed_gate_chi2", options.smoothed_gate_chi2, {atLeast(0.0)});
   section.optional("pcm_chi2", options.pcm_chi2, {greaterThan(0.0)});
   section.optional("pcm_max_closures", options.pcm_max_closures, {inRange(1, 10000)});
   section.optional("min_consistent_closures", options.min_consistent_closures, {atLeast(1)});

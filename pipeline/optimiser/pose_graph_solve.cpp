@@ -6,6 +6,8 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -330,6 +332,96 @@ void SlidingWindowPoseGraph::reweighFromResiduals(const std::vector<Factor>& fac
   }
 }
 
+std::vector<double> SlidingWindowPoseGraph::closureLeaveOneOutChi2(const std::vector<Factor>& factors) const {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> chi2(factors.size(), nan);
+  const int n = static_cast<int>(nodes_.size()) - first_active_;
+  if (n <= 0) return chi2;
+  // The normal matrix of the whole problem, sparse (odometry chain plus closures), with each factor
+  // as the solve weighs it (robust weights included).
+  std::vector<LinearisedFactor> linearised(factors.size());
+  std::vector<char> usable(factors.size(), 0);
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (size_t i = 0; i < factors.size(); ++i) {
+    LinearisedFactor& lf = linearised[i];
+    if (!linearise(factors[i], lf)) continue;
+    usable[i] = 1;
+    for (size_t p = 0; p < lf.nodes.size(); ++p) {
+      for (size_t q = 0; q < lf.nodes.size(); ++q) {
+        const Matrix6d block = lf.jacobian.middleCols<6>(6 * static_cast<int>(p)).transpose() *
+                               lf.jacobian.middleCols<6>(6 * static_cast<int>(q));
+        const int row = 6 * (lf.nodes[p] - first_active_), col = 6 * (lf.nodes[q] - first_active_);
+        for (int r = 0; r < 6; ++r)
+          for (int c = 0; c < 6; ++c) triplets.emplace_back(row + r, col + c, block(r, c));
+      }
+    }
+  }
+  Eigen::SparseMatrix<double> normal(6 * n, 6 * n);
+  normal.setFromTriplets(triplets.begin(), triplets.end());  // duplicates are summed
+  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(normal);
+  if (ldlt.info() != Eigen::Success) return chi2;
+
+  for (size_t i = 0; i < factors.size(); ++i) {
+    const LinearisedFactor& lf = linearised[i];
+    if (factors[i].kind != FactorKind::kClosure || !usable[i] || lf.nodes.size() != 2 || lf.robust_weight <= 0.0)
+      continue;
+    // K: the 12 x 12 covariance of the closure's two nodes under every factor.
+    Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(6 * n, 12);
+    for (int k = 0; k < 2; ++k)
+      unit.block<6, 6>(6 * (lf.nodes[k] - first_active_), 6 * k).setIdentity();
+    const Eigen::MatrixXd columns = ldlt.solve(unit);
+    if (ldlt.info() != Eigen::Success) continue;
+    Eigen::Matrix<double, 12, 12> k_ab;
+    for (int k = 0; k < 2; ++k) k_ab.middleRows<6>(6 * k) = columns.middleRows<6>(6 * (lf.nodes[k] - first_active_));
+    // Without the closure (Woodbury on its own rows, U = the weighted jacobian):
+    // K_out = K + K U' (I - U K U')^-1 U K.
+    const double w = lf.robust_weight;
+    const Eigen::Matrix<double, 6, 12> u = lf.jacobian;  // weighted: w x the whitened jacobian
+    const Matrix6d s_in = Matrix6d::Identity() - u * k_ab * u.transpose();
+    const Eigen::LDLT<Matrix6d> s_in_ldlt(0.5 * (s_in + s_in.transpose()));
+    if (s_in_ldlt.info() != Eigen::Success || s_in_ldlt.rcond() < 1e-12) continue;  // the closure alone holds them
+    const Eigen::Matrix<double, 12, 12> k_out = k_ab + k_ab * u.transpose() * s_in_ldlt.solve(u * k_ab);
+    // The unweighted whitened residual and jacobian; the solution without the closure moves its two
+    // nodes by K_out A' w^2 r (linearised), so its innovation is r + A K_out A' w^2 r.
+    const Eigen::Matrix<double, 6, 12> a = u / w;
+    const Vector6d r = lf.residual / w;
+    const Matrix6d g = a * k_out * a.transpose();
+    const Vector6d innovation = r + w * w * g * r;
+    const Matrix6d s_out = Matrix6d::Identity() + g;
+    const Eigen::LDLT<Matrix6d> s_out_ldlt(0.5 * (s_out + s_out.transpose()));
+    if (s_out_ldlt.info() != Eigen::Success) continue;
+    chi2[i] = innovation.dot(s_out_ldlt.solve(innovation));
+  }
+  return chi2;
+}
+
+bool SlidingWindowPoseGraph::rejectClosuresTheSurveyDoesNotHold(std::vector<Factor>& factors, UpdateReport& report,
+                                                               bool estimate_calibration) {
+  if (options_.smoothed_gate_chi2 <= 0.0) return true;
+  // One at a time, the worst first: an outlier pulls its neighbours' residuals up with it.
+  for (;;) {
+    int worst = -1;
+    double worst_chi2 = options_.smoothed_gate_chi2;
+    const std::vector<double> chi2 = closureLeaveOneOutChi2(factors);
+    for (size_t i = 0; i < factors.size(); ++i) {
+      if (std::isfinite(chi2[i]) && chi2[i] > worst_chi2) {
+        worst_chi2 = chi2[i];
+        worst = factors[i].index;
+      }
+    }
+    if (worst < 0) return true;
+    Closure& c = closures_[worst];
+    c.record.marginalised = false;  // full smoothing re-derives the prior without it: nothing withdrawn
+    setStatus(c, ClosureStatus::kRejected, ClosureRejection::kChiSquareGate);
+    ++report.closures_decided;
+    factors = allFactors();
+    UpdateReport again;
+    if (!solve(factors, options_.full_smoothing_max_iterations, again, false, estimate_calibration)) return false;
+    report.iterations += again.iterations;
+    report.solve_s += again.solve_s;
+  }
+}
+
 void SlidingWindowPoseGraph::marginaliseOldest() {
   const int m = first_active_;
   const std::vector<Factor> factors = factorsTouching(m);
@@ -506,7 +598,7 @@ UpdateReport SlidingWindowPoseGraph::smoothAll(bool mission_ended) {
   // Every node is a variable: solve with the window boundary at the first node.
   const int boundary = first_active_;
   first_active_ = 0;
-  const std::vector<Factor> factors = allFactors();
+  std::vector<Factor> factors = allFactors();
   bool ok = true;
   const bool calibrate = calibrationWanted();
   if (calibrate) calibration_utime_us_ = nodes_.back().utime_us;
@@ -536,6 +628,7 @@ UpdateReport SlidingWindowPoseGraph::smoothAll(bool mission_ended) {
   } else {
     ok = solve(factors, options_.full_smoothing_max_iterations, report, false, calibrate);
   }
+  if (ok) ok = rejectClosuresTheSurveyDoesNotHold(factors, report, calibrate);
   if (ok) reweighFromResiduals(factors, report, calibrate);
   if (ok) {
     // Re-derive the window's prior at the smoothed estimate, eliminating the old nodes in order.
