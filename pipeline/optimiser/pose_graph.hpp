@@ -92,7 +92,7 @@ struct PoseGraphOptions {
   // the survey the other factors give, under the covariance of both (linearised at the solution; an
   // outlier bends the graph towards itself, so its residual under the solution alone says little).
   // The worst closure beyond this is rejected (kChiSquareGate) and the graph solved again, until
-  // none is left. 0: off.
+  // none is left. It runs before closure_reweighting, under the closures' stated covariances. 0: off.
   double smoothed_gate_chi2 = 22.46;
   // Pairwise consistency (PCM): cycle closure_i * DR chain * closure_j^-1 * DR chain within this
   // chi-square (6 dof: 16.81 = 99 %); the largest mutually consistent set among the newest
