@@ -266,8 +266,8 @@ struct FixCounters {
 enum class ClosureStatus { kPending, kAccepted, kRejected, kSuperseded };
 enum class ClosureRejection {
   kNone,
-  kChiSquareGate,    // innovation against the current estimate beyond gate_chi2, or its residual
-                     // under the smoothed survey beyond smoothed_gate_chi2
+  kChiSquareGate,    // innovation against the current estimate beyond gate_chi2, or (at full
+                     // smoothing) its leave-one-out innovation beyond smoothed_gate_chi2
   kInconsistent,     // outside the largest pairwise-consistent set
   kNoSupport,        // left the PCM horizon without ever being in a large enough consistent set
 };

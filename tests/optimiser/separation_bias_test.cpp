@@ -19,17 +19,6 @@ namespace {
 
 using namespace test_helpers;
 
-// A good INS (as in variance_components_test): what DR says about the lines' separation is worth
-// comparing the closures against.
-synthetic::MissionOptions goodInsMission(uint64_t seed) {
-  synthetic::MissionOptions o = missionOptions(seed);
-  o.heading_bias_rad = 0.0005;
-  o.heading_noise_sigma_rad = 0.0005;
-  o.velocity_scale_error = 0.001;
-  o.position_random_walk_m_per_sqrt_m = 0.005;
-  return o;
-}
-
 PoseGraphOptions withBias(PoseGraphOptions options) {
   options.odometry_random_walk_m_per_sqrt_m = 0.01;
   options.odometry_drift_fraction = 0.002;
@@ -69,7 +58,7 @@ TEST(SeparationBias, ACommonShorteningOfOppositeSideClosuresIsEstimatedAndUndone
   off.separation_bias_sigma_m = 0.0;
   const PoseGraphOptions on = withBias(graphOptions());
   for (uint64_t seed = 1; seed <= 4; ++seed) {
-    const synthetic::Mission truthful = synthetic::makeLawnmowerMission(goodInsMission(seed));
+    const synthetic::Mission truthful = synthetic::makeLawnmowerMission(goodInsMissionOptions(seed));
     const synthetic::Mission biased = shortened(truthful, bias_m);
     const Solved reference = smooth(truthful, off);
     const Solved plain = smooth(biased, off);
@@ -104,7 +93,7 @@ TEST(SeparationBias, ByDefaultItIsMeasuredNotApplied) {
   off.separation_bias_sigma_m = 0.0;
   PoseGraphOptions measured = withBias(graphOptions());
   measured.separation_bias_apply = false;
-  const synthetic::Mission biased = shortened(synthetic::makeLawnmowerMission(goodInsMission(3)), 1.5);
+  const synthetic::Mission biased = shortened(synthetic::makeLawnmowerMission(goodInsMissionOptions(3)), 1.5);
   const Solved plain = smooth(biased, off);
   const Solved diagnosed = smooth(biased, measured);
   EXPECT_TRUE(diagnosed.bias.significant);
@@ -122,7 +111,7 @@ TEST(SeparationBias, TruthfulClosuresGiveNoBias) {
   off.separation_bias_sigma_m = 0.0;
   const PoseGraphOptions on = withBias(graphOptions());
   for (uint64_t seed = 1; seed <= 4; ++seed) {
-    const synthetic::Mission truthful = synthetic::makeLawnmowerMission(goodInsMission(seed));
+    const synthetic::Mission truthful = synthetic::makeLawnmowerMission(goodInsMissionOptions(seed));
     const Solved plain = smooth(truthful, off);
     const Solved estimated = smooth(truthful, on);
     std::printf("seed %llu: truthful closures: bias %.3f +- %.3f m (not applied); ATE %.3f -> %.3f m\n",
@@ -147,7 +136,7 @@ TEST(SeparationBias, WideningTheDisputedSeparationStopsBiasedClosuresPullingTheL
   PoseGraphOptions widen_options = plain_options;
   widen_options.separation_bias_widen = true;
   for (uint64_t seed = 1; seed <= 4; ++seed) {
-    const synthetic::Mission truthful = synthetic::makeLawnmowerMission(goodInsMission(seed));
+    const synthetic::Mission truthful = synthetic::makeLawnmowerMission(goodInsMissionOptions(seed));
     const synthetic::Mission biased = shortened(truthful, 1.5);
     const Solved plain = smooth(biased, plain_options);
     const Solved widened = smooth(biased, widen_options);
@@ -192,7 +181,7 @@ TEST(SeparationBias, WithAcceptedFixesTheDisputedSeparationIsWidenedByDefault) {
     return std::make_pair(synthetic::translationRmse(estimates(graph), mission.nodes), graph.separationBias());
   };
   for (uint64_t seed = 1; seed <= 4; ++seed) {
-    const synthetic::Mission truthful = synthetic::makeLawnmowerMission(goodInsMission(seed));
+    const synthetic::Mission truthful = synthetic::makeLawnmowerMission(goodInsMissionOptions(seed));
     const synthetic::Mission biased = shortened(truthful, 1.5);
     const auto [ate_truthful, bias_truthful] = run(truthful, options, true, seed);
     const auto [ate_truthful_off, unused_off] = run(truthful, off, true, seed);
@@ -216,7 +205,7 @@ TEST(SeparationBias, WithAcceptedFixesTheDisputedSeparationIsWidenedByDefault) {
 // Closures along one line (B ahead of A on the same track) or across it are not opposite-side pairs:
 // they take no bias. Cross lines (B's heading 90 deg off) neither.
 TEST(SeparationBias, OnlyParallelPairsOffToTheSideTakeIt) {
-  const synthetic::Mission mission = synthetic::makeLawnmowerMission(goodInsMission(1));
+  const synthetic::Mission mission = synthetic::makeLawnmowerMission(goodInsMissionOptions(1));
   synthetic::Mission turned = mission;
   for (synthetic::Closure& c : turned.closures) {
     // Rotate B's frame by 90 deg about down: B crosses A's line.
@@ -234,7 +223,7 @@ TEST(SeparationBias, OnlyParallelPairsOffToTheSideTakeIt) {
 // The applied bias survives a checkpoint (window updates after a restore use it); a version 2
 // checkpoint, written before the bias existed, restores with none.
 TEST(SeparationBias, SurvivesACheckpointAndOlderCheckpointsRestoreWithout) {
-  const synthetic::Mission biased = shortened(synthetic::makeLawnmowerMission(goodInsMission(2)), 1.5);
+  const synthetic::Mission biased = shortened(synthetic::makeLawnmowerMission(goodInsMissionOptions(2)), 1.5);
   const PoseGraphOptions options = withBias(graphOptions());
   SlidingWindowPoseGraph graph(options);
   feed(graph, biased, 0, biased.nodes.size());

@@ -26,16 +26,6 @@ struct Smoothed {
   uint64_t rejected_gate = 0;
 };
 
-// A good INS (as in separation_bias_test): drifting 0.1 % while the graph's model says 0.5 %.
-synthetic::MissionOptions goodInsMission(uint64_t seed) {
-  synthetic::MissionOptions o = missionOptions(seed);
-  o.heading_bias_rad = 0.0005;
-  o.heading_noise_sigma_rad = 0.0005;
-  o.velocity_scale_error = 0.001;
-  o.position_random_walk_m_per_sqrt_m = 0.005;
-  return o;
-}
-
 Smoothed smooth(const synthetic::Mission& mission, const PoseGraphOptions& options) {
   SlidingWindowPoseGraph graph(options);
   feed(graph, mission, 0, mission.nodes.size());
@@ -67,7 +57,7 @@ TEST(SmoothedGate, AClosureManySigmasFromTheSmoothedSurveyIsRejected) {
   off.smoothed_gate_chi2 = 0.0;
   const PoseGraphOptions on = graphOptions();
   for (uint64_t seed = 1; seed <= 4; ++seed) {
-    const synthetic::Mission truthful = synthetic::makeLawnmowerMission(goodInsMission(seed));
+    const synthetic::Mission truthful = synthetic::makeLawnmowerMission(goodInsMissionOptions(seed));
     synthetic::Mission corrupted = truthful;
     ASSERT_FALSE(corrupted.closures.empty());
     corrupted.closures[kOutlier].closure.T_a_b.translation.y() += kOffset_m;
@@ -97,7 +87,7 @@ TEST(SmoothedGate, TruthfulClosuresAllHold) {
   off.smoothed_gate_chi2 = 0.0;
   const PoseGraphOptions on = graphOptions();
   for (uint64_t seed = 1; seed <= 4; ++seed) {
-    const synthetic::Mission truthful = synthetic::makeLawnmowerMission(goodInsMission(seed));
+    const synthetic::Mission truthful = synthetic::makeLawnmowerMission(goodInsMissionOptions(seed));
     const Smoothed plain = smooth(truthful, off);
     const Smoothed gated = smooth(truthful, on);
     EXPECT_EQ(gated.rejected_gate, plain.rejected_gate) << "seed " << seed;

@@ -195,12 +195,7 @@ TEST(VarianceComponentsInGraph, DrBoundWidensClosuresThatStrainDrAndLeavesGoodOn
   bounded.closure_reweighting = "dr_bound";
   const int seeds = 4;
   for (uint64_t seed = 1; seed <= seeds; ++seed) {
-    synthetic::MissionOptions good_ins = missionOptions(seed);
-    good_ins.heading_bias_rad = 0.0005;
-    good_ins.heading_noise_sigma_rad = 0.0005;
-    good_ins.velocity_scale_error = 0.001;
-    good_ins.position_random_walk_m_per_sqrt_m = 0.005;
-    const synthetic::Mission truthful = synthetic::makeLawnmowerMission(good_ins);
+    const synthetic::Mission truthful = synthetic::makeLawnmowerMission(goodInsMissionOptions(seed));
     synthetic::Mission biased = truthful;
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> magnitude(3.0, 4.0);
