@@ -410,6 +410,53 @@ float parabolaPeak(float minus, float centre, float plus) {
   return std::clamp(0.5f * (minus - plus) / curvature, -0.5f, 0.5f);
 }
 
+// How much ZNCC the best score of A's patch at (sr, sc) over the search window stands above the
+// top of any separate peak (DenseMatcherOptions::min_peak_margin). The window's cells join, in
+// descending score, their already joined 8-neighbours (union-find, i.e. the superlevel sets from
+// the top down); the first cell that is then not in the best cell's component tops a second peak.
+// A shoulder of the best peak joins it and is not counted. Zero or negative when the window's best
+// lies more than a cell from (dr, dc), the offset PatchMatch settled on; 2 when no other peak exists.
+float peakMargin(const PatchScorer& score, int sr, int sc, int dr, int dc, const SearchWindow& window, int grid_rows,
+                 int grid_cols, int half) {
+  const int height = 2 * window.rows + 1, width = 2 * window.cols + 1;
+  std::vector<float> scores(static_cast<std::size_t>(height) * width, kNoScore);
+  std::vector<int> order;
+  order.reserve(scores.size());
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const int tr = sr + y - window.rows, tc = sc + x - window.cols;
+      if (tr < half || tc < half || tr >= grid_rows - half || tc >= grid_cols - half) continue;
+      const float s = score(sr, sc, tr, tc);
+      if (s <= kNoScore) continue;
+      scores[y * width + x] = s;
+      order.push_back(y * width + x);
+    }
+  }
+  const int found = (dr + window.rows) * width + (dc + window.cols);
+  if (order.empty() || scores[found] <= kNoScore) return -2.0f;
+  std::sort(order.begin(), order.end(), [&](int p, int q) { return scores[p] > scores[q] || (scores[p] == scores[q] && p < q); });
+  const int best = order.front();
+  if (std::abs(best / width - found / width) > 1 || std::abs(best % width - found % width) > 1)
+    return scores[found] - scores[best];
+  std::vector<int> parent(scores.size(), -1);  // -1: not joined yet
+  auto root = [&](int p) {
+    while (parent[p] != p) p = parent[p] = parent[parent[p]];
+    return p;
+  };
+  for (const int cell : order) {
+    parent[cell] = cell;
+    const int y = cell / width, x = cell % width;
+    for (int ny = std::max(0, y - 1); ny <= std::min(height - 1, y + 1); ++ny) {
+      for (int nx = std::max(0, x - 1); nx <= std::min(width - 1, x + 1); ++nx) {
+        const int neighbour = ny * width + nx;
+        if (neighbour != cell && parent[neighbour] >= 0) parent[root(neighbour)] = root(cell);
+      }
+    }
+    if (cell != best && root(cell) != root(best)) return scores[best] - scores[cell];
+  }
+  return 2.0f;
+}
+
 }  // namespace
 
 cv::Mat1b findReliefFeatures(const GeoImage& image, double outlier_sigmas) {
@@ -670,43 +717,73 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
     runPatchMatch(backward, score_ba, window, grid_rows, grid_cols, half, o, 0xB0B0B002ULL);
   }
 
+  const float max_fb_sq = static_cast<float>(o.max_fb_error_px * o.max_fb_error_px);
+  // The checks on the fields alone: score, aperture, forward-backward, coherence.
+  auto passesFieldChecks = [&](int i, int j) {
+    const int k = forward.index(i, j);
+    if (!forward.active[k] || forward.score[k] < o.min_zncc) return false;
+    const int sr = forward.gridRow(i), sc = forward.gridCol(j);
+    if (!structure_ratio_a.empty() && structure_ratio_a(sr, sc) < o.min_structure_ratio) return false;
+    const int tr = sr + forward.d_row[k], tc = sc + forward.d_col[k];
+    if (o.forward_backward_check) {
+      const int bi =
+          std::clamp(static_cast<int>(std::lround(double(tr - backward.row0) / o.stride)), 0, backward.rows - 1);
+      const int bj =
+          std::clamp(static_cast<int>(std::lround(double(tc - backward.col0) / o.stride)), 0, backward.cols - 1);
+      const int n = backward.index(bi, bj);
+      if (!backward.active[n] || backward.score[n] <= kNoScore) return false;
+      const float er = static_cast<float>(forward.d_row[k] + backward.d_row[n]);
+      const float ec = static_cast<float>(forward.d_col[k] + backward.d_col[n]);
+      if (er * er + ec * ec > max_fb_sq) return false;
+    }
+    // Local coherence: the DR error between two lines is a near-rigid shift, so a correct
+    // offset has neighbours with the same offset; a chance correlation on a wrong pair or a
+    // texture-poor patch does not.
+    if (o.min_coherent_neighbours > 0) {
+      int coherent = 0;
+      for (int ni = std::max(0, i - 1); ni <= std::min(forward.rows - 1, i + 1); ++ni) {
+        for (int nj = std::max(0, j - 1); nj <= std::min(forward.cols - 1, j + 1); ++nj) {
+          const int n = forward.index(ni, nj);
+          if (n == k || !forward.active[n] || forward.score[n] < o.min_zncc) continue;
+          if (std::abs(forward.d_row[n] - forward.d_row[k]) <= 1 && std::abs(forward.d_col[n] - forward.d_col[k]) <= 1)
+            ++coherent;
+        }
+      }
+      if (coherent < o.min_coherent_neighbours) return false;
+    }
+    return true;
+  };
+  // Periodic seabed: every surviving match scored over the whole window (the costly check, in
+  // parallel, on what the field checks leave).
+  std::vector<std::uint8_t> ambiguous;
+  if (o.min_peak_margin > 0.0) {
+    ambiguous.assign(forward_nodes, 0);
+    parallelFor((forward.rows + kBandRows - 1) / kBandRows, o.threads, [&](int band) {
+      for (int i = band * kBandRows; i < std::min(forward.rows, (band + 1) * kBandRows); ++i) {
+        for (int j = 0; j < forward.cols; ++j) {
+          if (!passesFieldChecks(i, j)) continue;
+          const int k = forward.index(i, j);
+          const float margin = peakMargin(score_ab, forward.gridRow(i), forward.gridCol(j), forward.d_row[k],
+                                          forward.d_col[k], window, grid_rows, grid_cols, half);
+          if (margin < o.min_peak_margin) ambiguous[k] = 1;
+        }
+      }
+    });
+  }
+
   std::vector<Correspondence> matches;
   matches.reserve(static_cast<std::size_t>(t.overlapping_pixels));
   std::vector<std::pair<int, int>> mirrored_nodes;  // forward lattice (i, j) of the mirror test's rejects
-  const float max_fb_sq = static_cast<float>(o.max_fb_error_px * o.max_fb_error_px);
   for (int i = 0; i < forward.rows; ++i) {
     for (int j = 0; j < forward.cols; ++j) {
+      if (!passesFieldChecks(i, j)) continue;
       const int k = forward.index(i, j);
-      if (!forward.active[k] || forward.score[k] < o.min_zncc) continue;
+      if (!ambiguous.empty() && ambiguous[k]) {
+        ++t.ambiguous_rejected;
+        continue;
+      }
       const int sr = forward.gridRow(i), sc = forward.gridCol(j);
-      if (!structure_ratio_a.empty() && structure_ratio_a(sr, sc) < o.min_structure_ratio) continue;
       const int tr = sr + forward.d_row[k], tc = sc + forward.d_col[k];
-      if (o.forward_backward_check) {
-        const int bi = std::clamp(static_cast<int>(std::lround(double(tr - backward.row0) / o.stride)), 0,
-                                  backward.rows - 1);
-        const int bj = std::clamp(static_cast<int>(std::lround(double(tc - backward.col0) / o.stride)), 0,
-                                  backward.cols - 1);
-        const int n = backward.index(bi, bj);
-        if (!backward.active[n] || backward.score[n] <= kNoScore) continue;
-        const float er = static_cast<float>(forward.d_row[k] + backward.d_row[n]);
-        const float ec = static_cast<float>(forward.d_col[k] + backward.d_col[n]);
-        if (er * er + ec * ec > max_fb_sq) continue;
-      }
-      // Local coherence: the DR error between two lines is a near-rigid shift, so a correct
-      // offset has neighbours with the same offset; a chance correlation on a wrong pair or a
-      // texture-poor patch does not.
-      if (o.min_coherent_neighbours > 0) {
-        int coherent = 0;
-        for (int ni = std::max(0, i - 1); ni <= std::min(forward.rows - 1, i + 1); ++ni) {
-          for (int nj = std::max(0, j - 1); nj <= std::min(forward.cols - 1, j + 1); ++nj) {
-            const int n = forward.index(ni, nj);
-            if (n == k || !forward.active[n] || forward.score[n] < o.min_zncc) continue;
-            if (std::abs(forward.d_row[n] - forward.d_row[k]) <= 1 && std::abs(forward.d_col[n] - forward.d_col[k]) <= 1)
-              ++coherent;
-          }
-        }
-        if (coherent < o.min_coherent_neighbours) continue;
-      }
       float fr = 0.0f, fc = 0.0f, curvature_col = 0.0f;
       if (o.subpixel && tr > half && tc > half && tr + 1 < grid_rows - half && tc + 1 < grid_cols - half) {
         fr = parabolaPeak(score_ab(sr, sc, tr - 1, tc), forward.score[k], score_ab(sr, sc, tr + 1, tc));

@@ -28,6 +28,7 @@ std::vector<std::string> validateDenseMatcherOptions(const DenseMatcherOptions& 
     problems.push_back("min_structure_ratio must be in [0, 1]");
   if (o.min_coherent_neighbours < 0 || o.min_coherent_neighbours > 8)
     problems.push_back("min_coherent_neighbours must be in [0, 8]");
+  if (!(o.min_peak_margin >= 0.0 && o.min_peak_margin <= 2.0)) problems.push_back("min_peak_margin must be in [0, 2]");
   if (o.stride < 1 || o.stride > 64) problems.push_back("stride must be in [1, 64]");
   if (o.threads < 1 || o.threads > 256) problems.push_back("threads must be in [1, 256]");
   return problems;
@@ -56,6 +57,7 @@ void readDenseMatcherOptions(sss::core::ConfigSection& section, DenseMatcherOpti
   section.optional("reject_inverted_relief", options.reject_inverted_relief);
   section.optional("min_coherent_neighbours", options.min_coherent_neighbours, {inRange(0, 8)});
   section.optional("min_structure_ratio", options.min_structure_ratio, {inRange(0.0, 1.0)});
+  section.optional("min_peak_margin", options.min_peak_margin, {inRange(0.0, 2.0)});
   section.optional("random_search_ratio", options.random_search_ratio,
                    {sss::core::satisfies<double>([](double v) { return v > 0.0 && v < 1.0; }, "a value in (0, 1)")});
   section.optional("stride", options.stride, {inRange(1, 64)});

@@ -138,6 +138,7 @@ void addTimings(MatchTimings& total, const MatchTimings& pass) {
   total.mirrored_relief_rejected += pass.mirrored_relief_rejected;
   total.shadowed_relief_rejected += pass.shadowed_relief_rejected;
   total.inverted_relief_rejected += pass.inverted_relief_rejected;
+  total.ambiguous_rejected += pass.ambiguous_rejected;
   total.shadowed_relief_marked += pass.shadowed_relief_marked;
 }
 

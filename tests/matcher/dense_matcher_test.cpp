@@ -462,6 +462,88 @@ TEST(DenseMatcher, MarkingShadowedReliefKeepsEveryMatchAndFlagsExactlyThoseTheRe
   EXPECT_LT(std::abs(unflagged_bias_m), 0.05);
 }
 
+// Sand waves of 3 m (6 px at 0.5 m pixels) on faint texture, seen by two parallel lines 25 m apart
+// from the same side (both look east over the strip beyond the second line, so the contrast is not
+// inverted), B geo-referenced 1.5 m off across the crests: a patch correlates almost as well one
+// wavelength either side of the truth as at it, and which peak PatchMatch settles on is up to the
+// speckle.
+Pair sameSideSandWavePair(double texture_contrast) {
+  synthetic::Seabed seabed;
+  seabed.seed = 5;
+  seabed.texture_contrast = texture_contrast;
+  seabed.sand_wave_wavelength_m = 3.0;
+  Pair pair;
+  pair.line_a.rows = 120;
+  pair.line_a.columns_per_side = 130;
+  pair.line_a.bin_size_m = 0.5;
+  pair.line_a.nadir_bins = 4;
+  pair.line_b = synthetic::secondLine(pair.line_a, Direction::kParallel, 25.0, 2.0);
+  synthetic::RenderOptions render_a, render_b;
+  render_a.speckle_seed = 11;
+  render_b.speckle_seed = 12;
+  pair.a = synthetic::render(seabed, pair.line_a, render_a);
+  pair.b = synthetic::render(seabed, pair.line_b, render_b);
+  synthetic::addDrError(pair.b, {0.3, 1.5}, 0.0);
+  return pair;
+}
+
+DenseMatcherOptions periodicTestOptions() {
+  DenseMatcherOptions options;
+  options.patch_size = 13;
+  options.max_dr_error_m = 3.0;
+  return options;
+}
+
+TEST(DenseMatcher, MatchesOnSandWavesThatPeakAWavelengthAwayTooAreDroppedByThePeakMargin) {
+  DenseMatcherOptions options = periodicTestOptions();
+  const Pair pair = sameSideSandWavePair(0.1);
+  MatchTimings plain_timings, margin_timings;
+  const std::vector<Correspondence> plain = DenseMatcher(options).match(pair.a, pair.b, &plain_timings);
+  options.min_peak_margin = 0.1;
+  const std::vector<Correspondence> kept = DenseMatcher(options).match(pair.a, pair.b, &margin_timings);
+  const synthetic::Evaluation e_plain =
+      synthetic::evaluate(plain, pair.line_a, pair.a, pair.line_b, pair.b, options.stride, options.patch_size, 2.0);
+  const synthetic::Evaluation e_kept =
+      synthetic::evaluate(kept, pair.line_a, pair.a, pair.line_b, pair.b, options.stride, options.patch_size, 2.0);
+  std::printf("same-side sand waves (3 m): %zu matches, within 2 px %.3f; peak margin 0.1: %zu (%ld dropped), within "
+              "2 px %.3f\n",
+              plain.size(), e_plain.withinFraction(), kept.size(), margin_timings.ambiguous_rejected,
+              e_kept.withinFraction());
+  EXPECT_EQ(plain_timings.ambiguous_rejected, 0);
+  ASSERT_GT(plain.size(), 200u);
+  EXPECT_LT(e_plain.withinFraction(), 0.8);  // a good share of the matches a wavelength off
+  EXPECT_EQ(static_cast<long>(plain.size() - kept.size()), margin_timings.ambiguous_rejected);
+  // What is left is right, or too little to make a closure from (min_matches: 100).
+  if (kept.size() >= 100u) {
+    EXPECT_GT(e_kept.withinFraction(), 0.9);
+  }
+}
+
+TEST(DenseMatcher, TextureWithoutPeriodicReliefKeepsMostMatchesWithThePeakMargin) {
+  // Reflectivity texture correlates at one offset only: what the margin costs is chance.
+  DenseMatcherOptions options = periodicTestOptions();
+  synthetic::Seabed seabed;
+  seabed.seed = 5;
+  seabed.texture_contrast = 1.0;
+  Pair pair = sameSideSandWavePair(1.0);
+  pair.a = synthetic::render(seabed, pair.line_a, {});
+  synthetic::RenderOptions render_b;
+  render_b.speckle_seed = 12;
+  pair.b = synthetic::render(seabed, pair.line_b, render_b);
+  synthetic::addDrError(pair.b, {0.3, 1.5}, 0.0);
+  const std::vector<Correspondence> plain = DenseMatcher(options).match(pair.a, pair.b);
+  options.min_peak_margin = 0.1;
+  MatchTimings timings;
+  const std::vector<Correspondence> kept = DenseMatcher(options).match(pair.a, pair.b, &timings);
+  const synthetic::Evaluation e_kept =
+      synthetic::evaluate(kept, pair.line_a, pair.a, pair.line_b, pair.b, options.stride, options.patch_size, 2.0);
+  std::printf("texture without sand waves: %zu matches, %zu with the peak margin (%ld dropped), within 2 px %.3f\n",
+              plain.size(), kept.size(), timings.ambiguous_rejected, e_kept.withinFraction());
+  ASSERT_GT(plain.size(), 200u);
+  EXPECT_GE(static_cast<double>(kept.size()), 0.8 * static_cast<double>(plain.size()));
+  EXPECT_GT(e_kept.withinFraction(), 0.9);
+}
+
 TEST(DenseMatcher, ImagesWithMismatchedMatricesAreRejected) {
   Pair pair = makePair(Direction::kParallel, 0.0, seabed(3), seabed(3));
   pair.b.valid = cv::Mat1b(10, 10, 255);
@@ -470,7 +552,7 @@ TEST(DenseMatcher, ImagesWithMismatchedMatricesAreRejected) {
 
 TEST(DenseMatcherOptions, ConfigFillsOptionsAndNamesBadValues) {
   sss::core::Config config =
-      sss::core::Config::fromString("matcher:\n  patch_size: 15\n  max_dr_error_m: 3.5\n  threads: 1\n");
+      sss::core::Config::fromString("matcher:\n  patch_size: 15\n  max_dr_error_m: 3.5\n  threads: 1\n  min_peak_margin: 0.15\n");
   sss::core::ConfigSection section = config.section("matcher");
   DenseMatcherOptions options;
   readDenseMatcherOptions(section, options);
@@ -478,6 +560,7 @@ TEST(DenseMatcherOptions, ConfigFillsOptionsAndNamesBadValues) {
   EXPECT_EQ(options.patch_size, 15);
   EXPECT_DOUBLE_EQ(options.max_dr_error_m, 3.5);
   EXPECT_EQ(options.threads, 1);
+  EXPECT_DOUBLE_EQ(options.min_peak_margin, 0.15);
   EXPECT_TRUE(validateDenseMatcherOptions(options).empty());
 
   sss::core::Config bad = sss::core::Config::fromString("matcher:\n  patch_size: 12\n");
@@ -489,6 +572,9 @@ TEST(DenseMatcherOptions, ConfigFillsOptionsAndNamesBadValues) {
   DenseMatcherOptions even;
   even.patch_size = 12;
   EXPECT_THROW(DenseMatcher{even}, std::invalid_argument);
+  DenseMatcherOptions negative_margin;
+  negative_margin.min_peak_margin = -0.1;
+  EXPECT_THROW(DenseMatcher{negative_margin}, std::invalid_argument);
 }
 
 }  // namespace
