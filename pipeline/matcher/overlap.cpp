@@ -41,6 +41,7 @@ double intersectionArea(const std::vector<cv::Point2d>& a, const std::vector<cv:
 
 void readOverlapOptions(sss::core::ConfigSection& section, OverlapOptions& options) {
   section.optional("min_overlap_fraction", options.min_overlap_fraction, {sss::core::inRange(0.0, 1.0)});
+  section.optional("fraction_of_swath", options.fraction_of_swath);
   section.optional("max_candidates", options.max_candidates, {sss::core::inRange(1, 100)});
   section.optional("footprint_row_step", options.footprint_row_step, {sss::core::inRange(1, 1000)});
   section.optional("skip_same_line", options.skip_same_line);
@@ -122,16 +123,31 @@ double overlapAreaM2(const Footprint& a, const Footprint& b) {
   return area;
 }
 
+// The pair's shared seabed as a fraction of the smaller of the two swaths (one side of a subframe)
+// that image it, the largest over the side pairs (OverlapOptions::fraction_of_swath).
+double sharedFractionOfSmallerSide(const Footprint& a, const Footprint& b) {
+  if ((a.bounds_ne_m & b.bounds_ne_m).area() <= 0.0) return 0.0;
+  const cv::Point2d origin(a.bounds_ne_m.x, a.bounds_ne_m.y);
+  double fraction = 0.0;
+  for (const auto* pa : {&a.port_ne_m, &a.starboard_ne_m}) {
+    for (const auto* pb : {&b.port_ne_m, &b.starboard_ne_m}) {
+      const double smaller = std::min(polygonArea(*pa), polygonArea(*pb));
+      if (smaller > 0.0) fraction = std::max(fraction, intersectionArea(*pa, *pb, origin) / smaller);
+    }
+  }
+  return fraction;
+}
+
 std::vector<OverlapCandidate> findOverlaps(const Footprint& footprint, const std::vector<Footprint>& others,
                                            const OverlapOptions& options) {
   std::vector<OverlapCandidate> candidates;
   for (const Footprint& other : others) {
     if (other.subframe_id == footprint.subframe_id) continue;
     if (options.skip_same_line && other.line_id == footprint.line_id) continue;
-    const double smaller = std::min(footprint.area_m2, other.area_m2);
-    if (smaller <= 0.0) continue;
+    if (footprint.area_m2 <= 0.0 || other.area_m2 <= 0.0) continue;
     const double area = overlapAreaM2(footprint, other);
-    const double fraction = area / smaller;
+    const double fraction = options.fraction_of_swath ? sharedFractionOfSmallerSide(footprint, other)
+                                                      : area / std::min(footprint.area_m2, other.area_m2);
     if (fraction >= options.min_overlap_fraction && area > 0.0) {
       candidates.push_back({other.subframe_id, fraction, area});
     }

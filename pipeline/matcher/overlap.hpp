@@ -17,6 +17,12 @@ struct OverlapOptions {
   // A pair is a candidate when the seabed both subframes image covers at least this fraction of
   // the smaller footprint (paper: overlapping subframes; adjacent survey lines overlap 40-80 %).
   double min_overlap_fraction = 0.15;
+  // true: of the smaller of the two swaths (one side of a subframe) that share the seabed instead.
+  // One side of a subframe meets one side of the other on parallel lines, so a fraction of the
+  // footprint (both sides) halves the overlap of adjacent lines, and halves it again when their
+  // subframes meet half a subframe apart: far-range lines (150 m apart, 93 m range) then get no
+  // pair at all. Measured, off (README): it recovers such missions and costs others.
+  bool fraction_of_swath = false;
   int max_candidates = 4;       // per new subframe, largest overlap first: bounded work per subframe
   int footprint_row_step = 10;  // rows between footprint vertices along track (10 pings = 5 m)
   // Subframes of the same survey line never overlap except at a shared edge; they are skipped.
@@ -45,7 +51,7 @@ double overlapAreaM2(const Footprint& a, const Footprint& b);
 
 struct OverlapCandidate {
   int64_t subframe_id = 0;
-  double overlap_fraction = 0.0;  // of the smaller footprint
+  double overlap_fraction = 0.0;  // of the smaller footprint (or swath: fraction_of_swath)
   double overlap_area_m2 = 0.0;
 };
 

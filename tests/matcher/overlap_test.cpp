@@ -102,6 +102,30 @@ TEST(Overlap, CandidatesAreBoundedOrderedAndSkipTheSameLineAndDistantOnes) {
   EXPECT_EQ(all[2].subframe_id, 1);
 }
 
+TEST(Overlap, FarRangePairsHalfASubframeApartAreCandidatesWithTheFractionOfTheSwath) {
+  // Lines 80 m apart with 50 m swaths: the shared strip is 30.1..49.9 m east of A, 41 % of a side's
+  // swath (2..49.9 m) but 21 % of the footprint (both sides). Survey lines' subframes rarely meet end
+  // to end: B starts half a subframe further north, so the pair shares half of that, 21 % of a
+  // swath and 10 % of the footprint, which a fraction of the footprint (15 %) does not match.
+  const Footprint a = footprintOf(straightSubframe(0, 0, 0.0, 0.0, 0.0));
+  const Footprint aligned = footprintOf(straightSubframe(1, 1, 99.5, 80.0, M_PI));
+  const Footprint shifted = footprintOf(straightSubframe(2, 1, 149.25, 80.0, M_PI));
+  const double strip_m = 49.9 - 30.1;
+  EXPECT_NEAR(overlapAreaM2(a, aligned), strip_m * 99.5, 0.02 * strip_m * 99.5);
+  EXPECT_NEAR(overlapAreaM2(a, shifted), strip_m * 49.75, 0.02 * strip_m * 49.75);
+  const auto of_footprint = findOverlaps(a, {aligned, shifted}, OverlapOptions{});
+  ASSERT_EQ(of_footprint.size(), 1u);
+  EXPECT_EQ(of_footprint[0].subframe_id, 1);
+  EXPECT_NEAR(of_footprint[0].overlap_fraction, strip_m / (2.0 * (49.9 - 2.0)), 0.02);
+  OverlapOptions per_swath;
+  per_swath.fraction_of_swath = true;
+  const auto candidates = findOverlaps(a, {aligned, shifted}, per_swath);
+  ASSERT_EQ(candidates.size(), 2u);
+  EXPECT_EQ(candidates[0].subframe_id, 1);
+  EXPECT_NEAR(candidates[0].overlap_fraction, strip_m / (49.9 - 2.0), 0.02);
+  EXPECT_NEAR(candidates[1].overlap_fraction, 0.5 * strip_m / (49.9 - 2.0), 0.02);
+}
+
 TEST(Overlap, OptionsFromConfigNameBadValues) {
   auto config = sss::core::Config::fromString("overlap: {min_overlap_fraction: 1.5, max_candidates: 0}\n");
   auto section = config.section("overlap");
