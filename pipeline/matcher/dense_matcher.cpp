@@ -753,32 +753,32 @@ std::vector<Correspondence> DenseMatcher::match(const GeoImage& a, const GeoImag
     }
     return true;
   };
-  // Periodic seabed: every surviving match scored over the whole window (the costly check, in
-  // parallel, on what the field checks leave).
-  std::vector<std::uint8_t> ambiguous;
-  if (o.min_peak_margin > 0.0) {
-    ambiguous.assign(forward_nodes, 0);
-    parallelFor((forward.rows + kBandRows - 1) / kBandRows, o.threads, [&](int band) {
-      for (int i = band * kBandRows; i < std::min(forward.rows, (band + 1) * kBandRows); ++i) {
-        for (int j = 0; j < forward.cols; ++j) {
-          if (!passesFieldChecks(i, j)) continue;
-          const int k = forward.index(i, j);
-          const float margin = peakMargin(score_ab, forward.gridRow(i), forward.gridCol(j), forward.d_row[k],
-                                          forward.d_col[k], window, grid_rows, grid_cols, half);
-          if (margin < o.min_peak_margin) ambiguous[k] = 1;
-        }
+  // Each node's verdict from the fields, in parallel; with min_peak_margin, the matches that pass
+  // are also scored over the whole window (periodic seabed: the costly check).
+  enum NodeVerdict : std::uint8_t { kFails = 0, kPasses = 1, kAmbiguous = 2 };
+  std::vector<std::uint8_t> verdict(forward_nodes, kFails);
+  parallelFor((forward.rows + kBandRows - 1) / kBandRows, o.threads, [&](int band) {
+    for (int i = band * kBandRows; i < std::min(forward.rows, (band + 1) * kBandRows); ++i) {
+      for (int j = 0; j < forward.cols; ++j) {
+        if (!passesFieldChecks(i, j)) continue;
+        const int k = forward.index(i, j);
+        verdict[k] = kPasses;
+        if (o.min_peak_margin > 0.0 &&
+            peakMargin(score_ab, forward.gridRow(i), forward.gridCol(j), forward.d_row[k], forward.d_col[k], window,
+                       grid_rows, grid_cols, half) < o.min_peak_margin)
+          verdict[k] = kAmbiguous;
       }
-    });
-  }
+    }
+  });
 
   std::vector<Correspondence> matches;
   matches.reserve(static_cast<std::size_t>(t.overlapping_pixels));
   std::vector<std::pair<int, int>> mirrored_nodes;  // forward lattice (i, j) of the mirror test's rejects
   for (int i = 0; i < forward.rows; ++i) {
     for (int j = 0; j < forward.cols; ++j) {
-      if (!passesFieldChecks(i, j)) continue;
       const int k = forward.index(i, j);
-      if (!ambiguous.empty() && ambiguous[k]) {
+      if (verdict[k] == kFails) continue;
+      if (verdict[k] == kAmbiguous) {
         ++t.ambiguous_rejected;
         continue;
       }

@@ -113,30 +113,34 @@ Footprint computeFootprint(const sss::core::Subframe& subframe, const std::vecto
   return footprint;
 }
 
-double overlapAreaM2(const Footprint& a, const Footprint& b) {
-  if ((a.bounds_ne_m & b.bounds_ne_m).area() <= 0.0) return 0.0;
-  const cv::Point2d origin(a.bounds_ne_m.x, a.bounds_ne_m.y);
-  double area = 0.0;
-  for (const auto* pa : {&a.port_ne_m, &a.starboard_ne_m}) {
-    for (const auto* pb : {&b.port_ne_m, &b.starboard_ne_m}) area += intersectionArea(*pa, *pb, origin);
-  }
-  return area;
-}
+namespace {
 
-// The pair's shared seabed as a fraction of the smaller of the two swaths (one side of a subframe)
-// that image it, the largest over the side pairs (OverlapOptions::fraction_of_swath).
-double sharedFractionOfSmallerSide(const Footprint& a, const Footprint& b) {
-  if ((a.bounds_ne_m & b.bounds_ne_m).area() <= 0.0) return 0.0;
+// The seabed two footprints share: its area (every side of one against every side of the other)
+// and, the largest over the side pairs, its fraction of the smaller of the two swaths (one side of a
+// subframe) that image it (OverlapOptions::fraction_of_swath).
+struct SharedSeabed {
+  double area_m2 = 0.0;
+  double fraction_of_smaller_swath = 0.0;
+};
+
+SharedSeabed sharedSeabed(const Footprint& a, const Footprint& b) {
+  SharedSeabed shared;
+  if ((a.bounds_ne_m & b.bounds_ne_m).area() <= 0.0) return shared;
   const cv::Point2d origin(a.bounds_ne_m.x, a.bounds_ne_m.y);
-  double fraction = 0.0;
   for (const auto* pa : {&a.port_ne_m, &a.starboard_ne_m}) {
     for (const auto* pb : {&b.port_ne_m, &b.starboard_ne_m}) {
+      const double area = intersectionArea(*pa, *pb, origin);
+      shared.area_m2 += area;
       const double smaller = std::min(polygonArea(*pa), polygonArea(*pb));
-      if (smaller > 0.0) fraction = std::max(fraction, intersectionArea(*pa, *pb, origin) / smaller);
+      if (smaller > 0.0) shared.fraction_of_smaller_swath = std::max(shared.fraction_of_smaller_swath, area / smaller);
     }
   }
-  return fraction;
+  return shared;
 }
+
+}  // namespace
+
+double overlapAreaM2(const Footprint& a, const Footprint& b) { return sharedSeabed(a, b).area_m2; }
 
 std::vector<OverlapCandidate> findOverlaps(const Footprint& footprint, const std::vector<Footprint>& others,
                                            const OverlapOptions& options) {
@@ -145,8 +149,9 @@ std::vector<OverlapCandidate> findOverlaps(const Footprint& footprint, const std
     if (other.subframe_id == footprint.subframe_id) continue;
     if (options.skip_same_line && other.line_id == footprint.line_id) continue;
     if (footprint.area_m2 <= 0.0 || other.area_m2 <= 0.0) continue;
-    const double area = overlapAreaM2(footprint, other);
-    const double fraction = options.fraction_of_swath ? sharedFractionOfSmallerSide(footprint, other)
+    const SharedSeabed shared = sharedSeabed(footprint, other);
+    const double area = shared.area_m2;
+    const double fraction = options.fraction_of_swath ? shared.fraction_of_smaller_swath
                                                       : area / std::min(footprint.area_m2, other.area_m2);
     if (fraction >= options.min_overlap_fraction && area > 0.0) {
       candidates.push_back({other.subframe_id, fraction, area});

@@ -113,7 +113,8 @@ std::vector<std::string> explainRun(const OfflineSummary& s, const Options& opti
         std::snprintf(text, sizeof text,
                       "no pair to match: the nearest lines run %.0f m apart, and the %.0f m of seabed the sonar "
                       "records per side leave their subframes less overlap than a pair needs "
-                      "(matcher.overlap.min_overlap_fraction of the smaller footprint; fraction_of_swath: true counts it per swath); closer lines or a longer "
+                      "(matcher.overlap.min_overlap_fraction of the smaller footprint; fraction_of_swath: true "
+                      "counts it per swath); closer lines or a longer "
                       "range would overlap",
                       s.nearest_other_line_m, swath_m);
       } else {
