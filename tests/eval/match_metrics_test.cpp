@@ -86,9 +86,23 @@ TEST(MatchFile, EvaluationFromTheFileEqualsTheInProcessOne) {
     in_process.push_back(evaluateMatches(survey, a, b, match.matches, options.dense.stride, match.decimation));
     writer.addPair(a, b, 0, match);
     const MatchEvaluation& e = in_process.back();
+    if (type == PairType::kAntiParallel) {
+      // The signed biases: every match moved half a metre nearer B's track (8 bins of 6 cm) moves
+      // the mean outward error by exactly that and the along-track one not at all.
+      std::vector<sss::matcher::Correspondence> nearer = match.matches;
+      const double bins = 8.0;
+      for (auto& m : nearer) m.col_b += static_cast<float>(m.col_b < b.geometry.bins_per_side ? bins : -bins);
+      const MatchEvaluation shifted = evaluateMatches(survey, a, b, nearer, options.dense.stride, match.decimation);
+      ASSERT_EQ(shifted.evaluated, e.evaluated);
+      EXPECT_NEAR(shifted.meanOutwardErrorM() - e.meanOutwardErrorM(), bins * b.geometry.bin_size_m, 1e-6);
+      EXPECT_NEAR(shifted.meanAlongErrorM(), e.meanAlongErrorM(), 1e-9);
+      // Matches as good as these are not off by a systematic half metre to begin with.
+      EXPECT_LT(std::abs(e.meanOutwardErrorM()), 0.3);
+    }
     std::printf("%s pair %lld-%lld: %ld matches, within 2 px %.3f, recall %.3f, EPE %.2f px %.3f m\n",
                 pairTypeName(type), static_cast<long long>(a.id), static_cast<long long>(b.id), e.matches,
                 e.withinFraction(), e.recall(), e.meanErrorPx(), e.meanErrorM());
+    std::printf("  bias along %+.3f m, outward %+.3f m\n", e.meanAlongErrorM(), e.meanOutwardErrorM());
   }
   ASSERT_OK(writer.close());
   std::string error;
@@ -111,6 +125,8 @@ TEST(MatchFile, EvaluationFromTheFileEqualsTheInProcessOne) {
     // The file keeps every input exactly (floats round-trip, altitudes at 17 digits).
     EXPECT_NEAR(got.error_sum_px, expected.error_sum_px, 1e-9 * expected.error_sum_px) << k;
     EXPECT_NEAR(got.error_sum_m, expected.error_sum_m, 1e-9 * expected.error_sum_m) << k;
+    EXPECT_NEAR(got.along_error_sum_m, expected.along_error_sum_m, 1e-9 * expected.error_sum_m) << k;
+    EXPECT_NEAR(got.outward_error_sum_m, expected.outward_error_sum_m, 1e-9 * expected.error_sum_m) << k;
   }
   EXPECT_EQ(file.overall.within_2px, in_process[0].within_2px + in_process[1].within_2px);
   EXPECT_NEAR(file.matching_pixel_m, 0.48, 1e-9);  // 8 bins of 6 cm

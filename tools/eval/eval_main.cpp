@@ -46,7 +46,9 @@ const char* kExplanation =
     "  matching image (rows = pings, columns = decimation bins) and in metres, the fraction within 2 px and\n"
     "  recall at 2 px (matches within 2 px over the matchable probe pixels, scaled to the matching grid),\n"
     "  per pair type by centre-heading difference (parallel <= 30 deg, anti-parallel >= 150 deg, else\n"
-    "  crossing) and overall; --match-table also lists every pair and round.\n"
+    "  crossing) and overall; bias along and bias outward: the mean signed error along B's track and\n"
+    "  in ground range (positive outward: the match nearer B's track than the truth), a systematic\n"
+    "  offset as against scatter; --match-table also lists every pair and round.\n"
     "Exit codes: 0 ok, 1 an output could not be written, 2 bad arguments or input files.\n";
 
 bool endsWith(const std::string& text, const std::string& suffix) {

@@ -57,6 +57,8 @@ MatchEvaluation& MatchEvaluation::operator+=(const MatchEvaluation& other) {
   matchable += other.matchable;
   error_sum_px += other.error_sum_px;
   error_sum_m += other.error_sum_m;
+  along_error_sum_m += other.along_error_sum_m;
+  outward_error_sum_m += other.outward_error_sum_m;
   return *this;
 }
 
@@ -77,8 +79,12 @@ MatchEvaluation evaluateMatches(const sss::sim::Mission& mission, const sss::cor
     const double error = std::hypot(row_error, (pixel->y() - m.col_b) / decimation);
     ++e.evaluated;
     e.error_sum_px += error;
-    e.error_sum_m += std::hypot(row_error * pingSpacingM(mission, b, pixel->x()),
-                                b.geometry.signedGroundRangeM(pixel->y()) - b.geometry.signedGroundRangeM(m.col_b));
+    const double along_error_m = row_error * pingSpacingM(mission, b, pixel->x());
+    const double truth_ground_m = b.geometry.signedGroundRangeM(pixel->y());
+    const double match_ground_m = b.geometry.signedGroundRangeM(m.col_b);
+    e.error_sum_m += std::hypot(along_error_m, truth_ground_m - match_ground_m);
+    e.along_error_sum_m += along_error_m;
+    e.outward_error_sum_m += std::abs(truth_ground_m) - std::abs(match_ground_m);
     if (error <= 2.0) ++e.within_2px;
   }
   long sampled = 0;

@@ -50,10 +50,17 @@ struct MatchEvaluation {
   long matchable = 0;      // probes whose true B pixel is valid with a full patch, times recall_step^2
   double error_sum_px = 0.0;
   double error_sum_m = 0.0;
+  // Signed, to tell a systematic offset from scatter: the truth's B row minus the match's, in
+  // metres along B's track (positive: the truth is later in B), and the truth's ground range in B
+  // minus the match's (positive: the match is nearer B's track than the truth).
+  double along_error_sum_m = 0.0;
+  double outward_error_sum_m = 0.0;
   double withinFraction() const { return evaluated ? double(within_2px) / evaluated : 0.0; }
   double recall() const { return matchable ? double(within_2px) / matchable : 0.0; }
   double meanErrorPx() const { return evaluated ? error_sum_px / evaluated : 0.0; }
   double meanErrorM() const { return evaluated ? error_sum_m / evaluated : 0.0; }
+  double meanAlongErrorM() const { return evaluated ? along_error_sum_m / evaluated : 0.0; }
+  double meanOutwardErrorM() const { return evaluated ? outward_error_sum_m / evaluated : 0.0; }
   MatchEvaluation& operator+=(const MatchEvaluation& other);
 };
 

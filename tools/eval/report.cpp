@@ -350,7 +350,8 @@ namespace {
 std::vector<std::string> matchRow(const std::string& label, long pairs, const MatchEvaluation& e) {
   return {label, std::to_string(pairs), std::to_string(e.matches), std::to_string(e.evaluated),
           e.evaluated ? cell(e.meanErrorPx(), 2) : "-", e.evaluated ? cell(e.meanErrorM(), 3) : "-",
-          e.evaluated ? cell(e.withinFraction(), 3) : "-", e.matchable ? cell(e.recall(), 3) : "-"};
+          e.evaluated ? cell(e.withinFraction(), 3) : "-", e.matchable ? cell(e.recall(), 3) : "-",
+          e.evaluated ? cell(e.meanAlongErrorM(), 3) : "-", e.evaluated ? cell(e.meanOutwardErrorM(), 3) : "-"};
 }
 
 std::string formatMatchTable(const MatchFileEvaluation& m, bool per_pair) {
@@ -362,8 +363,8 @@ std::string formatMatchTable(const MatchFileEvaluation& m, bool per_pair) {
                 m.path.c_str(), m.mission_dir.c_str(), m.pairs.size(), m.subframes, m.matching_pixel_m);
   out << title;
   std::vector<std::vector<std::string>> rows = {
-      {"pair type", "pairs", "matches", "evaluated", "mean EPE", "mean EPE", "within", "recall"},
-      {"", "", "", "", "px", "m", "2 px", "2 px"}};
+      {"pair type", "pairs", "matches", "evaluated", "mean EPE", "mean EPE", "within", "recall", "bias along", "bias outward"},
+      {"", "", "", "", "px", "m", "2 px", "2 px", "m", "m"}};
   for (int t = 0; t < kPairTypes; ++t) {
     rows.push_back(matchRow(pairTypeName(static_cast<PairType>(t)), m.pairs_by_type[t], m.by_type[t]));
   }
@@ -371,7 +372,8 @@ std::string formatMatchTable(const MatchFileEvaluation& m, bool per_pair) {
   out << formatColumns(rows);
   if (per_pair && !m.pairs.empty()) {
     std::vector<std::vector<std::string>> pair_rows = {
-        {"pair", "round", "type", "matches", "evaluated", "EPE px", "EPE m", "within 2 px", "recall 2 px"}};
+        {"pair", "round", "type", "matches", "evaluated", "EPE px", "EPE m", "within 2 px", "recall 2 px", "bias along m",
+         "bias outward m"}};
     for (const PairMatchReport& p : m.pairs) {
       // matchRow's pair count becomes the round, followed by the type.
       std::vector<std::string> row = matchRow(std::to_string(p.subframe_a) + "-" + std::to_string(p.subframe_b), 0,

@@ -111,6 +111,9 @@ void writeMatchTotals(Json& json, const MatchEvaluation& e) {
   json["recall_2px"] = jsonValue(e.matchable ? e.recall() : std::numeric_limits<double>::quiet_NaN());
   json["mean_error_px"] = jsonValue(e.evaluated ? e.meanErrorPx() : std::numeric_limits<double>::quiet_NaN());
   json["mean_error_m"] = jsonValue(e.evaluated ? e.meanErrorM() : std::numeric_limits<double>::quiet_NaN());
+  json["mean_along_error_m"] = jsonValue(e.evaluated ? e.meanAlongErrorM() : std::numeric_limits<double>::quiet_NaN());
+  json["mean_outward_error_m"] =
+      jsonValue(e.evaluated ? e.meanOutwardErrorM() : std::numeric_limits<double>::quiet_NaN());
   json["probes"] = jsonValue(static_cast<int64_t>(e.probes));
   json["matchable"] = jsonValue(static_cast<int64_t>(e.matchable));
 }
