@@ -1,6 +1,6 @@
 // The findings of a run that found no pair to match: the advice follows the configuration (a
 // swath that already follows the sonar's range is not to be widened again); a survey cut into
-// pieces by slow turns is said to be.
+// pieces by slow turns is said to be; closures that wait for support are not called rejected.
 #include "tools/process/run_summary.hpp"
 
 #include <gtest/gtest.h>
@@ -57,6 +57,34 @@ TEST(RunSummary, MostLinesShorterThanASubframeAreExplainedAsSlowTurns) {
   s.short_lines = 2;
   for (const std::string& finding : explainRun(s, Options{}))
     EXPECT_EQ(finding.find("less than one subframe"), std::string::npos) << finding;
+}
+
+// Closures that only wait for independent support (randomised rock_outcrops-1901767246: two
+// closures, each the only one of its line pair) are not said to be rejected: nothing found them
+// wrong, and the advice is more overlap. Rejected ones are said to be, with both counts.
+TEST(RunSummary, ClosuresStillWaitingForSupportAreNotCalledRejected) {
+  OfflineSummary s = linesTooFarApartForTheirOverlap();
+  s.pairs_attempted = 6;
+  s.matcher_closures = 2;
+  s.closures_pending = 2;
+  Options options;
+  options.optimiser.graph.min_consistent_closures = 2;
+  options.optimiser.graph.pcm_count_independent_subframes = true;
+  std::vector<std::string> findings = explainRun(s, options);
+  ASSERT_EQ(findings.size(), 1u);
+  EXPECT_NE(findings[0].find("no closure accepted"), std::string::npos) << findings[0];
+  EXPECT_EQ(findings[0].find("rejected"), std::string::npos) << findings[0];
+  EXPECT_NE(findings[0].find("2 still wait for support"), std::string::npos) << findings[0];
+  EXPECT_NE(findings[0].find("2 mutually consistent closures through different subframes"), std::string::npos)
+      << findings[0];
+  EXPECT_NE(findings[0].find("min_consistent_closures"), std::string::npos) << findings[0];
+
+  s.closures_pending = 1;
+  s.closures_rejected = 1;
+  findings = explainRun(s, options);
+  ASSERT_EQ(findings.size(), 1u);
+  EXPECT_NE(findings[0].find("rejected 1 (inconsistent"), std::string::npos) << findings[0];
+  EXPECT_NE(findings[0].find("1 still wait for support"), std::string::npos) << findings[0];
 }
 
 }  // namespace

@@ -225,6 +225,7 @@ Status Runner::writeOutputs() {
   summary_.closures_accepted = counters.closures_accepted;
   summary_.closures_rejected = counters.closures_rejected_gate + counters.closures_rejected_inconsistent +
                                counters.closures_rejected_no_support;
+  summary_.closures_pending = counters.closures_pending;
   summary_.closures_superseded = counters.closures_superseded;
   summary_.variance_factors = optimiser_.graph().varianceFactors();
   summary_.separation_bias = optimiser_.graph().separationBias();

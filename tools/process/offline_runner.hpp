@@ -88,6 +88,9 @@ struct OfflineSummary {
   uint64_t false_closures_injected = 0;  // of those, made wrong on purpose (false_closure_fraction)
   uint64_t closures_accepted = 0;  // by the optimiser, after full smoothing
   uint64_t closures_rejected = 0;
+  // Still waiting at the end for the support they need (optimiser.graph.min_consistent_closures):
+  // neither accepted nor rejected.
+  uint64_t closures_pending = 0;
   uint64_t closures_superseded = 0;
   // Factors on the closure and odometry covariances learnt from the residuals at the final
   // smoothing (1 when optimiser.graph.variance_component_iterations is 0).

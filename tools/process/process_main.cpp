@@ -80,11 +80,12 @@ int main(int argc, char** argv) {
   if (!s.corrected_copy.empty())
     std::printf("sss-process: corrected copy %s (%llu sonar records with the SLAM navigation)\n", s.corrected_copy.c_str(),
                 static_cast<unsigned long long>(s.corrected_records));
-  std::printf("sss-process: %llu pings, %llu subframes, %llu pairs, %llu closures (%llu accepted, %llu rejected), "
-              "%llu seabed points; mission %.0f s in %.1f s (%.1fx real time), peak %.0f MiB -> %s\n",
+  std::printf("sss-process: %llu pings, %llu subframes, %llu pairs, %llu closures (%llu accepted, %llu rejected, "
+              "%llu pending), %llu seabed points; mission %.0f s in %.1f s (%.1fx real time), peak %.0f MiB -> %s\n",
               static_cast<unsigned long long>(s.pings), static_cast<unsigned long long>(s.subframes),
               static_cast<unsigned long long>(s.pairs_attempted), static_cast<unsigned long long>(s.matcher_closures),
               static_cast<unsigned long long>(s.closures_accepted), static_cast<unsigned long long>(s.closures_rejected),
+              static_cast<unsigned long long>(s.closures_pending),
               static_cast<unsigned long long>(s.seabed_points), s.mission_s, s.wall_s, s.real_time_factor, s.peak_rss_mib,
               request.out_dir.c_str());
   return 0;

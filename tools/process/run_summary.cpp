@@ -137,9 +137,27 @@ std::vector<std::string> explainRun(const OfflineSummary& s, const Options& opti
     return findings;
   }
   if (s.closures_accepted == 0) {
-    findings.push_back("no closure accepted: the optimiser rejected all " + count(s.matcher_closures) +
-                       " (inconsistent with dead reckoning and with each other; see loop_closures.csv); the result is "
-                       "dead reckoning");
+    // Pending closures were not found wrong: they lack independent support. Saying "rejected"
+    // would send the user after a fault that is not there.
+    const auto& graph = options.optimiser.graph;
+    std::string text = "no closure accepted (the result is dead reckoning): ";
+    if (s.closures_rejected > 0) {
+      text += "the optimiser rejected " + count(s.closures_rejected) +
+              " (inconsistent with dead reckoning or with each other; see loop_closures.csv)";
+    }
+    if (s.closures_pending > 0) {
+      if (s.closures_rejected > 0) text += "; ";
+      text += count(s.closures_pending) + " still wait for support: a closure is trusted once " +
+              std::to_string(graph.min_consistent_closures) + " mutually consistent closures" +
+              (graph.pcm_count_independent_subframes ? " through different subframes" : "") +
+              " back it (optimiser.graph.min_consistent_closures), and these had none (too few pairs between "
+              "the lines: more overlap, another pass or a cross line would give them support)";
+    }
+    if (s.closures_rejected == 0 && s.closures_pending == 0) {
+      text += "the " + count(s.matcher_closures) + " closures of the matcher were all superseded or refused (see "
+              "loop_closures.csv)";
+    }
+    findings.push_back(text);
   }
   // DR strained beyond its own error model: on the randomised missions this marked exactly the
   // runs SLAM made worse than DR (closures with an error common to a pair, relief at far range).
@@ -249,7 +267,7 @@ sss::core::Status writeSummaryJson(const std::string& path, const OfflineRequest
       {"pairs_attempted", s.pairs_attempted}, {"matcher_closures", s.matcher_closures},
       {"false_closures_injected", s.false_closures_injected},
       {"closures_accepted", s.closures_accepted}, {"closures_rejected", s.closures_rejected},
-      {"closures_superseded", s.closures_superseded}, {"seabed_points", s.seabed_points},
+      {"closures_pending", s.closures_pending}, {"closures_superseded", s.closures_superseded}, {"seabed_points", s.seabed_points},
       {"input_faults", s.input_faults}};
   for (const auto& [name, value] : counts) json[name] = jsonValue(value);
   const auto& fusion = s.buffer.fusion;
