@@ -186,16 +186,18 @@ TEST_F(EvalCli, ComparesHeightmapsAndWritesErrorMaps) {
 
 TEST_F(EvalCli, ScoresLoopClosuresAndLandmarkConsistency) {
   // Two closures between lines 0 and 1 (poses 200 and 800, 0.5 m apart on the path); the accepted
-  // one 0.3 m too far along track, the rejected one 4 m.
+  // one 0.3 m too far along track, the rejected one 4 m; both with sigmas of 0.3 m along and 0.2 m
+  // across, so NEES 1 and 178.
   std::ofstream csv(path("loop_closures.csv"));
   csv << "# loop closures\nsubframe_id_a,subframe_id_b,utime_a_us,utime_b_us,round,status,rejection,dx_m,dy_m,dz_m,"
-         "droll_rad,dpitch_rad,dheading_rad,num_inliers,mean_zncc,north_a_m,east_a_m,north_b_m,east_b_m\n";
+         "droll_rad,dpitch_rad,dheading_rad,num_inliers,mean_zncc,north_a_m,east_a_m,north_b_m,east_b_m,cov_xx_m2,"
+         "cov_xy_m2,cov_yy_m2\n";
   const sss::core::Pose T_a_b = truth_[200].T_world_body.inverse() * truth_[800].T_world_body;
   const double heading_rad = sss::core::eulerFromQuaternion(T_a_b.rotation).heading_rad;
   for (const auto& [status, along_error_m] : {std::pair<const char*, double>{"accepted", 0.3}, {"rejected", 4.0}}) {
     csv << "3,7," << truth_[200].utime_us << "," << truth_[800].utime_us << ",0," << status << ",none,"
         << std::setprecision(12) << T_a_b.translation.x() + along_error_m << "," << T_a_b.translation.y() << ","
-        << T_a_b.translation.z() << ",0,0," << heading_rad << ",50,0.6,0,0,0,0\n";
+        << T_a_b.translation.z() << ",0,0," << heading_rad << ",50,0.6,0,0,0,0,0.09,0,0.04\n";
   }
   csv.close();
   const ProgramRun result = run("--gt " + path("truth.tum") + " --est " + path("dr.tum") + " --label DR --est " +
@@ -205,6 +207,7 @@ TEST_F(EvalCli, ScoresLoopClosuresAndLandmarkConsistency) {
   EXPECT_NE(result.out.find("truth (self-check)"), std::string::npos) << result.out;
   EXPECT_NE(result.out.find("3-7"), std::string::npos) << result.out;  // the per-closure table
   EXPECT_NE(result.out.find("accepted"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("NEES"), std::string::npos) << result.out;  // the closure's own sigmas and NEES
 
   const YAML::Node json = YAML::LoadFile(path("c.json"));
   const YAML::Node closures = json["closures"];
@@ -220,9 +223,13 @@ TEST_F(EvalCli, ScoresLoopClosuresAndLandmarkConsistency) {
   // DR is the truth shifted 2 m east everywhere: its relative poses are the truth's.
   EXPECT_NEAR(closures["groups"][0]["dr"]["horizontal_m"]["max"].as<double>(), 0.0, 1e-5);
   for (const char* key : {"subframe_id_a", "subframe_id_b", "round", "status", "rejection", "utime_a_us", "utime_b_us",
-                          "truth", "error", "dr_error"}) {
+                          "truth", "error", "dr_error", "sigma_along_m", "sigma_lateral_m", "horizontal_nees"}) {
     EXPECT_TRUE(closures["closures"][0][key]) << key;
   }
+  EXPECT_NEAR(closures["closures"][0]["sigma_along_m"].as<double>(), 0.3, 1e-9);
+  EXPECT_NEAR(closures["closures"][0]["sigma_lateral_m"].as<double>(), 0.2, 1e-9);
+  EXPECT_NEAR(closures["closures"][0]["horizontal_nees"].as<double>(), 1.0, 1e-3);
+  EXPECT_NEAR(closures["closures"][1]["horizontal_nees"].as<double>(), 16.0 / 0.09, 1e-2);
 
   const YAML::Node lce = json["lce"];
   EXPECT_DOUBLE_EQ(lce["seabed_depth_m"].as<double>(), 50.0);

@@ -81,6 +81,13 @@ std::string formatClosureTable(const EvalReport& report) {
     std::vector<std::vector<std::string>> list = {
         {"closure a-b", "round", "status", "true dx", "true dy", "along", "lateral", "depth", "heading"},
         {"", "", "", "m", "m", "err m", "err m", "err m", "err deg"}};
+    // The closure's own sigmas and its horizontal NEES, when the file carries its covariance.
+    bool any_covariance = false;
+    for (const ClosureError& e : ev.closures) any_covariance = any_covariance || e.closure.has_covariance;
+    if (any_covariance) {
+      for (const char* name : {"sigma", "sigma", "NEES"}) list[0].push_back(name);
+      for (const char* unit : {"along m", "lat. m", "horiz."}) list[1].push_back(unit);
+    }
     if (!dr_label.empty()) {
       for (const char* name : {"DR along", "DR lateral", "DR depth", "DR heading"}) list[0].push_back(name);
       for (const char* unit : {"err m", "err m", "err m", "err deg"}) list[1].push_back(unit);
@@ -92,6 +99,12 @@ std::string formatClosureTable(const EvalReport& report) {
                                       e.has_truth ? cell(e.truth.translation_m.x(), 2) : "-",
                                       e.has_truth ? cell(e.truth.translation_m.y(), 2) : "-"};
       for (const std::string& v : closureErrorCells(e.has_truth, e.closure_error)) row.push_back(v);
+      if (any_covariance) {
+        const Eigen::Matrix2d& cov = c.horizontal_covariance_m2;
+        row.push_back(c.has_covariance ? cell(std::sqrt(std::max(0.0, cov(0, 0))), 2) : "-");
+        row.push_back(c.has_covariance ? cell(std::sqrt(std::max(0.0, cov(1, 1))), 2) : "-");
+        row.push_back(std::isfinite(e.horizontal_nees) ? cell(e.horizontal_nees, 1) : "-");
+      }
       if (!dr_label.empty()) {
         for (const std::string& v : closureErrorCells(e.has_dr, e.dr_error)) row.push_back(v);
       }
