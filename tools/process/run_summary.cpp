@@ -147,11 +147,13 @@ std::vector<std::string> explainRun(const OfflineSummary& s, const Options& opti
     }
     if (s.closures_pending > 0) {
       if (s.closures_rejected > 0) text += "; ";
-      text += count(s.closures_pending) + " still wait for support: a closure is trusted once " +
-              std::to_string(graph.min_consistent_closures) + " mutually consistent closures" +
-              (graph.pcm_count_independent_subframes ? " through different subframes" : "") +
-              " back it (optimiser.graph.min_consistent_closures), and these had none (too few pairs between "
-              "the lines: more overlap, another pass or a cross line would give them support)";
+      const bool one = s.closures_pending == 1;
+      text += count(s.closures_pending) + (one ? " closure still waits" : " closures still wait") +
+              " for support: a closure is trusted once " + std::to_string(graph.min_consistent_closures) +
+              " mutually consistent closures" + (graph.pcm_count_independent_subframes ? " through different subframes" : "") +
+              " back it (optimiser.graph.min_consistent_closures), and " + (one ? "it" : "these") +
+              " had none (too few pairs between the lines: more overlap, another pass or a cross line would give " +
+              (one ? "it" : "them") + " support)";
     }
     if (s.closures_rejected == 0 && s.closures_pending == 0) {
       text += "the " + count(s.matcher_closures) + " closures of the matcher were all superseded or refused (see "
