@@ -99,7 +99,9 @@ Footprint computeFootprint(const sss::core::Subframe& subframe, const std::vecto
   }
   footprint.port_ne_m = hull(port);
   footprint.starboard_ne_m = hull(starboard);
-  footprint.area_m2 = polygonArea(footprint.port_ne_m) + polygonArea(footprint.starboard_ne_m);
+  footprint.port_area_m2 = polygonArea(footprint.port_ne_m);
+  footprint.starboard_area_m2 = polygonArea(footprint.starboard_ne_m);
+  footprint.area_m2 = footprint.port_area_m2 + footprint.starboard_area_m2;
   double n_min = 1e300, n_max = -1e300, e_min = 1e300, e_max = -1e300;
   for (const auto* polygon : {&footprint.port_ne_m, &footprint.starboard_ne_m}) {
     for (const auto& p : *polygon) {
@@ -127,11 +129,15 @@ SharedSeabed sharedSeabed(const Footprint& a, const Footprint& b) {
   SharedSeabed shared;
   if ((a.bounds_ne_m & b.bounds_ne_m).area() <= 0.0) return shared;
   const cv::Point2d origin(a.bounds_ne_m.x, a.bounds_ne_m.y);
-  for (const auto* pa : {&a.port_ne_m, &a.starboard_ne_m}) {
-    for (const auto* pb : {&b.port_ne_m, &b.starboard_ne_m}) {
-      const double area = intersectionArea(*pa, *pb, origin);
+  const std::pair<const std::vector<cv::Point2d>*, double> sides_a[] = {{&a.port_ne_m, a.port_area_m2},
+                                                                         {&a.starboard_ne_m, a.starboard_area_m2}};
+  const std::pair<const std::vector<cv::Point2d>*, double> sides_b[] = {{&b.port_ne_m, b.port_area_m2},
+                                                                         {&b.starboard_ne_m, b.starboard_area_m2}};
+  for (const auto& [polygon_a, area_a_m2] : sides_a) {
+    for (const auto& [polygon_b, area_b_m2] : sides_b) {
+      const double area = intersectionArea(*polygon_a, *polygon_b, origin);
       shared.area_m2 += area;
-      const double smaller = std::min(polygonArea(*pa), polygonArea(*pb));
+      const double smaller = std::min(area_a_m2, area_b_m2);
       if (smaller > 0.0) shared.fraction_of_smaller_swath = std::max(shared.fraction_of_smaller_swath, area / smaller);
     }
   }

@@ -39,7 +39,9 @@ struct Footprint {
   int line_id = 0;
   std::vector<cv::Point2d> port_ne_m;
   std::vector<cv::Point2d> starboard_ne_m;
-  double area_m2 = 0.0;
+  double port_area_m2 = 0.0;
+  double starboard_area_m2 = 0.0;
+  double area_m2 = 0.0;  // both sides
   cv::Rect2d bounds_ne_m;  // of both polygons (a quick rejection test)
 };
 

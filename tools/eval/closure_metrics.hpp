@@ -7,6 +7,8 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -30,6 +32,11 @@ struct ClosureRecord {
   // frame), when the file has the columns.
   bool has_covariance = false;
   Eigen::Matrix2d horizontal_covariance_m2 = Eigen::Matrix2d::Zero();
+  // Its 1-sigma along track (x) and across (y); NaN without the covariance.
+  double sigmaM(int axis) const {
+    return has_covariance ? std::sqrt(std::max(0.0, horizontal_covariance_m2(axis, axis)))
+                          : std::numeric_limits<double>::quiet_NaN();
+  }
 };
 
 // Header line first (columns found by name in any order, extra columns ignored; needed:

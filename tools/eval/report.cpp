@@ -100,9 +100,7 @@ std::string formatClosureTable(const EvalReport& report) {
                                       e.has_truth ? cell(e.truth.translation_m.y(), 2) : "-"};
       for (const std::string& v : closureErrorCells(e.has_truth, e.closure_error)) row.push_back(v);
       if (any_covariance) {
-        const Eigen::Matrix2d& cov = c.horizontal_covariance_m2;
-        row.push_back(c.has_covariance ? cell(std::sqrt(std::max(0.0, cov(0, 0))), 2) : "-");
-        row.push_back(c.has_covariance ? cell(std::sqrt(std::max(0.0, cov(1, 1))), 2) : "-");
+        for (const double value : {c.sigmaM(0), c.sigmaM(1)}) row.push_back(std::isfinite(value) ? cell(value, 2) : "-");
         row.push_back(std::isfinite(e.horizontal_nees) ? cell(e.horizontal_nees, 1) : "-");
       }
       if (!dr_label.empty()) {

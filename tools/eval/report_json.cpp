@@ -2,9 +2,9 @@
 // report.hpp.
 #include "tools/eval/report.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 
 #include "tools/eval/json_values.hpp"
 
@@ -75,15 +75,12 @@ void writeClosuresJson(Json& json, const ClosureReport& closures) {
     writeRelativePoseError(closure_json, "error", e.has_truth, e.closure_error);
     writeRelativePoseError(closure_json, "dr_error", e.has_dr, e.dr_error);
     // The closure's own horizontal sigmas (A's frame) and its error against them.
-    if (c.has_covariance) {
-      closure_json["sigma_along_m"] = jsonValue(std::sqrt(std::max(0.0, c.horizontal_covariance_m2(0, 0))));
-      closure_json["sigma_lateral_m"] = jsonValue(std::sqrt(std::max(0.0, c.horizontal_covariance_m2(1, 1))));
-    } else {
-      closure_json["sigma_along_m"] = nullptr;
-      closure_json["sigma_lateral_m"] = nullptr;
+    for (const auto& [key, value] : {std::pair<const char*, double>{"sigma_along_m", c.sigmaM(0)},
+                                     {"sigma_lateral_m", c.sigmaM(1)},
+                                     {"horizontal_nees", e.horizontal_nees}}) {
+      if (std::isfinite(value)) closure_json[key] = jsonValue(value);
+      else closure_json[key] = nullptr;
     }
-    if (std::isfinite(e.horizontal_nees)) closure_json["horizontal_nees"] = jsonValue(e.horizontal_nees);
-    else closure_json["horizontal_nees"] = nullptr;
   }
 }
 
