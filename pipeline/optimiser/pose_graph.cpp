@@ -287,8 +287,25 @@ Status SlidingWindowPoseGraph::addFix(const AbsoluteFix& fix) {
   Fix f;
   f.record.fix = fix;
   f.record.fix.covariance_m2 = covariance;
+  f.record.information_weight = fixInformationWeight(fix);
   fixes_.push_back(std::move(f));
   return Status::success();
+}
+
+double SlidingWindowPoseGraph::fixInformationWeight(const AbsoluteFix& fix) const {
+  const double tau_s = fix.source == "usbl" ? options_.usbl_fix_correlation_s : options_.gnss_fix_correlation_s;
+  if (!(tau_s > 0.0)) return 1.0;
+  // The nearest earlier fix of the same source (fixes arrive in time order per source; one that
+  // arrives late is weighted against what came before it).
+  int64_t previous_utime_us = std::numeric_limits<int64_t>::min();
+  for (const Fix& other : fixes_)
+    if (other.record.fix.source == fix.source && other.record.fix.utime_us <= fix.utime_us)
+      previous_utime_us = std::max(previous_utime_us, other.record.fix.utime_us);
+  if (previous_utime_us == std::numeric_limits<int64_t>::min()) return 1.0;
+  // Gauss-Markov: the part of this fix's error not already in the previous one's. A repeated fix
+  // of the same time adds nothing; the floor keeps its covariance finite.
+  const double rho = std::exp(-1e-6 * static_cast<double>(fix.utime_us - previous_utime_us) / tau_s);
+  return std::max((1.0 - rho) / (1.0 + rho), 1e-6);
 }
 
 bool SlidingWindowPoseGraph::tieFix(Fix& f, int n) const {
@@ -299,11 +316,15 @@ bool SlidingWindowPoseGraph::tieFix(Fix& f, int n) const {
   // The DR between the node and the fix drifts like any odometry edge of that length.
   const double dr_variance =
       odometryCovariance(options_, std::abs(f.record.fix.dr_distance_m - node.distance_m))(0, 0);
-  const Eigen::Matrix2d covariance = f.record.fix.covariance_m2 + dr_variance * Eigen::Matrix2d::Identity();
+  const Eigen::Matrix2d dr_covariance = dr_variance * Eigen::Matrix2d::Identity();
+  // The gate tests the fix against its own sigma; the solve takes the share of its information the
+  // fixes before it did not already give (correlated errors, fixInformationWeight).
+  f.gate_covariance = f.record.fix.covariance_m2 + dr_covariance;
+  const Eigen::Matrix2d covariance = f.record.fix.covariance_m2 / f.record.information_weight + dr_covariance;
   const Eigen::LLT<Eigen::Matrix2d> llt(covariance);
   if (llt.info() != Eigen::Success) return false;
   f.sqrt_information = llt.matrixL().solve(Eigen::Matrix2d::Identity());
-  return f.sqrt_information.allFinite();
+  return f.sqrt_information.allFinite() && f.gate_covariance.allFinite();
 }
 
 Eigen::Matrix2d SlidingWindowPoseGraph::calibrationDriftCovariance(int m, int n) const {
@@ -367,7 +388,7 @@ void SlidingWindowPoseGraph::decideFixes(bool final) {
     skew << 0, -f.p_body.z(), f.p_body.y(), f.p_body.z(), 0, -f.p_body.x(), -f.p_body.y(), f.p_body.x(), 0;
     jacobian.leftCols<3>() = rotation.topRows<2>();
     jacobian.rightCols<3>() = -(rotation * skew).topRows<2>();
-    const Eigen::Matrix2d fix_covariance = (f.sqrt_information.transpose() * f.sqrt_information).inverse();
+    const Eigen::Matrix2d& fix_covariance = f.gate_covariance;
     const Matrix6d node_covariance = node.has_covariance ? node.covariance : Matrix6d::Zero();
     // Plus the systematic drift the held calibration leaves since the newest node an accepted fix
     // ties down (or the first node): the window's covariance grows with the square root of the

@@ -168,6 +168,19 @@ struct PoseGraphOptions {
   // node's current estimate and covariance (2 dof: 13.82 = 99.9 %), so an outlying USBL fix does not
   // pull the survey, and it enters the solve under the closures' robust loss.
   double fix_gate_chi2 = 13.82;
+  // A GNSS receiver's error (ionosphere, satellite orbits and clocks, multipath) changes over
+  // minutes, not from one fix to the next: a vehicle logging 1 Hz GGA for five minutes at the
+  // surface has a few independent fixes' worth of information, not 300. Treated as independent they
+  // would pin the survey to their common error with a tenth of its sigma. The error is modelled as
+  // first-order Gauss-Markov with this correlation time per source (0: independent fixes): a fix dt
+  // after the previous fix of its source, rho = exp(-dt / tau), enters the solve with its information
+  // times (1 - rho) / (1 + rho). Summed over a run of fixes that is exactly the information a
+  // correlated series holds about a common offset (1 + (n - 1)(1 - rho) / (1 + rho) fixes' worth).
+  // Each fix is still gated against its own sigma. USBL errors are mostly the acoustic noise of each
+  // reply (independent); a USBL system known for slow errors (sound-speed profile, a mounting
+  // misalignment) can set a time.
+  double gnss_fix_correlation_s = 300.0;
+  double usbl_fix_correlation_s = 0.0;
 
   // ---- calibration of the DR sensors -----------------------------------------------------------------
   // DVL scale factor s (DR's horizontal odometry is (1 + s) times the distance flown) and the INS
@@ -254,6 +267,9 @@ struct FixRecord {
   double innovation_chi2 = std::numeric_limits<double>::quiet_NaN();  // at the gate
   // After the solve: the fix less the node's estimate carried to the fix time (north, east), m.
   Eigen::Vector2d residual_ne_m = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+  // The share of the fix's own information the solve takes (1: independent of the fixes before it;
+  // PoseGraphOptions::gnss_fix_correlation_s).
+  double information_weight = 1.0;
 };
 
 struct FixCounters {
@@ -506,7 +522,8 @@ class SlidingWindowPoseGraph {
     FixRecord record;
     int node = -1;                                      // index; -1 until tied
     Eigen::Vector3d p_body = Eigen::Vector3d::Zero();   // DR position at the fix time, node's DR frame
-    Eigen::Matrix2d sqrt_information = Eigen::Matrix2d::Identity();  // fix + DR between node and fix
+    Eigen::Matrix2d sqrt_information = Eigen::Matrix2d::Identity();  // fix (weighted) + DR between node and fix
+    Eigen::Matrix2d gate_covariance = Eigen::Matrix2d::Identity();   // fix (its own sigma) + DR: the gate's
   };
 
   struct Closure {
@@ -556,6 +573,9 @@ class SlidingWindowPoseGraph {
   void decideFixes(bool final);
   // Ties fix f to node n: its body-frame offset and whitening (also used by the checkpoint).
   bool tieFix(Fix& f, int n) const;
+  // The information weight of a fix arriving after fixes_ (see gnss_fix_correlation_s): from the
+  // nearest earlier fix of its source among them.
+  double fixInformationWeight(const AbsoluteFix& fix) const;
   // North/east covariance of node n's position relative to node m that the DR calibration's
   // uncertainty leaves (its sigma once estimated, else the priors): the window holds the
   // calibration constant, so its covariance does not carry the systematic drift between them.

@@ -320,6 +320,8 @@ Status SlidingWindowPoseGraph::restoreCheckpointText(const std::string& text) {
       const Eigen::LLT<Eigen::Matrix2d> llt(x.covariance_m2);
       if (!x.position_ne_m.allFinite() || !x.dr_position_m.allFinite() || llt.info() != Eigen::Success)
         return fail("fix record " + std::to_string(i) + " is not finite or its covariance not positive definite");
+      // Not stored: the same function of the fixes before it as when it arrived.
+      f.record.information_weight = g.fixInformationWeight(x);
       if (node >= 0) {
         if (!g.tieFix(f, node)) return fail("fix record " + std::to_string(i) + " cannot be tied to its node");
         g.nodes_[node].fixes.push_back(static_cast<int>(g.fixes_.size()));

@@ -55,6 +55,8 @@ std::vector<std::string> validatePoseGraphOptions(const PoseGraphOptions& o) {
   if (!(o.separation_bias_significance >= 0.0))
     problems.push_back("separation_bias_significance must be >= 0 (sigmas; 0: always significant)");
   positive(o.fix_gate_chi2, "fix_gate_chi2");
+  nonNegative(o.gnss_fix_correlation_s, "gnss_fix_correlation_s");
+  nonNegative(o.usbl_fix_correlation_s, "usbl_fix_correlation_s");
   if (o.calibration != "auto" && o.calibration != "heading" && o.calibration != "always" && o.calibration != "never")
     problems.push_back("calibration must be one of auto, heading, always, never (got '" + o.calibration + "')");
   positive(o.calibration_scale_sigma, "calibration_scale_sigma");
@@ -121,6 +123,8 @@ void readPoseGraphOptions(sss::core::ConfigSection& section, PoseGraphOptions& o
   section.optional("separation_bias_widen_with_fixes", options.separation_bias_widen_with_fixes);
   section.optional("separation_bias_significance", options.separation_bias_significance, {inRange(0.0, 100.0)});
   section.optional("fix_gate_chi2", options.fix_gate_chi2, {greaterThan(0.0)});
+  section.optional("gnss_fix_correlation_s", options.gnss_fix_correlation_s, {atLeast(0.0)});
+  section.optional("usbl_fix_correlation_s", options.usbl_fix_correlation_s, {atLeast(0.0)});
   section.optional("calibration", options.calibration, {sss::core::oneOf({"auto", "heading", "always", "never"})});
   section.optional("calibration_scale_sigma", options.calibration_scale_sigma, {inRange(1e-6, 0.5)});
   section.optional("calibration_period_s", options.calibration_period_s, {inRange(0.0, 1e6)});

@@ -304,6 +304,104 @@ TEST(PositionFixGraph, FirstNodeAnchorFollowsTheInsAccuracy) {
   EXPECT_EQ(fresh.firstNodeInsSigma(), Eigen::Vector2d::Zero());
 }
 
+// A GNSS receiver at the surface logs a fix a second for the minute before the dive; its error (here 2.0 m north,
+// -1.5 m east, 1.5 m per axis as its GST says) is common to the whole minute, as a receiver's
+// error changes over minutes. Taken as 60 independent fixes the start would be claimed known to
+// 0.19 m while it is 2.5 m off; weighted by their correlation (300 s) the minute is worth about one
+// fix and the start's covariance covers its error. The gate still tests every fix against its own
+// sigma: a fix 15 m off after the minute is refused although it enters with 1/600 of its
+// information. USBL fixes are weighted on their own (independent by default).
+TEST(PositionFixGraph, CorrelatedGnssFixesCountAsTheInformationTheyHold) {
+  const synthetic::Mission mission = synthetic::makeLawnmowerMission(missionOptions(1));
+  const synthetic::Node& first = mission.nodes[0];
+  const Eigen::Vector2d common_error_m(2.0, -1.5);
+  std::mt19937_64 random(17);
+  std::normal_distribution<double> receiver_noise(0.0, 0.05);
+  std::vector<AbsoluteFix> minute;
+  for (int second = 0; second < 60; ++second) {
+    AbsoluteFix fix = fixAt(first, 1.5, random);
+    fix.utime_us = first.utime_us - (59 - second) * 1000000LL;  // the minute before the dive, at the first node's position
+    fix.position_ne_m = first.truth.translation.head<2>() + common_error_m +
+                        Eigen::Vector2d(receiver_noise(random), receiver_noise(random));
+    minute.push_back(fix);
+  }
+  auto startNees = [&](double correlation_s, double* sigma_north_m) {
+    PoseGraphOptions options = graphOptions();
+    options.gnss_fix_correlation_s = correlation_s;
+    options.calibration = "never";  // the start's position alone: no DVL scale or heading error to share it with
+    SlidingWindowPoseGraph graph(options);
+    EXPECT_TRUE(graph.setFirstNodeHorizontalSigma(10.0, 10.0).ok);  // the INS barely knew the start
+    EXPECT_TRUE(graph.addNode(first.subframe_id, first.utime_us, first.dr, first.distance_m).ok);
+    for (const AbsoluteFix& fix : minute) EXPECT_TRUE(graph.addFix(fix).ok);
+    for (size_t i = 1; i < 4; ++i) {
+      const synthetic::Node& n = mission.nodes[i];
+      EXPECT_TRUE(graph.addNode(n.subframe_id, n.utime_us, n.dr, n.distance_m).ok);
+      EXPECT_TRUE(graph.optimize().ok);
+    }
+    EXPECT_TRUE(graph.fullSmoothing().ok);
+    EXPECT_EQ(graph.fixCounters().accepted, 60u);
+    const Eigen::Matrix2d covariance = graph.covariance(first.subframe_id)->topLeftCorner<2, 2>();
+    const Eigen::Vector2d error = (graph.nodes()[0].T_world_body.translation - first.truth.translation).head<2>();
+    *sigma_north_m = std::sqrt(covariance(0, 0));
+    return error.dot(covariance.ldlt().solve(error));
+  };
+  double sigma_independent_m = 0.0, sigma_correlated_m = 0.0;
+  const double nees_independent = startNees(0.0, &sigma_independent_m);
+  const double nees_correlated = startNees(300.0, &sigma_correlated_m);
+  std::printf("a minute of 1 Hz GNSS, 2.5 m off in common: start sigma %.2f m, NEES %.1f (independent) vs "
+              "%.2f m, NEES %.1f (correlated over 300 s)\n",
+              sigma_independent_m, nees_independent, sigma_correlated_m, nees_correlated);
+  EXPECT_NEAR(sigma_independent_m, 1.5 / std::sqrt(60.0), 0.02);
+  EXPECT_GT(nees_independent, 50.0);
+  // One fix plus 59 times (1 - rho) / (1 + rho), rho = exp(-1 / 300): 1.10 fixes' worth.
+  const double rho = std::exp(-1.0 / 300.0);
+  const double worth = 1.0 + 59.0 * (1.0 - rho) / (1.0 + rho);
+  EXPECT_NEAR(sigma_correlated_m, 1.5 / std::sqrt(worth + 1.5 * 1.5 / 100.0), 0.03);
+  EXPECT_LT(nees_correlated, 5.99);  // chi-square 2 dof, 95 %
+
+  PoseGraphOptions options = graphOptions();
+  SlidingWindowPoseGraph graph(options);
+  ASSERT_TRUE(graph.setFirstNodeHorizontalSigma(10.0, 10.0).ok);
+  ASSERT_TRUE(graph.addNode(first.subframe_id, first.utime_us, first.dr, first.distance_m).ok);
+  for (const AbsoluteFix& fix : minute) ASSERT_TRUE(graph.addFix(fix).ok);
+  for (size_t i = 1; i < 4; ++i) {
+    const synthetic::Node& n = mission.nodes[i];
+    ASSERT_TRUE(graph.addNode(n.subframe_id, n.utime_us, n.dr, n.distance_m).ok);
+    ASSERT_TRUE(graph.optimize().ok);
+    if (i == 1) {  // the minute is in the estimate: two late fixes of its last second
+      AbsoluteFix far = minute.back();
+      far.utime_us += 500000;
+      far.position_ne_m += Eigen::Vector2d(15.0, 0.0);
+      ASSERT_TRUE(graph.addFix(far).ok);
+      AbsoluteFix usbl = minute.back();
+      usbl.utime_us += 700000;
+      usbl.source = "usbl";
+      ASSERT_TRUE(graph.addFix(usbl).ok);
+    }
+  }
+  ASSERT_TRUE(graph.fullSmoothing().ok);
+  const std::vector<FixRecord> records = graph.fixes();
+  ASSERT_EQ(records.size(), 62u);
+  EXPECT_DOUBLE_EQ(records[0].information_weight, 1.0);
+  for (size_t i = 1; i < 60; ++i) EXPECT_NEAR(records[i].information_weight, (1.0 - rho) / (1.0 + rho), 1e-12) << i;
+  const double rho_half = std::exp(-0.5 / 300.0);
+  EXPECT_NEAR(records[60].information_weight, (1.0 - rho_half) / (1.0 + rho_half), 1e-12);
+  EXPECT_EQ(records[60].status, FixStatus::kRejected) << "chi-square " << records[60].innovation_chi2;
+  EXPECT_DOUBLE_EQ(records[61].information_weight, 1.0);  // the first USBL fix: another source
+  EXPECT_EQ(records[61].status, FixStatus::kAccepted);
+
+  // A restored graph weighs its fixes as the original did.
+  SlidingWindowPoseGraph restored(options);
+  ASSERT_TRUE(restored.restoreCheckpointText(graph.checkpointText()).ok);
+  ASSERT_EQ(restored.fixes().size(), records.size());
+  for (size_t i = 0; i < records.size(); ++i)
+    EXPECT_DOUBLE_EQ(restored.fixes()[i].information_weight, records[i].information_weight) << i;
+
+  PoseGraphOptions negative = graphOptions();
+  negative.gnss_fix_correlation_s = -1.0;
+  EXPECT_FALSE(validatePoseGraphOptions(negative).empty());
+}
+
 TEST(PositionFixGraph, BadFixesAreRefusedWithTheReason) {
   SlidingWindowPoseGraph graph(graphOptions());
   AbsoluteFix fix;

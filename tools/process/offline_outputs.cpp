@@ -18,25 +18,30 @@ Status Runner::writeFixOutputs(const std::string& dir) {
   s.rejected_gate = graph.fixCounters().rejected_gate;
   if (records.empty()) return Status::success();
   double sum_squared = 0.0;
+  s.accepted_independent_equivalent = 0.0;
   for (const auto& r : records)
-    if (r.status == sss::optimiser::FixStatus::kAccepted) sum_squared += r.residual_ne_m.squaredNorm();
+    if (r.status == sss::optimiser::FixStatus::kAccepted) {
+      sum_squared += r.residual_ne_m.squaredNorm();
+      s.accepted_independent_equivalent += r.information_weight;
+    }
   s.rms_residual_m = s.accepted > 0 ? std::sqrt(sum_squared / static_cast<double>(s.accepted)) : 0.0;
 
   const std::string csv_path = dir + "/fixes.csv";
   std::FILE* f = std::fopen(csv_path.c_str(), "w");
   if (!f) return Status::error("cannot write " + csv_path);
   std::fprintf(f, "# absolute fixes given to the optimiser (local NED of the mission origin); residual = fix - SLAM "
-                  "estimate at the fix time; chi2 = innovation at the gate (2 dof)\n"
+                  "estimate at the fix time; chi2 = innovation at the gate (2 dof); information_weight = the share of the fix's "
+                  "information the solve takes (its error correlated with the fix before it)\n"
                   "utime_us,source,north_m,east_m,sigma_north_m,sigma_east_m,status,innovation_chi2,subframe_id,"
-                  "residual_north_m,residual_east_m\n");
+                  "residual_north_m,residual_east_m,information_weight\n");
   for (const auto& r : records) {
     const char* status = r.status == sss::optimiser::FixStatus::kAccepted   ? "accepted"
                          : r.status == sss::optimiser::FixStatus::kRejected ? "rejected_gate"
                                                                               : "pending";
-    std::fprintf(f, "%lld,%s,%.3f,%.3f,%.3f,%.3f,%s,%.3f,%lld,%.3f,%.3f\n", static_cast<long long>(r.fix.utime_us),
+    std::fprintf(f, "%lld,%s,%.3f,%.3f,%.3f,%.3f,%s,%.3f,%lld,%.3f,%.3f,%.6f\n", static_cast<long long>(r.fix.utime_us),
                  r.fix.source.c_str(), r.fix.position_ne_m.x(), r.fix.position_ne_m.y(),
                  std::sqrt(r.fix.covariance_m2(0, 0)), std::sqrt(r.fix.covariance_m2(1, 1)), status, r.innovation_chi2,
-                 static_cast<long long>(r.subframe_id), r.residual_ne_m.x(), r.residual_ne_m.y());
+                 static_cast<long long>(r.subframe_id), r.residual_ne_m.x(), r.residual_ne_m.y(), r.information_weight);
   }
   if (std::fclose(f) != 0) return Status::error("cannot write " + csv_path);
 

@@ -66,6 +66,9 @@ struct FixSummary {
   uint64_t rejected_gate = 0;
   uint64_t refused = 0;            // by the optimiser (non-finite, bad covariance)
   double rms_residual_m = 0.0;     // of the accepted fixes at the final estimate (horizontal)
+  // What the accepted fixes are worth in independent fixes once their errors' correlation in time
+  // is counted (optimiser.graph.gnss_fix_correlation_s): a surfacing of 1 Hz GNSS is a few.
+  double accepted_independent_equivalent = 0.0;
 };
 
 struct OfflineSummary {

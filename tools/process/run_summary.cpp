@@ -327,6 +327,7 @@ sss::core::Status writeSummaryJson(const std::string& path, const OfflineRequest
   fixes_json["rejected_gate"] = jsonValue(s.fixes.rejected_gate);
   fixes_json["refused"] = jsonValue(s.fixes.refused);
   fixes_json["rms_residual_m"] = jsonValue(s.fixes.rms_residual_m, 4);
+  fixes_json["accepted_independent_equivalent"] = jsonValue(s.fixes.accepted_independent_equivalent, 3);
   Json& coverage_json = (json["coverage"] = Json::object());  // coverage.yaml: how many lines saw each 5 m cell (SLAM poses)
   coverage_json["covered_m2"] = jsonValue(s.coverage_covered_m2, 8);
   coverage_json["seen_twice_m2"] = jsonValue(s.coverage_seen_twice_m2, 8);

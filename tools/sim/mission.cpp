@@ -143,11 +143,18 @@ std::string fixesNmea(const Mission& mission) {
   };
   const double duration_s = mission.durationS();
   if (f.gnss != "none") {
+    Eigen::Vector2d error_m = Eigen::Vector2d::Zero();
+    double previous_s = -1.0;  // time of the previous fix (-1: none yet)
     for (double t = 0.0; t <= duration_s; t += f.gnss_period_s) {
       const TrajectorySample truth = mission.trajectory().sample(t);
       if (truth.T_world_body.translation.z() > f.gnss_max_depth_m) continue;
       const Eigen::Vector2d noise(gauss(rng), gauss(rng));
-      const Eigen::Vector2d measured = truth.T_world_body.translation.head<2>() + f.gnss_sigma_m * noise;
+      // Gauss-Markov: what is left of the previous fix's error plus a fresh part, stationary sigma.
+      const double rho =
+          previous_s >= 0.0 && f.gnss_correlation_time_s > 0.0 ? std::exp(-(t - previous_s) / f.gnss_correlation_time_s) : 0.0;
+      error_m = rho * error_m + std::sqrt(1.0 - rho * rho) * f.gnss_sigma_m * noise;
+      previous_s = t;
+      const Eigen::Vector2d measured = truth.T_world_body.translation.head<2>() + error_m;
       sentences.push_back({t, sss::ins::encodePositionFix(fixAt(t, measured, f.gnss_sigma_m, 10), "GP")});
     }
   }

@@ -21,7 +21,10 @@ namespace sss::sim {
 // USBL from a ship holding station over the middle of the survey.
 struct SimFixOptions {
   std::string gnss = "none";        // none, start, start-end, lines: when the vehicle surfaces for them
-  double gnss_sigma_m = 1.5;        // per axis, white (the GST says so)
+  double gnss_sigma_m = 1.5;        // per axis (the GST says so)
+  // A receiver's error wanders over minutes (ionosphere, orbits, multipath): first-order
+  // Gauss-Markov with this correlation time, stationary sigma gnss_sigma_m. 0: white.
+  double gnss_correlation_time_s = 300.0;
   double gnss_period_s = 5.0;       // one fix every period while at the surface
   double gnss_max_depth_m = 0.5;    // the antenna is out of the water above this depth
   double usbl_period_s = 0.0;       // 0: no USBL

@@ -161,6 +161,7 @@ void readSimOptions(sss::core::ConfigSection section, SimOptions& o) {
   SimFixOptions& f = o.fixes;
   fixes.optional("gnss", f.gnss, {sss::core::oneOf({"none", "start", "start-end", "lines"})});
   fixes.optional("gnss_sigma_m", f.gnss_sigma_m, {inRange(0.01, 100.0)});
+  fixes.optional("gnss_correlation_time_s", f.gnss_correlation_time_s, {inRange(0.0, 86400.0)});
   fixes.optional("gnss_period_s", f.gnss_period_s, {inRange(0.1, 600.0)});
   fixes.optional("gnss_max_depth_m", f.gnss_max_depth_m, {inRange(0.0, 10.0)});
   fixes.optional("usbl_period_s", f.usbl_period_s, {inRange(0.0, 3600.0)});
@@ -321,6 +322,7 @@ std::string simOptionsYaml(const SimOptions& o) {
   const SimFixOptions& f = o.fixes;
   out << YAML::Key << "fixes" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "gnss" << YAML::Value << f.gnss << YAML::Key << "gnss_sigma_m" << YAML::Value << f.gnss_sigma_m
+      << YAML::Key << "gnss_correlation_time_s" << YAML::Value << f.gnss_correlation_time_s
       << YAML::Key << "gnss_period_s" << YAML::Value << f.gnss_period_s << YAML::Key << "gnss_max_depth_m" << YAML::Value
       << f.gnss_max_depth_m << YAML::Key << "usbl_period_s" << YAML::Value << f.usbl_period_s << YAML::Key
       << "usbl_sigma_fraction" << YAML::Value << f.usbl_sigma_fraction << YAML::Key << "usbl_sigma_floor_m" << YAML::Value
