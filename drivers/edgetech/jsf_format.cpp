@@ -107,6 +107,9 @@ void encodeSonarNavigation(const SonarChannelRecord& record, uint8_t* b) {
   double heading_deg = std::fmod(record.heading_rad * kRadToDeg, 360.0);
   if (heading_deg < 0.0) heading_deg += 360.0;
   writeLe<uint16_t>(b, 172, static_cast<uint16_t>(std::lround(heading_deg * 100.0) % 36000));
+  double course_deg = std::fmod(record.course_rad * kRadToDeg, 360.0);
+  if (course_deg < 0.0) course_deg += 360.0;
+  writeLe<int16_t>(b, 192, static_cast<int16_t>(std::lround(course_deg) % 360));
   writeLe<int16_t>(b, 174, clampToInt16(record.pitch_rad * kRadToDeg / kAngleScale));
   writeLe<int16_t>(b, 176, clampToInt16(record.roll_rad * kRadToDeg / kAngleScale));
 }
@@ -174,9 +177,26 @@ sss::core::Result<SonarChannelRecord> decodeSonarData(const JsfMessageHeader& he
   SonarChannelRecord r;
   r.subsystem = header.subsystem;
   r.channel = header.channel;
-  const int32_t seconds = readLe<int32_t>(body, 0);
+  int64_t seconds = readLe<int32_t>(body, 0);
   const uint32_t ms_today = readLe<uint32_t>(body, 200);
-  r.ping_time_us = static_cast<int64_t>(seconds) * 1000000 + static_cast<int64_t>(ms_today % 1000) * 1000;
+  if (seconds == 0) {
+    // Before protocol 8 bytes 0-3 held a trace sequence number (always 0) and the time was only the
+    // calendar: year, day of the year, hour, minute, second (MB-System reads such files so).
+    const int year = readLe<int16_t>(body, 156), day_of_year = readLe<int16_t>(body, 158);
+    const int hour = readLe<int16_t>(body, 160), minute = readLe<int16_t>(body, 162), second = readLe<int16_t>(body, 164);
+    if (year >= 1970 && year <= 2200 && day_of_year >= 1 && day_of_year <= 366 && hour >= 0 && hour <= 23 &&
+        minute >= 0 && minute <= 59 && second >= 0 && second <= 60) {
+      tm calendar{};
+      calendar.tm_year = year - 1900;
+      calendar.tm_mon = 0;
+      calendar.tm_mday = day_of_year;  // timegm carries days past January into the right month
+      calendar.tm_hour = hour;
+      calendar.tm_min = minute;
+      calendar.tm_sec = second;
+      seconds = static_cast<int64_t>(timegm(&calendar));
+    }
+  }
+  r.ping_time_us = seconds * 1000000 + static_cast<int64_t>(ms_today % 1000) * 1000;
   r.start_depth_samples = readLe<uint32_t>(body, 4);
   r.ping_number = readLe<uint32_t>(body, 8);
   const uint16_t msbs = readLe<uint16_t>(body, 16);
@@ -214,6 +234,9 @@ sss::core::Result<SonarChannelRecord> decodeSonarData(const JsfMessageHeader& he
   }
   r.weighting_factor = readLe<int16_t>(body, 168);
   r.heading_rad = readLe<uint16_t>(body, 172) * 0.01 * kDegToRad;
+  double course_deg = std::fmod(static_cast<double>(readLe<int16_t>(body, 192)), 360.0);  // whole degrees
+  if (course_deg < 0.0) course_deg += 360.0;
+  r.course_rad = course_deg * kDegToRad;
   r.pitch_rad = readLe<int16_t>(body, 174) * kAngleScale * kDegToRad;
   r.roll_rad = readLe<int16_t>(body, 176) * kAngleScale * kDegToRad;
 

@@ -17,10 +17,38 @@ void PingAssembler::emit(Pending&& pending, std::vector<AssembledPing>& out) {
 }
 
 void PingAssembler::add(SonarChannelRecord record, int64_t arrival_us, std::vector<AssembledPing>& out) {
-  if (record.subsystem != options_.subsystem) {
-    ++counters_.other_subsystem;
+  if (record.subsystem == options_.subsystem) {
+    if (!configured_seen_) {
+      configured_seen_ = true;
+      counters_.other_subsystem += held_other_.size();
+      held_other_.clear();
+    }
+    join(std::move(record), arrival_us, out);
     return;
   }
+  const bool side_scan = record.subsystem >= kSubsystemSideScanLow && record.subsystem <= kSubsystemSideScanLow + 2;
+  if (!configured_seen_ && side_scan && options_.adopt_other_side_scan_after > 0) {
+    if (!held_other_.empty() && held_other_.front().first.subsystem != record.subsystem) {
+      // Two other frequencies and not the configured one: nothing says which one is meant.
+      counters_.other_subsystem += held_other_.size() + 1;
+      held_other_.clear();
+      configured_seen_ = true;  // stop adopting
+      return;
+    }
+    held_other_.emplace_back(std::move(record), arrival_us);
+    if (static_cast<int>(held_other_.size()) >= options_.adopt_other_side_scan_after) {
+      options_.subsystem = held_other_.front().first.subsystem;
+      counters_.adopted_subsystem = options_.subsystem;
+      configured_seen_ = true;
+      for (auto& [held, held_arrival_us] : held_other_) join(std::move(held), held_arrival_us, out);
+      held_other_.clear();
+    }
+    return;
+  }
+  ++counters_.other_subsystem;
+}
+
+void PingAssembler::join(SonarChannelRecord record, int64_t arrival_us, std::vector<AssembledPing>& out) {
   auto it = std::find_if(pending_.begin(), pending_.end(),
                          [&](const Pending& p) { return p.ping.ping_number == record.ping_number; });
   if (it == pending_.end()) {
@@ -57,6 +85,13 @@ void PingAssembler::expire(int64_t now_us, std::vector<AssembledPing>& out) {
 }
 
 void PingAssembler::flush(std::vector<AssembledPing>& out) {
+  if (!configured_seen_ && !held_other_.empty()) {  // a short file of another frequency only
+    options_.subsystem = held_other_.front().first.subsystem;
+    counters_.adopted_subsystem = options_.subsystem;
+    configured_seen_ = true;
+    for (auto& [held, held_arrival_us] : held_other_) join(std::move(held), held_arrival_us, out);
+    held_other_.clear();
+  }
   while (!pending_.empty()) {
     Pending oldest = std::move(pending_.front());
     pending_.pop_front();

@@ -16,6 +16,11 @@ using sss::sonar::AssembledPing;  // drivers/sonar/sonar_ping.hpp
 
 struct PingAssemblerOptions {
   uint8_t subsystem = kSubsystemSideScanLow;  // the side-scan frequency to use; others are ignored
+  // A sonar recording one frequency only (a 4125 or 2205 set to its high frequency) writes
+  // subsystem 21 or 22 and never the configured 20: every ping would be ignored. When this many
+  // side-scan records (subsystems 20-22) of one other subsystem arrive before any of the configured
+  // one, that subsystem is used instead (held back meanwhile, so none is lost). 0: never.
+  int adopt_other_side_scan_after = 64;
   double missing_side_timeout_s = 1.0;        // a lone side waits this long for its partner
   int max_pending_pings = 8;                   // more incomplete pings than this: the oldest goes out
 };
@@ -25,6 +30,8 @@ struct PingAssemblerCounters {
   uint64_t incomplete_pings = 0;   // handed out with one side missing
   uint64_t duplicate_channels = 0; // a side seen twice for one ping: the later one is kept
   uint64_t other_subsystem = 0;    // messages of another subsystem, ignored
+  // The subsystem used in place of the configured one, which the data never held (-1: none).
+  int adopted_subsystem = -1;
 };
 
 class PingAssembler {
@@ -47,8 +54,12 @@ class PingAssembler {
     int64_t first_arrival_us = 0;
   };
   void emit(Pending&& pending, std::vector<AssembledPing>& out);
+  void join(SonarChannelRecord record, int64_t arrival_us, std::vector<AssembledPing>& out);
 
   PingAssemblerOptions options_;
+  bool configured_seen_ = false;
+  // Side-scan records of one other subsystem held while the configured one has not appeared.
+  std::vector<std::pair<SonarChannelRecord, int64_t>> held_other_;
   std::deque<Pending> pending_;  // in arrival order
   PingAssemblerCounters counters_;
 };

@@ -137,6 +137,7 @@ void readSonarDriverOptions(sss::core::ConfigSection& section, SonarDriverOption
   int subsystem = options.assembler.subsystem;
   section.optional("subsystem", subsystem, {inRange(0, 255)});
   options.assembler.subsystem = static_cast<uint8_t>(subsystem);
+  section.optional("adopt_other_side_scan_after", options.assembler.adopt_other_side_scan_after, {atLeast(0)});
   section.optional("missing_side_timeout_s", options.assembler.missing_side_timeout_s, {inRange(0.01, 60.0)});
   section.optional("max_pending_pings", options.assembler.max_pending_pings, {inRange(1, 1000)});
   section.optional("max_message_bytes", options.parser.max_body_bytes, {inRange(1024, 64 * 1024 * 1024)});

@@ -38,6 +38,9 @@ std::string readNodeOptions(const std::string& config_path, NodeOptions& options
   section.optional("replay_file", options.input.replay_file);
   section.optional("replay_speed", options.input.replay_speed, {inRange(0.0, 1000.0)});
   section.optional("xtf_pair_index", options.input.xtf_pair_index, {inRange(0, 7)});
+  std::string nav_units = "file";
+  section.optional("xtf_nav_units", nav_units, {oneOf({"file", "latlon", "metres"})});
+  options.input.xtf_nav_units = nav_units == "latlon" ? 3 : nav_units == "metres" ? 0 : -1;
   section.rejectUnknownKeys();
   return config.problemReport();
 }

@@ -62,6 +62,7 @@ sss::core::Status SonarInputSource::open() {
     case Kind::kXtfFile: {
       sss::xtf::XtfReaderOptions xtf_options;
       xtf_options.pair_index = options_.xtf_pair_index;
+      xtf_options.nav_units = options_.xtf_nav_units;
       xtf_reader_ = std::make_unique<sss::xtf::XtfReader>(options_.replay_file, xtf_options);
       if (!xtf_reader_->isOpen()) return sss::core::Status::error(xtf_reader_->error());
       say(hooks_.info, xtf_reader_->summary());

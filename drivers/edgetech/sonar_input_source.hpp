@@ -27,6 +27,7 @@ struct SonarInputOptions {
   std::string replay_file;    // non-empty: read this .jsf or .xtf file instead of TCP
   double replay_speed = 1.0;  // 0: as fast as possible
   int xtf_pair_index = 0;     // XTF with several side-scan pairs: 0 = lowest frequency
+  int xtf_nav_units = -1;     // XTF NavUnits forced (0 metres, 3 lat/lon); -1: as the file says
   // A replay decodes this many pings ahead of its pace and hands over at most replay_pings_per_step
   // per step(), so that the process stays responsive to signals and its status.
   size_t replay_read_ahead_pings = 64;

@@ -55,6 +55,7 @@ struct SonarChannelRecord {
   double depth_m = 0.0;
   double altitude_m = 0.0;
   double heading_rad = 0.0;        // [0, 2 pi)
+  double course_rad = 0.0;         // course over ground [0, 2 pi), with kValidCourse (JSF)
   double pitch_rad = 0.0;          // bow up positive
   double roll_rad = 0.0;           // port up positive
   std::vector<float> samples;      // envelope magnitude (JSF: 2^-N applied; I/Q: sqrt(I^2 + Q^2))

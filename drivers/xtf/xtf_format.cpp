@@ -384,8 +384,11 @@ SonarDecodeResult decodeSonarPacket(const XtfFileInfo& info, const SonarDecodeOp
     common.roll_rad = roll_deg * kDegToRad;
     common.validity |= sss::sonar::kValidPitchRoll;
   }
+  // XTF has no validity flags: a towfish without a compass writes 0 in every ping. Exactly 0 is
+  // taken as no heading (the course over ground stands in, offline_inputs.hpp); a compass reading
+  // north to the last bit loses only the crab angle by it.
   const float heading_deg = readF32(p, offset::kSensorHeading);
-  if (std::isfinite(heading_deg) && std::fabs(heading_deg) <= 720.0f) {
+  if (std::isfinite(heading_deg) && std::fabs(heading_deg) <= 720.0f && heading_deg != 0.0f) {
     double wrapped = std::fmod(static_cast<double>(heading_deg), 360.0);
     if (wrapped < 0.0) wrapped += 360.0;
     common.heading_rad = wrapped * kDegToRad;
@@ -440,11 +443,17 @@ SonarDecodeResult decodeSonarPacket(const XtfFileInfo& info, const SonarDecodeOp
       record.channel = is_port ? sss::sonar::kChannelPort : sss::sonar::kChannelStarboard;
       record.start_frequency_hz = record.end_frequency_hz = frequencyHz(channel.frequency);
       // Sample spacing from the recorded slant range (range = i x SlantRange / NumSamples), or
-      // else from the two-way TimeDuration; stored as two-way time so slantRangeM() agrees.
+      // else from the two-way TimeDuration; stored as two-way time so slantRangeM() agrees. When
+      // the data starts after a TimeDelay, SlantRange is the far range while the samples span only
+      // TimeDuration ("time from the start of the data to its end"): the spacing is that over N.
       const float slant_range_m = readF32(header, offset::kSlantRange);
       const float duration_s = readF32(header, offset::kTimeDuration);
+      const float delay_s = readF32(header, offset::kTimeDelay);
+      const bool delayed = std::isfinite(delay_s) && delay_s > 0.0f;
       if (num_samples > 0) {
-        if (std::isfinite(slant_range_m) && slant_range_m > 0.0f) {
+        if (delayed && std::isfinite(duration_s) && duration_s > 0.0f) {
+          record.sample_interval_s = static_cast<double>(duration_s) / static_cast<double>(num_samples);
+        } else if (std::isfinite(slant_range_m) && slant_range_m > 0.0f) {
           record.sample_interval_s = 2.0 * slant_range_m / (static_cast<double>(record.sound_speed_m_s) * num_samples);
         } else if (std::isfinite(duration_s) && duration_s > 0.0f) {
           record.sample_interval_s = static_cast<double>(duration_s) / static_cast<double>(num_samples);
@@ -454,8 +463,7 @@ SonarDecodeResult decodeSonarPacket(const XtfFileInfo& info, const SonarDecodeOp
           return result;
         }
       }
-      const float delay_s = readF32(header, offset::kTimeDelay);
-      if (record.sample_interval_s > 0.0 && std::isfinite(delay_s) && delay_s > 0.0f) {
+      if (record.sample_interval_s > 0.0 && delayed) {
         const double start = static_cast<double>(delay_s) / record.sample_interval_s;
         record.start_depth_samples = static_cast<uint32_t>(std::min(std::round(start), 1e9));
       }

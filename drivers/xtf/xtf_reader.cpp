@@ -78,6 +78,7 @@ void XtfReader::openWith() {
     return;
   }
   info_ = std::move(*header);
+  if (options_.nav_units >= 0) info_.nav_units = static_cast<uint16_t>(options_.nav_units);
   const std::vector<ChannelPair> pairs = sideScanPairs(info_);
   if (pairs.empty()) {
     error_ = "XTF '" + source_name_ + "': no side-scan channel among its " + std::to_string(info_.channels.size()) +

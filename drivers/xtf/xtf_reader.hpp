@@ -27,6 +27,9 @@ struct XtfReaderOptions {
   // side-scan writers commonly leave the flag 0 while storing unsigned intensities (pyxtf
   // always reads unsigned).
   bool polar_as_signed = false;
+  // The file header's NavUnits, unless set here: kNavUnitsMetres (0) or kNavUnitsLatLon (3), for a
+  // file whose header says one and whose pings hold the other (-1: as the file says).
+  int nav_units = -1;
   size_t read_chunk_bytes = 256 * 1024;
 };
 

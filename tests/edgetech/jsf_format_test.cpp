@@ -87,6 +87,25 @@ TEST(JsfFormat, DecodeGivesBackTheRecordWithinTheWireResolution) {
   EXPECT_NEAR(r.slantRangeM(100), 100 * 20e-6 * 750.0, 1e-9);
 }
 
+// Before protocol 8, bytes 0-3 of a sonar data message held a trace sequence number (always 0),
+// and the ping time was the calendar at 156-164 (year, day of the year, hour, minute, second) plus
+// the milliseconds of byte 200. Such a record gets the same time as with the epoch seconds; the
+// course over ground (whole degrees, signed, byte 192) comes back too.
+TEST(JsfFormat, RecordsBeforeProtocolEightTakeTheCalendarTime) {
+  SonarChannelRecord sent = test::makeRecord(12, kChannelPort);
+  sent.ping_time_us = 1780387199987000LL;  // 2026-06-01T23:59:59.987Z: day 152
+  sent.course_rad = 271.0 * M_PI / 180.0;
+  std::vector<uint8_t> bytes = test::encodeRecord(sent, 10);
+  const int32_t trace_sequence = 0;
+  std::memcpy(bytes.data() + 16, &trace_sequence, 4);
+  const auto header = decodeHeader(bytes.data());
+  ASSERT_TRUE(header);
+  const sss::core::Result<SonarChannelRecord> result = decodeSonarData(*header, bytes.data() + 16, bytes.size() - 16);
+  ASSERT_OK(result);
+  EXPECT_EQ(result->ping_time_us, sent.ping_time_us);
+  EXPECT_NEAR(result->course_rad, sent.course_rad, 1e-12);
+}
+
 // Coordinate units 1 (mm), 3 (dm) and 4 (cm) at byte 88: projected X (east) / Y (north), kept in
 // metres with no latitude/longitude; unknown units give no position.
 TEST(JsfFormat, ProjectedCoordinateUnitsGiveEastingAndNorthing) {

@@ -57,12 +57,69 @@ TEST(PingAssembler, OtherSubsystemsAreIgnoredAndDuplicatesCounted) {
   high.subsystem = kSubsystemSideScanHigh;
   assembler.add(high, 0, out);
   EXPECT_EQ(assembler.pending(), 0u);
-  EXPECT_EQ(assembler.counters().other_subsystem, 1u);
   assembler.add(test::makeRecord(2, kChannelPort), 0, out);
+  EXPECT_EQ(assembler.counters().other_subsystem, 1u) << "the configured subsystem is there: the other is ignored";
   assembler.add(test::makeRecord(2, kChannelPort), 1, out);
   EXPECT_EQ(assembler.counters().duplicate_channels, 1u);
   assembler.flush(out);
   EXPECT_EQ(out.size(), 1u);
+  EXPECT_EQ(assembler.counters().adopted_subsystem, -1);
+}
+
+// A sonar recording its high frequency only (subsystem 21) with the default subsystem 20
+// configured: after 64 such records and none of 20, subsystem 21 is used, the records held
+// meanwhile included; a short file of it is taken at its end. Two other frequencies and not the
+// configured one: nothing says which is meant, so none is taken.
+TEST(PingAssembler, AFileOfAnotherSideScanFrequencyOnlyIsTakenWhole) {
+  auto records = [](uint8_t subsystem, uint32_t pings, std::vector<SonarChannelRecord>& into) {
+    for (uint32_t p = 0; p < pings; ++p) {
+      for (uint8_t channel : {kChannelPort, kChannelStarboard}) {
+        SonarChannelRecord r = test::makeRecord(p, channel);
+        r.subsystem = subsystem;
+        into.push_back(r);
+      }
+    }
+  };
+  for (const uint32_t pings : {50u, 5u}) {
+    std::vector<SonarChannelRecord> high;
+    records(kSubsystemSideScanHigh, pings, high);
+    PingAssembler assembler;
+    std::vector<AssembledPing> out;
+    for (const auto& r : high) assembler.add(r, 0, out);
+    assembler.flush(out);
+    ASSERT_EQ(out.size(), pings);
+    for (uint32_t p = 0; p < pings; ++p) {
+      EXPECT_TRUE(out[p].complete());
+      EXPECT_EQ(out[p].ping_number, p);
+      EXPECT_EQ(out[p].port->subsystem, kSubsystemSideScanHigh);
+    }
+    EXPECT_EQ(assembler.counters().adopted_subsystem, kSubsystemSideScanHigh);
+    EXPECT_EQ(assembler.counters().other_subsystem, 0u);
+  }
+  {
+    std::vector<SonarChannelRecord> two;
+    records(kSubsystemSideScanHigh, 1, two);
+    records(kSubsystemSideScanHigh + 1, 40, two);
+    PingAssembler assembler;
+    std::vector<AssembledPing> out;
+    for (const auto& r : two) assembler.add(r, 0, out);
+    assembler.flush(out);
+    EXPECT_TRUE(out.empty());
+    EXPECT_EQ(assembler.counters().adopted_subsystem, -1);
+    EXPECT_EQ(assembler.counters().other_subsystem, two.size());
+  }
+  {
+    PingAssemblerOptions never;
+    never.adopt_other_side_scan_after = 0;
+    PingAssembler assembler(never);
+    std::vector<SonarChannelRecord> high;
+    records(kSubsystemSideScanHigh, 50, high);
+    std::vector<AssembledPing> out;
+    for (const auto& r : high) assembler.add(r, 0, out);
+    assembler.flush(out);
+    EXPECT_TRUE(out.empty());
+    EXPECT_EQ(assembler.counters().other_subsystem, high.size());
+  }
 }
 
 }  // namespace

@@ -6,6 +6,112 @@
 
 namespace {
 
+// A recorder that stamps every ping with its newest GPS fix: a 1 Hz GPS under a 4 Hz sonar repeats
+// each position for four pings, then jumps 2 m (the real Iver2 XTF repeats its fixes for 2-6 pings).
+// The repeats are no new fixes: they are placed between the fixes in time, so the track advances
+// every ping, on the straight line flown, instead of a staircase of 2 m steps.
+TEST_F(OfflineRunnerTest, PositionsRepeatedUntilTheNextGpsFixArePlacedBetweenTheFixes) {
+  const sss::xtf::XtfWriterOptions options = sss::test::makeXtfOptions({100.0f}, 2, sss::xtf::kNavUnitsMetres);
+  const std::string path = root_ + "/gps_1hz.xtf";
+  const double heading_rad = 30.0 * M_PI / 180.0, speed_m_s = 2.0, altitude_m = 15.0, spacing_m = 0.03;
+  {
+    sss::xtf::XtfWriter writer(path, options);
+    ASSERT_TRUE(writer.isOpen());
+    std::mt19937 random(5);
+    for (int i = 0; i < 400; ++i) {  // 100 s at 4 Hz
+      const double fix_s = std::floor(0.25 * i);  // the newest whole-second fix
+      sss::xtf::XtfPingInput ping;
+      ping.ping_number = static_cast<uint32_t>(i);
+      ping.ping_time_us = 1780300800000000LL + i * 250000LL;
+      ping.sound_velocity = 750.0f;
+      ping.sensor_x = 650123.0 + speed_m_s * fix_s * std::sin(heading_rad);   // easting
+      ping.sensor_y = 6580456.0 + speed_m_s * fix_s * std::cos(heading_rad);  // northing
+      ping.depth_m = 30.0f;
+      ping.heading_deg = 30.0f;
+      ping.altitude_m = static_cast<float>(altitude_m);
+      addSeabedChannels(ping, 2500, spacing_m, altitude_m, random);
+      ASSERT_TRUE(writer.write(ping));
+    }
+  }
+  const std::string out_dir = root_ + "/run_gps_1hz";
+  const auto result = runSonarFileOnly(path, out_dir);
+  ASSERT_TRUE(result.ok) << result.error;
+  const auto& s = result.summary;
+  EXPECT_EQ(s.pings, 400u);
+  EXPECT_EQ(s.nav_positions_interpolated, 99u * 3u) << "three repeats a second between the first and the last fix";
+  EXPECT_NE(readFile(out_dir + "/summary.json").find("\"positions_interpolated\": 297"), std::string::npos);
+  const auto dr = sss::eval::readTum(out_dir + "/dead_reckoning.tum");
+  ASSERT_TRUE(dr.ok) << dr.error;
+  ASSERT_GT(dr.poses.size(), 300u);
+  double worst_m = 0.0;
+  size_t checked = 0;
+  for (const auto& pose : dr.poses) {
+    const double t_s = 1e-6 * static_cast<double>(pose.utime_us - 1780300800000000LL);
+    if (t_s > 99.0) continue;  // after the last fix the position is held (nothing follows it)
+    const Eigen::Vector2d truth = speed_m_s * t_s * Eigen::Vector2d(std::cos(heading_rad), std::sin(heading_rad));
+    worst_m = std::max(worst_m, (pose.T_world_body.translation.head<2>() - truth).norm());
+    ++checked;
+  }
+  std::printf("1 Hz GPS under 4 Hz pings: %zu poses, worst %.3f m off the line flown\n", checked, worst_m);
+  EXPECT_GT(checked, 300u);
+  EXPECT_LT(worst_m, 0.01) << "held positions were up to 1.5 m behind the vehicle";
+}
+
+// An XTF whose header says projected metres (NavUnits 0) while its pings hold latitude and
+// longitude: read as metres, a 300 m line moves 3 mm. The run says what the positions look like and
+// names the key; with sonar_driver.xtf_nav_units: latlon the file is read in degrees.
+TEST_F(OfflineRunnerTest, DegreesInAFileDeclaredMetresAreNamedAndReadWithTheOverride) {
+  const sss::xtf::XtfWriterOptions options = sss::test::makeXtfOptions({100.0f}, 2, sss::xtf::kNavUnitsMetres);
+  const std::string path = root_ + "/degrees_as_metres.xtf";
+  const sss::core::LocalTangentPlane plane(57.7, 11.9);
+  const double heading_rad = 30.0 * M_PI / 180.0;
+  {
+    sss::xtf::XtfWriter writer(path, options);
+    ASSERT_TRUE(writer.isOpen());
+    std::mt19937 random(4);
+    for (int i = 0; i < 600; ++i) {  // 150 s at 4 Hz, 2 m/s
+      const auto geo = plane.toGeodetic(0.5 * i * Eigen::Vector3d(std::cos(heading_rad), std::sin(heading_rad), 0.0));
+      sss::xtf::XtfPingInput ping;
+      ping.ping_number = static_cast<uint32_t>(i);
+      ping.ping_time_us = 1780300800000000LL + i * 250000LL;
+      ping.sound_velocity = 750.0f;
+      ping.sensor_y = geo.latitude_deg;
+      ping.sensor_x = geo.longitude_deg;
+      ping.depth_m = 30.0f;
+      ping.altitude_m = 15.0f;
+      ping.heading_deg = 30.0f;
+      addSeabedChannels(ping, 2500, 0.03, 15.0, random);
+      ASSERT_TRUE(writer.write(ping));
+    }
+  }
+  const auto as_declared = runSonarFileOnly(path, root_ + "/run_degrees_as_metres");
+  ASSERT_TRUE(as_declared.ok) << as_declared.error;
+  EXPECT_LT(as_declared.summary.projected_track_m, 0.01);
+  EXPECT_NE(std::find_if(as_declared.summary.findings.begin(), as_declared.summary.findings.end(),
+                         [](const std::string& f) { return f.find("xtf_nav_units: latlon") != std::string::npos; }),
+            as_declared.summary.findings.end());
+
+  const std::string config = root_ + "/nav_units_latlon.yaml";
+  std::ofstream(config) << "sonar_driver:\n  xtf_nav_units: latlon\n";
+  sss::offline::OfflineRequest forced;
+  forced.sonar_path = path;
+  forced.config_path = config;
+  forced.out_dir = root_ + "/run_degrees_forced";
+  forced.write_mosaics = false;
+  const auto result = sss::offline::runOffline(forced);
+  ASSERT_TRUE(result.ok) << result.error;
+  ASSERT_TRUE(result.summary.origin);
+  EXPECT_NEAR(result.summary.origin->latitude_deg, 57.7, 1e-6);
+  EXPECT_EQ(result.summary.projected_track_m, -1.0);
+  const auto dr = sss::eval::readTum(forced.out_dir + "/dead_reckoning.tum");
+  ASSERT_TRUE(dr.ok) << dr.error;
+  const Eigen::Vector3d last = dr.poses.back().T_world_body.translation;
+  const double along_m = 0.5 * 599;
+  EXPECT_NEAR(last.x(), along_m * std::cos(heading_rad), 0.5);
+  EXPECT_NEAR(last.y(), along_m * std::sin(heading_rad), 0.5);
+  for (const std::string& f : result.summary.findings) EXPECT_EQ(f.find("xtf_nav_units"), std::string::npos) << f;
+}
+
 // An XTF with its navigation in projected metres (NavUnits 0, as Isis writes it) and no altitude
 // (a towed fish), with attitude packets between the pings, built from the public layout: it is
 // processed in the file's own grid (north = northing - N0 of the first fix), says so, and tracks
@@ -317,6 +423,123 @@ TEST_F(OfflineRunnerTest, JsfSituationOrNmeaMessagesPositionPingsWithoutPosition
     EXPECT_NEAR(last.z(), 30.0, 0.1) << "the depth of the situation messages";
   }
  }
+}
+
+// A towfish without a compass: its JSF ping headers carry the position (1 Hz GPS, repeated in
+// between) but the heading validity bit is clear and the heading field 0. Taken as recorded, every
+// image would be turned to north while the fish runs at 60 deg. With the recorded course over
+// ground (validity bit 1) that stands in; without it, the track's own direction does. Either way
+// the run says so.
+TEST_F(OfflineRunnerTest, JsfWithoutAValidHeadingTakesTheCourseOverGround) {
+  for (const bool course_recorded : {true, false}) {
+    SCOPED_TRACE(course_recorded ? "course recorded" : "course from the track");
+    const std::string path = root_ + (course_recorded ? "/no_heading_course.jsf" : "/no_heading.jsf");
+    const sss::core::LocalTangentPlane plane(43.1, 5.9);
+    const double course_rad = 60.0 * M_PI / 180.0;
+    {
+      std::ofstream out(path, std::ios::binary);
+      std::mt19937 random(9);
+      std::exponential_distribution<double> speckle(1.0);
+      uint8_t sequence = 0;
+      for (int i = 0; i < 600; ++i) {  // 150 s at 4 Hz, 1.5 m/s
+        const double fix_s = std::floor(0.25 * i);
+        const auto geo = plane.toGeodetic(1.5 * fix_s * Eigen::Vector3d(std::cos(course_rad), std::sin(course_rad), 0.0));
+        for (uint8_t channel : {sss::sonar::kChannelPort, sss::sonar::kChannelStarboard}) {
+          sss::sonar::SonarChannelRecord record;
+          record.channel = channel;
+          record.ping_time_us = 1780300800000000LL + i * 250000LL;
+          record.ping_number = static_cast<uint32_t>(i);
+          record.sample_interval_s = 4e-5;  // 3 cm
+          record.validity = sss::sonar::kValidLatLon | sss::sonar::kValidAltitude | sss::sonar::kValidDepth |
+                            sss::sonar::kValidSoundSpeed | (course_recorded ? sss::sonar::kValidCourse : 0);
+          record.latitude_deg = geo.latitude_deg;
+          record.longitude_deg = geo.longitude_deg;
+          record.depth_m = 20.0;
+          record.altitude_m = 12.0;
+          record.heading_rad = 0.0;  // no compass: the field is left 0
+          record.course_rad = course_rad;
+          std::vector<float> magnitudes;
+          for (int k = 0; k < 2500; ++k) {
+            const double r = k * 0.03;
+            magnitudes.push_back(static_cast<float>((r < 12.0 ? 2.0 : 400.0 * 12.0 / r) * speckle(random)));
+          }
+          int16_t weighting = 0;
+          const auto codes = sss::edgetech::quantiseEnvelope(magnitudes, weighting);
+          record.weighting_factor = weighting;
+          const auto bytes = sss::edgetech::encodeSonarData(record, codes, sequence++);
+          out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+        }
+      }
+    }
+    const std::string out_dir = root_ + (course_recorded ? "/run_no_heading_course" : "/run_no_heading");
+    const auto result = runSonarFileOnly(path, out_dir);
+    ASSERT_TRUE(result.ok) << result.error;
+    const auto& s = result.summary;
+    EXPECT_GE(s.pings_with_pose, 570u);
+    if (course_recorded) {
+      EXPECT_EQ(s.nav_headings_from_course, 600u);
+      EXPECT_EQ(s.nav_headings_from_track, 0u);
+    } else {
+      EXPECT_EQ(s.nav_headings_from_course, 0u);
+      EXPECT_EQ(s.nav_headings_from_track, 600u) << "the first 10 m wait for the track's direction";
+    }
+    EXPECT_EQ(s.nav_headings_unknown, 0u);
+    EXPECT_NE(std::find_if(s.findings.begin(), s.findings.end(),
+                           [](const std::string& f) { return f.find("no valid heading") != std::string::npos; }),
+              s.findings.end());
+    const auto dr = sss::eval::readTum(out_dir + "/dead_reckoning.tum");
+    ASSERT_TRUE(dr.ok) << dr.error;
+    ASSERT_GT(dr.poses.size(), 500u);
+    double worst_deg = 0.0;
+    for (const auto& pose : dr.poses) {
+      const Eigen::Matrix3d r = pose.T_world_body.rotation.toRotationMatrix();
+      const double heading_rad = std::atan2(r(1, 0), r(0, 0));
+      worst_deg = std::max(worst_deg, std::abs(std::remainder(heading_rad - course_rad, 2.0 * M_PI)) * 180.0 / M_PI);
+    }
+    std::printf("no compass, %s: heading worst %.2f deg off the 60 deg run\n",
+                course_recorded ? "course recorded" : "course from the track", worst_deg);
+    // The recorded course: 60 in whole degrees. The track's: a JSF position is quantised to 1e-4 arc
+    // minute (0.19 m north, 0.14 m east here), which turns a 10 m base by up to ~0.9 deg.
+    EXPECT_LT(worst_deg, course_recorded ? 0.01 : 1.0);
+  }
+}
+
+// The same fish in an XTF, which has no validity flags: its SensorHeading is 0 in every ping.
+// Exactly 0 is taken as no heading, and the track's direction stands in.
+TEST_F(OfflineRunnerTest, XtfWithHeadingZeroInEveryPingTakesTheTracksDirection) {
+  const sss::xtf::XtfWriterOptions options = sss::test::makeXtfOptions({100.0f}, 2, sss::xtf::kNavUnitsMetres);
+  const std::string path = root_ + "/no_compass.xtf";
+  const double course_rad = 60.0 * M_PI / 180.0;
+  {
+    sss::xtf::XtfWriter writer(path, options);
+    ASSERT_TRUE(writer.isOpen());
+    std::mt19937 random(6);
+    for (int i = 0; i < 400; ++i) {  // 100 s at 4 Hz, 1.5 m/s
+      sss::xtf::XtfPingInput ping;
+      ping.ping_number = static_cast<uint32_t>(i);
+      ping.ping_time_us = 1780300800000000LL + i * 250000LL;
+      ping.sound_velocity = 750.0f;
+      ping.sensor_x = 650123.0 + 1.5 * 0.25 * i * std::sin(course_rad);
+      ping.sensor_y = 6580456.0 + 1.5 * 0.25 * i * std::cos(course_rad);
+      ping.depth_m = 20.0f;
+      ping.altitude_m = 12.0f;
+      ping.heading_deg = 0.0f;
+      addSeabedChannels(ping, 2500, 0.03, 12.0, random);
+      ASSERT_TRUE(writer.write(ping));
+    }
+  }
+  const auto result = runSonarFileOnly(path, root_ + "/run_no_compass_xtf");
+  ASSERT_TRUE(result.ok) << result.error;
+  EXPECT_EQ(result.summary.nav_headings_from_track, 400u);
+  const auto dr = sss::eval::readTum(root_ + "/run_no_compass_xtf/dead_reckoning.tum");
+  ASSERT_TRUE(dr.ok) << dr.error;
+  double worst_deg = 0.0;
+  for (const auto& pose : dr.poses) {
+    const Eigen::Matrix3d r = pose.T_world_body.rotation.toRotationMatrix();
+    worst_deg = std::max(worst_deg, std::abs(std::remainder(std::atan2(r(1, 0), r(0, 0)) - course_rad, 2.0 * M_PI)) *
+                                        180.0 / M_PI);
+  }
+  EXPECT_LT(worst_deg, 0.01);
 }
 
 // The towed record of the real-file issue, rebuilt: an XTF in latitude/longitude with altitude and

@@ -147,6 +147,21 @@ TEST(RealFile, SssProcessWithoutConfigGivesATrajectoryInTheFilesBoxAndAMosaicOfT
     ASSERT_GE(geodetic.longitude_deg, facts.longitude_min - margin_deg);
     ASSERT_LE(geodetic.longitude_deg, facts.longitude_max + margin_deg);
   }
+  // The recorder stamps each ping with its newest fix (220 positions over 461 pings, repeated for
+  // 2-6 pings): the repeats are placed between the fixes in time, so the track advances at every
+  // ping instead of standing still and jumping a few decimetres.
+  EXPECT_GT(s.nav_positions_interpolated, 200u);
+  const auto dr = sss::eval::readTum(request.out_dir + "/dead_reckoning.tum");
+  ASSERT_TRUE(dr.ok) << dr.error;
+  std::vector<double> steps_m;
+  for (size_t i = 1; i < dr.poses.size(); ++i)
+    steps_m.push_back((dr.poses[i].T_world_body.translation - dr.poses[i - 1].T_world_body.translation).head<2>().norm());
+  ASSERT_GT(steps_m.size(), 400u);
+  const double step_median_m = percentile(steps_m, 0.5);
+  std::printf("real file DR: step between pings p2 %.3f m, median %.3f m, p98 %.3f m\n", percentile(steps_m, 0.02),
+              step_median_m, percentile(steps_m, 0.98));
+  EXPECT_GT(percentile(steps_m, 0.02), 0.3 * step_median_m) << "no ping stands still";
+  EXPECT_LT(percentile(steps_m, 0.98), 3.0 * step_median_m) << "no jump of several pings' travel";
   const std::string mosaic_yaml = readFile(request.out_dir + "/mosaic_dr.yaml");
   EXPECT_NE(mosaic_yaml.find("origin_latitude_deg"), std::string::npos) << mosaic_yaml;
 

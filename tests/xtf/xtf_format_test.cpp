@@ -138,13 +138,14 @@ TEST(XtfFormat, CalendarToUtc) {
   EXPECT_FALSE(xtf::utcFromCalendar(0, 1, 1, 0, 0, 0, 0));
 }
 
-xtf::SonarDecodeResult decodeOne(float sound_velocity, float slant_range_m, float duration_s) {
+xtf::SonarDecodeResult decodeOne(float sound_velocity, float slant_range_m, float duration_s, float delay_s = 0.0f) {
   const xtf::XtfWriterOptions options = test::makeXtfOptions({100.0f}, 2);
   xtf::XtfPingInput input = test::makeXtfPing(options, 1, 100);
   input.sound_velocity = sound_velocity;
   for (auto& channel : input.channels) {
     channel.slant_range_m = slant_range_m;
     channel.time_duration_s = duration_s;
+    channel.time_delay_s = delay_s;
   }
   const std::vector<uint8_t> header = xtf::encodeFileHeader(options);
   const std::vector<uint8_t> packet = xtf::encodeSonarPacket(options, input);
@@ -182,6 +183,21 @@ TEST(XtfFormat, RangeFromTimeDurationWithoutSlantRange) {
   const xtf::SonarDecodeResult none = decodeOne(750.0f, 0.0f, -1.0f);
   EXPECT_FALSE(none.ping);
   EXPECT_NE(none.error.find("slant range"), std::string::npos);
+}
+
+// A record that starts after a delay (the water column left out): SlantRange is the far range,
+// TimeDelay the two-way time to the first sample, TimeDuration the time the samples span. 15 m to
+// 80 m over 100 samples: spaced by TimeDuration / 100, the first at the delay (to the nearest
+// sample: start_depth_samples is whole), the last at 80 m, not at 80 m plus the delay.
+TEST(XtfFormat, DelayedRecordSpansTimeDurationFromTheDelay) {
+  const float delay_s = 2.0f * 15.0f / 1500.0f, duration_s = 2.0f * 65.0f / 1500.0f;
+  const xtf::SonarDecodeResult result = decodeOne(750.0f, 80.0f, duration_s, delay_s);
+  ASSERT_TRUE(result.ping) << result.error;
+  const sonar::SonarChannelRecord& port = *result.ping->ping.port;
+  const double spacing_m = 0.65;
+  EXPECT_NEAR(port.sample_interval_s, duration_s / 100.0, 1e-9);
+  EXPECT_NEAR(port.slantRangeM(0), 15.0, 0.5 * spacing_m);
+  EXPECT_NEAR(port.slantRangeM(100), 80.0, 0.5 * spacing_m);
 }
 
 }  // namespace

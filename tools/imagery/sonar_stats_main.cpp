@@ -99,8 +99,9 @@ int main(int argc, char** argv) {
   command_line.add_option("--sonar", sonar_path, "FILE.jsf or FILE.xtf")->required();
   command_line.add_option("--json", json_path, "write the statistics as JSON");
   command_line.add_option("--waterfall", waterfall_path, "write the raw slant-range waterfall (PNG)");
-  command_line.add_option("--subsystem", subsystem, "JSF side-scan subsystem")->check(CLI::Range(0, 255))
-      ->capture_default_str();
+  CLI::Option* subsystem_option = command_line.add_option("--subsystem", subsystem, "JSF side-scan subsystem")
+                                      ->check(CLI::Range(0, 255))
+                                      ->capture_default_str();
   command_line.add_option("--pair", pair, "XTF channel pair")->check(sss::cli::nonNegative())->capture_default_str();
   command_line.add_option("--max-pings", max_pings, "read at most this many pings (0: all)")
       ->check(sss::cli::nonNegative());
@@ -139,6 +140,9 @@ int main(int argc, char** argv) {
     }
     sss::edgetech::SonarDriverOptions options;
     options.assembler.subsystem = static_cast<uint8_t>(subsystem);
+    // Asked for by name: that subsystem or nothing. Left at the default: a file of another
+    // side-scan frequency only is read as it is (PingAssemblerOptions::adopt_other_side_scan_after).
+    if (subsystem_option->count() > 0) options.assembler.adopt_other_side_scan_after = 0;
     options.time_source = sss::edgetech::TimeSource::kSonarClock;
     sss::edgetech::SonarDriver driver(options);
     std::vector<char> chunk(1 << 20);

@@ -12,6 +12,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "drivers/edgetech/ping_message.hpp"
@@ -96,6 +97,7 @@ class JsfSource : public PingSource {
     const auto& c = driver_.parserCounters();
     return c.bad_headers + c.truncated_messages + driver_.sonarDecodeErrors();
   }
+  const sss::edgetech::PingAssemblerCounters& assemblerCounters() const { return driver_.assemblerCounters(); }
 
  private:
   std::ifstream file_;
@@ -173,15 +175,29 @@ class InsFileSource {
 
 // Navigation from a sonar ping's header (JSF type 80 and XTF carry position, attitude, altitude).
 // With no origin configured, the first ping with a position is the origin.
+//
+// Many recorders stamp every ping with the newest GPS or INS position they hold, so a 1 Hz GPS
+// under a 10-30 Hz sonar repeats one position for 10-30 pings and then jumps: a staircase track
+// whose steps are pixels of the image (the real Iver2 XTF repeats each position for 2-6 pings).
+// A position that repeats the previous one exactly is no new fix: those samples are held back until
+// the next new position and their horizontal position is interpolated in time between the two
+// (attitude, depth and altitude stay each ping's own). A vehicle that really holds still repeats
+// for longer than max_hold: those go out as recorded. The samples come out of takeReady() in time
+// order; a held ping waits for its navigation in the ping-navigation fusion like any late nav.
 class EmbeddedNavigation {
  public:
+  static constexpr int64_t kMaxHoldUs = 10'000'000;  // a GPS at 0.1 Hz still interpolates
+  static constexpr size_t kMaxHeldSamples = 128;      // within the fusion's 256 waiting pings
+
   explicit EmbeddedNavigation(const std::optional<sss::core::MissionOrigin>& origin) {
     if (origin) setOrigin(*origin);
   }
   const std::optional<sss::core::MissionOrigin>& origin() const { return origin_; }
   // Set once a ping with projected metres (XTF NavUnits 0) founded the frame: its easting, northing.
   const std::optional<Eigen::Vector2d>& projectedOrigin() const { return projected_origin_; }
-  std::optional<NavInput> fromPing(const sss::sonar::DriverPing& driver_ping) {
+  // True when the ping's header carries a position (its sample then comes out of takeReady, now or
+  // once the next new position arrives).
+  bool fromPing(const sss::sonar::DriverPing& driver_ping) {
     const auto& side = driver_ping.ping.port ? *driver_ping.ping.port : *driver_ping.ping.starboard;
     // The header fields a navigation packet borrows (not the samples: this runs for every ping).
     last_side_.validity = side.validity;
@@ -194,14 +210,15 @@ class EmbeddedNavigation {
   }
   // A navigation packet of an XTF whose pings carry no position (types 42 and 107 give one, 3
   // and 107 attitude): each position goes with the newest packet attitude (else the last ping's),
-  // and the last ping's depth and altitude. Coordinates are in the file's NavUnits.
-  std::optional<NavInput> fromPacket(const FileNavigation& record, bool projected_units) {
+  // and the last ping's depth and altitude. Coordinates are in the file's NavUnits. True when the
+  // packet gave a position.
+  bool fromPacket(const FileNavigation& record, bool projected_units) {
     if (record.pitch_rad) packet_pitch_rad_ = record.pitch_rad;
     if (record.roll_rad) packet_roll_rad_ = record.roll_rad;
     if (record.heading_rad) packet_heading_rad_ = record.heading_rad;
     if (record.depth_m) packet_depth_m_ = record.depth_m;
     if (record.altitude_m) packet_altitude_m_ = record.altitude_m;
-    if (!record.y || !record.x) return std::nullopt;
+    if (!record.y || !record.x) return false;
     sss::sonar::SonarChannelRecord side = last_side_;
     side.pitch_rad = packet_pitch_rad_.value_or(side.pitch_rad);
     side.roll_rad = packet_roll_rad_.value_or(side.roll_rad);
@@ -217,22 +234,41 @@ class EmbeddedNavigation {
       side.northing_m = *record.y;
       side.easting_m = *record.x;
     } else {
-      if (std::abs(*record.y) > 90.0 || std::abs(*record.x) > 180.0) return std::nullopt;
+      if (std::abs(*record.y) > 90.0 || std::abs(*record.x) > 180.0) return false;
       side.latitude_deg = *record.y;
       side.longitude_deg = *record.x;
       side.validity |= sss::sonar::kValidLatLon;
     }
     return fromSide(record.utime_us, side);
   }
+  // The samples complete so far, in time order.
+  std::vector<NavInput> takeReady() { return std::exchange(ready_, {}); }
+  // End of input: the samples still held keep the last position (nothing comes after it).
+  std::vector<NavInput> finish() {
+    flushHeld();
+    releaseAwaitingCourse();
+    return takeReady();
+  }
+  // Horizontal distance along the samples handed out (their own positions, in the frame's units).
+  double distanceM() const { return distance_m_; }
+  // Samples whose repeated position was interpolated between two new positions.
+  uint64_t positionsInterpolated() const { return positions_interpolated_; }
+  // Headers without a valid heading: given the recorded course over ground, the track's direction
+  // over kCourseBaseM, or (the vehicle never moved that far) left as recorded.
+  uint64_t headingsFromCourse() const { return headings_from_course_; }
+  uint64_t headingsFromTrack() const { return headings_from_track_; }
+  uint64_t headingsUnknown() const { return headings_unknown_; }
+  // Long enough that a JSF position's quantisation (1e-4 arc minute: 0.19 m) turns it by under a degree.
+  static constexpr double kCourseBaseM = 10.0;
 
  private:
-  std::optional<NavInput> fromSide(int64_t utime_us, const sss::sonar::SonarChannelRecord& side) {
+  bool fromSide(int64_t utime_us, const sss::sonar::SonarChannelRecord& side) {
     if (side.projected_position) return fromProjected(utime_us, side);
     if (!(side.validity & sss::sonar::kValidLatLon) && side.latitude_deg == 0.0 && side.longitude_deg == 0.0) {
-      return std::nullopt;  // no position in this ping
+      return false;  // no position in this ping
     }
     if (!plane_) {
-      if (!sss::core::isFirstFixCandidate(side.latitude_deg, side.longitude_deg)) return std::nullopt;
+      if (!sss::core::isFirstFixCandidate(side.latitude_deg, side.longitude_deg)) return false;
       setOrigin({side.latitude_deg, side.longitude_deg});
     }
     NavInput nav;
@@ -240,31 +276,115 @@ class EmbeddedNavigation {
     nav.origin = origin_;
     nav.position_ned_m = plane_->toNed({side.latitude_deg, side.longitude_deg, side.depth_m});
     fillAttitude(nav, side);
-    return nav;
+    hold({std::move(nav), heading_from_track_}, Eigen::Vector2d(side.latitude_deg, side.longitude_deg));
+    return true;
   }
 
   // Projected metres: processed in the file's own grid, north = northing - N0, east = easting -
   // E0 of the first fix (the CRS is not in the file, so no latitude/longitude). The heading is
   // used as recorded: true north, which differs from the grid's north by the projection's
   // meridian convergence (within a degree or two in UTM).
-  std::optional<NavInput> fromProjected(int64_t utime_us, const sss::sonar::SonarChannelRecord& side) {
+  bool fromProjected(int64_t utime_us, const sss::sonar::SonarChannelRecord& side) {
     if (!projected_origin_) projected_origin_ = Eigen::Vector2d(side.easting_m, side.northing_m);
     NavInput nav;
     nav.utime_us = utime_us;
     nav.position_ned_m = Eigen::Vector3d(side.northing_m - projected_origin_->y(), side.easting_m - projected_origin_->x(),
                                          side.depth_m);
     fillAttitude(nav, side);
-    return nav;
+    hold({std::move(nav), heading_from_track_}, Eigen::Vector2d(side.northing_m, side.easting_m));
+    return true;
   }
   void fillAttitude(NavInput& nav, const sss::sonar::SonarChannelRecord& side) {
     nav.roll_rad = side.roll_rad;
     nav.pitch_rad = side.pitch_rad;
     nav.heading_rad = side.heading_rad;
+    // A header whose heading is flagged invalid (JSF validity bit 3 clear: a towfish without a
+    // compass) holds a 0 that would turn every image to north. The recorded course over ground
+    // stands in for it, else the track's own direction (emit); neither sees a crab angle.
+    heading_from_track_ = false;
+    if (!(side.validity & sss::sonar::kValidHeading)) {
+      if (side.validity & sss::sonar::kValidCourse) {
+        nav.heading_rad = side.course_rad;
+        ++headings_from_course_;
+      } else {
+        heading_from_track_ = true;
+      }
+    }
     nav.altitude_m = side.altitude_m;
     nav.altitude_valid = (side.validity & sss::sonar::kValidAltitude) != 0 && side.altitude_m > 0.0;
+  }
+  // A navigation sample on its way out; heading_from_track: its header had no heading of its own.
+  struct Sample {
+    NavInput nav;
+    bool heading_from_track = false;
+  };
+  // recorded: the position as the file holds it (compared exactly: a repeat is the same bytes).
+  void hold(Sample sample, const Eigen::Vector2d& recorded) {
+    const int64_t t_us = sample.nav.utime_us;
+    const bool repeated = last_new_ && recorded == last_new_recorded_ && t_us >= last_new_->utime_us;
+    if (repeated) {
+      held_.push_back(std::move(sample));
+      if (held_.size() >= kMaxHeldSamples || t_us - last_new_->utime_us > kMaxHoldUs) {
+        flushHeld();  // holding still, or navigation that stopped: as recorded
+      }
+      return;
+    }
+    if (last_new_ && !held_.empty() && t_us > last_new_->utime_us) {
+      const Eigen::Vector2d from = last_new_->position_ned_m.head<2>(), to = sample.nav.position_ned_m.head<2>();
+      const double span_us = static_cast<double>(t_us - last_new_->utime_us);
+      for (Sample& h : held_) {
+        const double f = static_cast<double>(h.nav.utime_us - last_new_->utime_us) / span_us;
+        h.nav.position_ned_m.head<2>() = from + f * (to - from);
+        ++positions_interpolated_;
+        emit(std::move(h));
+      }
+      held_.clear();
+    }
+    flushHeld();  // a new position out of time order: what was held keeps its position
+    last_new_ = sample.nav;
+    last_new_recorded_ = recorded;
+    emit(std::move(sample));
+  }
+  void flushHeld() {
+    if (held_.empty()) return;
+    last_new_ = held_.back().nav;  // interpolation starts again from the last one held
+    for (Sample& h : held_) emit(std::move(h));
+    held_.clear();
+  }
+  void emit(Sample sample) {
+    NavInput& nav = sample.nav;
     if (last_) distance_m_ += (nav.position_ned_m - *last_).head<2>().norm();
     last_ = nav.position_ned_m;
     nav.distance_travelled_m = distance_m_;
+    if (!sample.heading_from_track) {
+      releaseAwaitingCourse();  // in time order (a file whose headers gain a heading part way)
+      ready_.push_back(std::move(nav));
+      return;
+    }
+    // The direction from the newest earlier position at least kCourseBaseM behind: over one ping
+    // the step is position noise. Samples before the first such base wait for it.
+    track_.push_back(nav.position_ned_m.head<2>());
+    while (track_.size() > 2 && (track_.back() - track_[1]).norm() >= kCourseBaseM) track_.pop_front();
+    const Eigen::Vector2d travelled = track_.back() - track_.front();
+    awaiting_course_.push_back(std::move(nav));
+    if (travelled.norm() >= kCourseBaseM) {
+      const double course_rad = std::atan2(travelled.y(), travelled.x());
+      for (NavInput& waiting : awaiting_course_) {
+        waiting.heading_rad = course_rad < 0.0 ? course_rad + 2.0 * M_PI : course_rad;
+        ++headings_from_track_;
+        ready_.push_back(std::move(waiting));
+      }
+      awaiting_course_.clear();
+    } else if (awaiting_course_.size() >= kMaxHeldSamples) {
+      releaseAwaitingCourse();  // holding still: no direction to take
+    }
+  }
+  void releaseAwaitingCourse() {
+    for (NavInput& waiting : awaiting_course_) {
+      ++headings_unknown_;
+      ready_.push_back(std::move(waiting));
+    }
+    awaiting_course_.clear();
   }
   std::optional<Eigen::Vector2d> projected_origin_;
   sss::sonar::SonarChannelRecord last_side_;  // the last ping's header (depth, altitude, attitude)
@@ -275,6 +395,15 @@ class EmbeddedNavigation {
   }
   std::optional<sss::core::MissionOrigin> origin_;
   std::optional<sss::core::LocalTangentPlane> plane_;
+  std::optional<NavInput> last_new_;       // the newest sample with a new position (or the last held one)
+  Eigen::Vector2d last_new_recorded_ = Eigen::Vector2d::Zero();
+  std::vector<Sample> held_;               // samples repeating last_new_'s position, after it in time
+  std::vector<NavInput> ready_;
+  uint64_t positions_interpolated_ = 0;
+  bool heading_from_track_ = false;        // the sample being built has no heading of its own
+  std::deque<Eigen::Vector2d> track_;      // emitted positions of those, back to kCourseBaseM
+  std::vector<NavInput> awaiting_course_;  // emitted before the track was kCourseBaseM long
+  uint64_t headings_from_course_ = 0, headings_from_track_ = 0, headings_unknown_ = 0;
   std::optional<Eigen::Vector3d> last_;
   double distance_m_ = 0.0;
 };

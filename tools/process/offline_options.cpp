@@ -36,6 +36,11 @@ sss::core::Status readOptions(const std::string& path, Options& options) {
     ConfigSection sonar = config.section("sonar_driver");
     sss::edgetech::readSonarDriverOptions(sonar, options.sonar);
     sonar.optional("xtf_pair_index", options.xtf.pair_index, {inRange(0, 7)});
+    // XTF NavUnits as the file says (file), or forced: a header saying metres over pings in degrees.
+    std::string nav_units = "file";
+    sonar.optional("xtf_nav_units", nav_units, {oneOf({"file", "latlon", "metres"})});
+    if (nav_units == "latlon") options.xtf.nav_units = sss::xtf::kNavUnitsLatLon;
+    if (nav_units == "metres") options.xtf.nav_units = sss::xtf::kNavUnitsMetres;
     ConfigSection ins = config.section("ins_bridge");
     sss::ins::readInsBridgeOptions(ins, options.ins);
     ConfigSection buffer = config.section("subframe_buffer");

@@ -119,6 +119,7 @@ OfflineResult runOffline(const OfflineRequest& request) {
     }
   } else {
     std::unique_ptr<PingSource> pings;
+    const JsfSource* jsf_source = nullptr;  // the JSF reader, when the file is one
     if (hasExtension(request.sonar_path, ".xtf")) {
       auto xtf = std::make_unique<XtfSource>(request.sonar_path, options.xtf);
       if (!xtf->reader().isOpen()) {
@@ -132,6 +133,7 @@ OfflineResult runOffline(const OfflineRequest& request) {
         result.error = "cannot read " + request.sonar_path;
         return result;
       }
+      jsf_source = jsf.get();
       pings = std::move(jsf);
     } else {
       result.error = "unknown sonar file type " + request.sonar_path + " (expected .jsf or .xtf)";
@@ -181,10 +183,8 @@ OfflineResult runOffline(const OfflineRequest& request) {
     auto feedPackets = [&](int64_t up_to_us) {
       while (!packet_queue.empty() && packet_queue.front().utime_us <= up_to_us) {
         if (embedded && !ping_positions_seen) {
-          if (auto nav = embedded->fromPacket(packet_queue.front(), pings->projectedUnits())) {
-            runner.addNav(*nav);
-            ++runner.summary().nav_from_packets;
-          }
+          if (embedded->fromPacket(packet_queue.front(), pings->projectedUnits())) ++runner.summary().nav_from_packets;
+          for (const NavInput& nav : embedded->takeReady()) runner.addNav(nav);
         }
         packet_queue.pop_front();
       }
@@ -208,13 +208,13 @@ OfflineResult runOffline(const OfflineRequest& request) {
       ping_queue.pop_front();
       feedPackets(ping.utime_us);
       if (embedded) {
-        if (auto nav = embedded->fromPing(ping)) {
+        if (embedded->fromPing(ping)) {
           ping_positions_seen = true;
-          runner.addNav(*nav);
         } else {
           ++without_nav;
           ++runner.summary().pings_without_position;
         }
+        for (const NavInput& nav : embedded->takeReady()) runner.addNav(nav);
       }
       const sss_msgs::ping_t message = sss::edgetech::toPingMessage(ping);
       record(request.ping_channel, message, message.utime);
@@ -222,12 +222,27 @@ OfflineResult runOffline(const OfflineRequest& request) {
       runner.progress(pings->fractionRead(), false);
     }
     feedPackets(INT64_MAX);  // the file's last navigation, after its last ping
+    if (embedded) {
+      for (const NavInput& nav : embedded->finish()) runner.addNav(nav);
+      runner.summary().nav_positions_interpolated = embedded->positionsInterpolated();
+      runner.summary().nav_headings_from_course = embedded->headingsFromCourse();
+      runner.summary().nav_headings_from_track = embedded->headingsFromTrack();
+      runner.summary().nav_headings_unknown = embedded->headingsUnknown();
+    }
     faults += pings->faults() + (ins ? ins->faults() : 0);
+    if (jsf_source) runner.summary().jsf_adopted_subsystem = jsf_source->assemblerCounters().adopted_subsystem;
     if (runner.summary().pings == 0) {
       result.error = "no usable pings in " + request.sonar_path;
+      if (jsf_source && jsf_source->assemblerCounters().other_subsystem > 0) {
+        result.error += ": " + std::to_string(jsf_source->assemblerCounters().other_subsystem) +
+                        " sonar records of other subsystems than sonar.subsystem (" +
+                        std::to_string(options.sonar.assembler.subsystem) +
+                        ") were ignored; set sonar.subsystem to the side-scan frequency wanted (20 low, 21 high)";
+      }
       return result;
     }
     if (embedded) projected_origin = embedded->projectedOrigin();
+    if (embedded && projected_origin) runner.summary().projected_track_m = embedded->distanceM();
     if (embedded && without_nav == runner.summary().pings && runner.summary().nav_from_packets == 0) {
       result.error = request.sonar_path + " carries no navigation in its ping headers; give an INS file with --ins";
       return result;

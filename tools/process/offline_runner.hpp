@@ -80,6 +80,7 @@ struct OfflineSummary {
   // origin_source "projected_first_fix" (XTF NavUnits 0): the frame is the file's grid less these.
   double projected_origin_easting_m = 0.0;
   double projected_origin_northing_m = 0.0;
+  double projected_track_m = -1.0;  // the track's length in the projected grid (-1: not projected)
   uint64_t nav_samples = 0;
   uint64_t pings = 0;            // pings read
   uint64_t pings_with_pose = 0;  // pings that got a DR pose (in the trajectories)
@@ -133,6 +134,16 @@ struct OfflineSummary {
   sss::subframe::BottomTrackerCounters bottom_track;
   uint64_t pings_without_position = 0;  // embedded navigation: a ping header without a position
   uint64_t nav_from_packets = 0;        // navigation samples from the sonar file's own nav packets
+  // Embedded navigation: samples that repeated the previous position (a recorder stamping every ping
+  // with its newest GPS fix) and were interpolated in time between two new positions.
+  uint64_t nav_positions_interpolated = 0;
+  // Embedded navigation: headers without a valid heading (JSF validity bit 3 clear), given the
+  // recorded course over ground, the track's direction, or left at the recorded value (no motion).
+  uint64_t nav_headings_from_course = 0;
+  uint64_t nav_headings_from_track = 0;
+  uint64_t nav_headings_unknown = 0;
+  // JSF: the side-scan subsystem used because the file holds none of sonar.subsystem (-1: none).
+  int jsf_adopted_subsystem = -1;
   uint64_t survey_lines = 0;
   // Lines holding fewer pings than one full subframe: short lines, or the pieces a turn slower than
   // the turn-rate threshold is cut into (a new line at every max_heading_deviation_rad of heading).

@@ -1,7 +1,9 @@
 // What a run yields, and why not. See run_summary.hpp.
 #include "tools/process/run_summary.hpp"
 
+#include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <fstream>
 
 #include "tools/eval/json_values.hpp"
@@ -53,6 +55,34 @@ std::vector<std::string> explainRun(const OfflineSummary& s, const Options& opti
                                         : "no ping got a pose (" + count(pings) + " pings, " + count(s.nav_samples) +
                                               " navigation samples)");
     return findings;
+  }
+  // XTF NavUnits 0 (metres) whose positions are degrees: read as metres, a survey of kilometres
+  // moves millimetres, at a first fix within +-90 / +-180 of the grid's origin.
+  if (s.projected_track_m >= 0.0 && s.projected_track_m < 1.0 && s.mission_s > 60.0 &&
+      std::abs(s.projected_origin_northing_m) <= 90.0 && std::abs(s.projected_origin_easting_m) <= 180.0 &&
+      !(s.projected_origin_northing_m == 0.0 && s.projected_origin_easting_m == 0.0)) {
+    char text[512];
+    std::snprintf(text, sizeof text,
+                  "the file's positions are declared projected metres (XTF NavUnits 0) but move %.4f m in %.0f s "
+                  "from (%.6f, %.6f): they look like latitude and longitude in degrees; set sonar_driver."
+                  "xtf_nav_units: latlon",
+                  s.projected_track_m, s.mission_s, s.projected_origin_northing_m, s.projected_origin_easting_m);
+    findings.push_back(text);
+  }
+  if (s.jsf_adopted_subsystem >= 0) {
+    findings.push_back("the file holds no side-scan records of sonar.subsystem " +
+                       std::to_string(options.sonar.assembler.subsystem) + ", only of subsystem " +
+                       std::to_string(s.jsf_adopted_subsystem) + " (another frequency): that one was used");
+  }
+  const uint64_t headings_missing = s.nav_headings_from_course + s.nav_headings_from_track + s.nav_headings_unknown;
+  // A header or two (an XTF compass reading exactly north) is no missing compass.
+  if (headings_missing > 0 && 100 * headings_missing > pings) {
+    findings.push_back(
+        count(headings_missing) + " of " + count(pings) + " ping headers carry no valid heading (a towfish without a "
+        "compass): the course over ground stands in for it (" + count(s.nav_headings_from_course) + " recorded, " +
+        count(s.nav_headings_from_track) + " from the track over 10 m" +
+        (s.nav_headings_unknown > 0 ? ", " + count(s.nav_headings_unknown) + " left as recorded: no motion" : "") +
+        "), so a crab angle turns the images; give the vehicle's INS file with --ins for its true heading");
   }
   if (s.subframes == 0) {
     const auto& builder = s.buffer.builder;
@@ -276,6 +306,13 @@ sss::core::Status writeSummaryJson(const std::string& path, const OfflineRequest
   Json& navigation_json = (json["navigation"] = Json::object());
   navigation_json["ping_headers_without_position"] = jsonValue(s.pings_without_position);
   navigation_json["samples_from_nav_packets"] = jsonValue(s.nav_from_packets);  // XTF attitude/navigation packets
+  // ping headers repeating the previous position (no new fix), placed between the fixes in time
+  navigation_json["positions_interpolated"] = jsonValue(s.nav_positions_interpolated);
+  // ping headers without a valid heading: what stood in for it
+  navigation_json["headings_from_course"] = jsonValue(s.nav_headings_from_course);
+  navigation_json["headings_from_track"] = jsonValue(s.nav_headings_from_track);
+  navigation_json["headings_unknown"] = jsonValue(s.nav_headings_unknown);
+  json["jsf_subsystem_adopted"] = s.jsf_adopted_subsystem >= 0 ? jsonValue(static_cast<uint64_t>(s.jsf_adopted_subsystem)) : Json();
   navigation_json["samples_without_position"] = jsonValue(fusion.nav_without_position);
   Json& pings_dropped_json = (json["pings_dropped"] = Json::object());
   const std::pair<const char*, uint64_t> drops[] = {
