@@ -36,9 +36,8 @@ bool parseAngle(const std::string& text, const std::string& hemisphere, int degr
   return std::abs(degrees) <= limit;
 }
 
-}  // namespace
-
-std::optional<GgaFix> parseGga(const std::string& sentence) {
+// The sentence's fields without '$', CR/LF and a checksum, which must match when present.
+std::optional<std::vector<std::string>> nmeaFields(const std::string& sentence) {
   std::string_view body = sentence;
   while (!body.empty() && (body.back() == '\r' || body.back() == '\n')) body.remove_suffix(1);
   if (!body.empty() && body.front() == '$') body.remove_prefix(1);
@@ -53,15 +52,60 @@ std::optional<GgaFix> parseGga(const std::string& sentence) {
     body = body.substr(0, star);
   }
   const std::vector<std::string_view> view = splitFields(body);
-  const std::vector<std::string> fields(view.begin(), view.end());
-  if (fields.size() < 10 || fields[0].size() != 5 || fields[0].compare(2, 3, "GGA") != 0) return std::nullopt;
-  GgaFix fix;
-  double time = 0.0, quality = 0.0;
-  if (!parseNumber(fields[1], time) || fields[1].size() < 6) return std::nullopt;
+  return std::vector<std::string>(view.begin(), view.end());
+}
+
+// hhmmss[.ss] as seconds of the day.
+bool parseTimeOfDay(const std::string& text, double& seconds_of_day) {
+  double time = 0.0;
+  if (!parseNumber(text, time) || text.size() < 6) return false;
   const int hh = static_cast<int>(time / 10000), mm = static_cast<int>(std::fmod(time / 100, 100));
   const double ss = std::fmod(time, 100.0);
-  if (hh > 23 || mm > 59 || ss >= 61.0) return std::nullopt;
-  fix.seconds_of_day = hh * 3600.0 + mm * 60.0 + ss;
+  if (hh > 23 || mm > 59 || ss >= 61.0) return false;
+  seconds_of_day = hh * 3600.0 + mm * 60.0 + ss;
+  return true;
+}
+
+bool isSentence(const std::vector<std::string>& fields, const char* type) {
+  return !fields.empty() && fields[0].size() == 5 && fields[0].compare(2, 3, type) == 0;
+}
+
+}  // namespace
+
+std::optional<GgaFix> parseNmeaPosition(const std::string& sentence) {
+  const std::optional<std::vector<std::string>> parsed = nmeaFields(sentence);
+  if (!parsed) return std::nullopt;
+  const std::vector<std::string>& fields = *parsed;
+  GgaFix fix;
+  fix.quality = 1;
+  if (isSentence(fields, "GGA")) return parseGga(sentence);
+  if (isSentence(fields, "RMC")) {  // time, status, lat, N/S, lon, E/W, speed, course, date, ...
+    if (fields.size() < 7 || fields[2] != "A" || !parseTimeOfDay(fields[1], fix.seconds_of_day) ||
+        !parseAngle(fields[3], fields[4], 2, 'N', 'S', 90.0, fix.latitude_deg) ||
+        !parseAngle(fields[5], fields[6], 3, 'E', 'W', 180.0, fix.longitude_deg)) {
+      return std::nullopt;
+    }
+    return fix;
+  }
+  if (isSentence(fields, "GLL")) {  // lat, N/S, lon, E/W, time, status[, mode]
+    if (fields.size() < 7 || fields[6] != "A" || !parseTimeOfDay(fields[5], fix.seconds_of_day) ||
+        !parseAngle(fields[1], fields[2], 2, 'N', 'S', 90.0, fix.latitude_deg) ||
+        !parseAngle(fields[3], fields[4], 3, 'E', 'W', 180.0, fix.longitude_deg)) {
+      return std::nullopt;
+    }
+    return fix;
+  }
+  return std::nullopt;
+}
+
+std::optional<GgaFix> parseGga(const std::string& sentence) {
+  const std::optional<std::vector<std::string>> parsed = nmeaFields(sentence);
+  if (!parsed) return std::nullopt;
+  const std::vector<std::string>& fields = *parsed;
+  if (fields.size() < 10 || !isSentence(fields, "GGA")) return std::nullopt;
+  GgaFix fix;
+  double quality = 0.0;
+  if (!parseTimeOfDay(fields[1], fix.seconds_of_day)) return std::nullopt;
   if (!parseAngle(fields[2], fields[3], 2, 'N', 'S', 90.0, fix.latitude_deg) ||
       !parseAngle(fields[4], fields[5], 3, 'E', 'W', 180.0, fix.longitude_deg) || !parseNumber(fields[6], quality)) {
     return std::nullopt;

@@ -23,4 +23,9 @@ struct GgaFix {
 // match); nullopt for another sentence, a malformed one, or quality 0 (no fix).
 std::optional<GgaFix> parseGga(const std::string& sentence);
 
+// A position from GGA, or from RMC or GLL with status A (valid), whichever the sentence is: a sonar
+// file's NMEA feed may carry only one of them. RMC and GLL carry no quality, satellites or HDOP:
+// quality 1, the rest 0. nullopt for other sentences, malformed ones, no fix or status V.
+std::optional<GgaFix> parseNmeaPosition(const std::string& sentence);
+
 }  // namespace sss::ins

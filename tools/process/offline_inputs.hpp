@@ -66,8 +66,8 @@ class JsfSource : public PingSource {
     for (const auto& r : driver_.takeNavigation()) {
       FileNavigation nav{r.time_us, r.latitude_deg, r.longitude_deg, r.depth_m, r.altitude_m, r.pitch_rad, r.roll_rad,
                          r.heading_rad};
-      if (r.nmea) {  // 2002: a GGA fix gives the position, at the message's (sonar clock) time
-        if (const auto fix = sss::ins::parseGga(*r.nmea)) {
+      if (r.nmea) {  // 2002: a GGA, RMC or GLL fix gives the position, at the message's (sonar clock) time
+        if (const auto fix = sss::ins::parseNmeaPosition(*r.nmea)) {
           nav.y = fix->latitude_deg;
           nav.x = fix->longitude_deg;
         }
