@@ -58,7 +58,8 @@ std::optional<std::vector<std::string>> nmeaFields(const std::string& sentence) 
 // hhmmss[.ss] as seconds of the day.
 bool parseTimeOfDay(const std::string& text, double& seconds_of_day) {
   double time = 0.0;
-  if (!parseNumber(text, time) || text.size() < 6) return false;
+  // Below 24 h before the casts: a corrupt field holds any number.
+  if (!parseNumber(text, time) || text.size() < 6 || time < 0.0 || time >= 240000.0) return false;
   const int hh = static_cast<int>(time / 10000), mm = static_cast<int>(std::fmod(time / 100, 100));
   const double ss = std::fmod(time, 100.0);
   if (hh > 23 || mm > 59 || ss >= 61.0) return false;

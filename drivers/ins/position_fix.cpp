@@ -31,7 +31,8 @@ bool parseNumber(std::string_view text, double& value) {
 // hhmmss[.ss] as seconds of the day.
 bool parseTimeOfDay(std::string_view text, double& seconds) {
   double value = 0.0;
-  if (text.size() < 6 || !parseNumber(text, value) || value < 0.0) return false;
+  // Below 24 h before the casts: a corrupt field holds any number (fuzzed: 1e69).
+  if (text.size() < 6 || !parseNumber(text, value) || value < 0.0 || value >= 240000.0) return false;
   const int hh = static_cast<int>(value / 10000), mm = static_cast<int>(std::fmod(value / 100, 100));
   const double ss = std::fmod(value, 100.0);
   if (hh > 23 || mm > 59 || ss >= 61.0) return false;
@@ -212,11 +213,13 @@ void PositionFixReader::addSentence(const std::string& body) {
     std::optional<int64_t> days;
     if (fields.size() >= 5 && type == "ZDA" && parseTimeOfDay(fields[1], seconds)) {
       double dd = 0, mm = 0, yyyy = 0;
-      if (parseNumber(fields[2], dd) && parseNumber(fields[3], mm) && parseNumber(fields[4], yyyy))
+      // Range-checked before the casts: a corrupt field holds any number (fuzzed: a day of 4e69).
+      if (parseNumber(fields[2], dd) && parseNumber(fields[3], mm) && parseNumber(fields[4], yyyy) && dd >= 1.0 &&
+          dd <= 31.0 && mm >= 1.0 && mm <= 12.0 && yyyy >= 1970.0 && yyyy <= 2200.0)
         days = daysSinceEpoch(static_cast<int>(yyyy), static_cast<int>(mm), static_cast<int>(dd));
     } else if (fields.size() >= 10 && type == "RMC" && parseTimeOfDay(fields[1], seconds) && fields[9].size() == 6) {
       double ddmmyy = 0;
-      if (parseNumber(fields[9], ddmmyy)) {
+      if (parseNumber(fields[9], ddmmyy) && ddmmyy >= 0.0 && ddmmyy < 1e6) {
         const int value = static_cast<int>(ddmmyy);
         days = daysSinceEpoch(2000 + value % 100, (value / 100) % 100, value / 10000);
       }

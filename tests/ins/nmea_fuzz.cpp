@@ -1,5 +1,5 @@
 // libFuzzer target for the INS NMEA path (stream parser + sentence parser + assembler + encoder)
-// and the position fix reader (GGA/GST/ZDA/RMC).
+// the position fix reader (GGA/GST/ZDA/RMC) and a sonar file's NMEA positions (GGA/RMC/GLL).
 // Also linked into nmea_fuzz_regression_test, which replays the corpus with any compiler.
 #include <cmath>
 #include <cstddef>
@@ -10,6 +10,7 @@
 
 #include "drivers/ins/ins_state_assembler.hpp"
 #include "drivers/ins/ixblue_nmea.hpp"
+#include "drivers/ins/nmea_gga.hpp"
 #include "drivers/ins/nmea_stream_parser.hpp"
 #include "drivers/ins/position_fix.hpp"
 
@@ -84,6 +85,17 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     check(fix.sigma_north_m > 0.0 && fix.sigma_east_m > 0.0 && std::isfinite(fix.sigma_north_m) &&
           std::isfinite(fix.sigma_east_m));
     check(fix.seconds_of_day >= 0.0 && fix.seconds_of_day < 86401.0);
+  }
+
+  // A sonar file's NMEA positions (GGA, RMC, GLL): every framed sentence, and the raw input as one
+  // sentence; what is accepted is a position on Earth at a time of day.
+  std::vector<std::string> candidates = sentences;
+  candidates.emplace_back(reinterpret_cast<const char*>(data), size);
+  for (const std::string& sentence : candidates) {
+    if (const auto position = parseNmeaPosition(sentence)) {
+      check(std::abs(position->latitude_deg) <= 90.0 && std::abs(position->longitude_deg) <= 180.0);
+      check(position->seconds_of_day >= 0.0 && position->seconds_of_day < 86401.0 && position->quality > 0);
+    }
   }
   return 0;
 }
