@@ -35,6 +35,11 @@ constexpr double kDegToRad = M_PI / 180.0;
 constexpr double kMinutesX10000PerDegree = 600000.0;  // coordinate units 2
 constexpr double kAngleScale = 180.0 / 32768.0;       // pitch/roll degrees per count
 
+double degrees0To360(double degrees) {
+  const double wrapped = std::fmod(degrees, 360.0);
+  return wrapped < 0.0 ? wrapped + 360.0 : wrapped;
+}
+
 int32_t clampToInt32(double value) {
   return static_cast<int32_t>(std::clamp(std::llround(value), static_cast<long long>(INT32_MIN),
                                          static_cast<long long>(INT32_MAX)));
@@ -104,12 +109,8 @@ void encodeSonarNavigation(const SonarChannelRecord& record, uint8_t* b) {
     writeLe<int16_t>(b, 88, 2);  // coordinate units: minutes of arc x 10000
   }
   writeLe<int32_t>(b, 136, clampToInt32(record.depth_m * 1000.0));
-  double heading_deg = std::fmod(record.heading_rad * kRadToDeg, 360.0);
-  if (heading_deg < 0.0) heading_deg += 360.0;
-  writeLe<uint16_t>(b, 172, static_cast<uint16_t>(std::lround(heading_deg * 100.0) % 36000));
-  double course_deg = std::fmod(record.course_rad * kRadToDeg, 360.0);
-  if (course_deg < 0.0) course_deg += 360.0;
-  writeLe<int16_t>(b, 192, static_cast<int16_t>(std::lround(course_deg) % 360));
+  writeLe<uint16_t>(b, 172, static_cast<uint16_t>(std::lround(degrees0To360(record.heading_rad * kRadToDeg) * 100.0) % 36000));
+  writeLe<int16_t>(b, 192, static_cast<int16_t>(std::lround(degrees0To360(record.course_rad * kRadToDeg)) % 360));
   writeLe<int16_t>(b, 174, clampToInt16(record.pitch_rad * kRadToDeg / kAngleScale));
   writeLe<int16_t>(b, 176, clampToInt16(record.roll_rad * kRadToDeg / kAngleScale));
 }
@@ -234,9 +235,7 @@ sss::core::Result<SonarChannelRecord> decodeSonarData(const JsfMessageHeader& he
   }
   r.weighting_factor = readLe<int16_t>(body, 168);
   r.heading_rad = readLe<uint16_t>(body, 172) * 0.01 * kDegToRad;
-  double course_deg = std::fmod(static_cast<double>(readLe<int16_t>(body, 192)), 360.0);  // whole degrees
-  if (course_deg < 0.0) course_deg += 360.0;
-  r.course_rad = course_deg * kDegToRad;
+  r.course_rad = degrees0To360(readLe<int16_t>(body, 192)) * kDegToRad;  // whole degrees
   r.pitch_rad = readLe<int16_t>(body, 174) * kAngleScale * kDegToRad;
   r.roll_rad = readLe<int16_t>(body, 176) * kAngleScale * kDegToRad;
 

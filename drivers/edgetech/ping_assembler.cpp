@@ -36,16 +36,18 @@ void PingAssembler::add(SonarChannelRecord record, int64_t arrival_us, std::vect
       return;
     }
     held_other_.emplace_back(std::move(record), arrival_us);
-    if (static_cast<int>(held_other_.size()) >= options_.adopt_other_side_scan_after) {
-      options_.subsystem = held_other_.front().first.subsystem;
-      counters_.adopted_subsystem = options_.subsystem;
-      configured_seen_ = true;
-      for (auto& [held, held_arrival_us] : held_other_) join(std::move(held), held_arrival_us, out);
-      held_other_.clear();
-    }
+    if (static_cast<int>(held_other_.size()) >= options_.adopt_other_side_scan_after) adoptHeld(out);
     return;
   }
   ++counters_.other_subsystem;
+}
+
+void PingAssembler::adoptHeld(std::vector<AssembledPing>& out) {
+  options_.subsystem = held_other_.front().first.subsystem;
+  counters_.adopted_subsystem = options_.subsystem;
+  configured_seen_ = true;
+  for (auto& [held, held_arrival_us] : held_other_) join(std::move(held), held_arrival_us, out);
+  held_other_.clear();
 }
 
 void PingAssembler::join(SonarChannelRecord record, int64_t arrival_us, std::vector<AssembledPing>& out) {
@@ -85,13 +87,7 @@ void PingAssembler::expire(int64_t now_us, std::vector<AssembledPing>& out) {
 }
 
 void PingAssembler::flush(std::vector<AssembledPing>& out) {
-  if (!configured_seen_ && !held_other_.empty()) {  // a short file of another frequency only
-    options_.subsystem = held_other_.front().first.subsystem;
-    counters_.adopted_subsystem = options_.subsystem;
-    configured_seen_ = true;
-    for (auto& [held, held_arrival_us] : held_other_) join(std::move(held), held_arrival_us, out);
-    held_other_.clear();
-  }
+  if (!configured_seen_ && !held_other_.empty()) adoptHeld(out);  // a short file of another frequency only
   while (!pending_.empty()) {
     Pending oldest = std::move(pending_.front());
     pending_.pop_front();

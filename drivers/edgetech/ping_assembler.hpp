@@ -55,6 +55,8 @@ class PingAssembler {
   };
   void emit(Pending&& pending, std::vector<AssembledPing>& out);
   void join(SonarChannelRecord record, int64_t arrival_us, std::vector<AssembledPing>& out);
+  // Uses the subsystem of the held records from now on and joins them (held_other_ not empty).
+  void adoptHeld(std::vector<AssembledPing>& out);
 
   PingAssemblerOptions options_;
   bool configured_seen_ = false;

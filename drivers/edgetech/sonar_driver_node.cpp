@@ -40,7 +40,7 @@ std::string readNodeOptions(const std::string& config_path, NodeOptions& options
   section.optional("xtf_pair_index", options.input.xtf_pair_index, {inRange(0, 7)});
   std::string nav_units = "file";
   section.optional("xtf_nav_units", nav_units, {oneOf({"file", "latlon", "metres"})});
-  options.input.xtf_nav_units = nav_units == "latlon" ? 3 : nav_units == "metres" ? 0 : -1;
+  options.input.xtf_nav_units = sss::xtf::xtfNavUnitsFromName(nav_units);
   section.rejectUnknownKeys();
   return config.problemReport();
 }

@@ -55,23 +55,22 @@ std::optional<std::vector<std::string>> nmeaFields(const std::string& sentence) 
   return std::vector<std::string>(view.begin(), view.end());
 }
 
-// hhmmss[.ss] as seconds of the day.
-bool parseTimeOfDay(const std::string& text, double& seconds_of_day) {
+bool isSentence(const std::vector<std::string>& fields, const char* type) {
+  return !fields.empty() && fields[0].size() == 5 && fields[0].compare(2, 3, type) == 0;
+}
+
+}  // namespace
+
+bool parseNmeaTimeOfDay(std::string_view text, double& seconds_of_day) {
   double time = 0.0;
-  // Below 24 h before the casts: a corrupt field holds any number.
-  if (!parseNumber(text, time) || text.size() < 6 || time < 0.0 || time >= 240000.0) return false;
+  // Below 24 h before the casts: a corrupt field holds any number (fuzzed: 1e69).
+  if (text.size() < 6 || !parseNumber(std::string(text), time) || time < 0.0 || time >= 240000.0) return false;
   const int hh = static_cast<int>(time / 10000), mm = static_cast<int>(std::fmod(time / 100, 100));
   const double ss = std::fmod(time, 100.0);
   if (hh > 23 || mm > 59 || ss >= 61.0) return false;
   seconds_of_day = hh * 3600.0 + mm * 60.0 + ss;
   return true;
 }
-
-bool isSentence(const std::vector<std::string>& fields, const char* type) {
-  return !fields.empty() && fields[0].size() == 5 && fields[0].compare(2, 3, type) == 0;
-}
-
-}  // namespace
 
 std::optional<GgaFix> parseNmeaPosition(const std::string& sentence) {
   const std::optional<std::vector<std::string>> parsed = nmeaFields(sentence);
@@ -81,7 +80,7 @@ std::optional<GgaFix> parseNmeaPosition(const std::string& sentence) {
   fix.quality = 1;
   if (isSentence(fields, "GGA")) return parseGga(sentence);
   if (isSentence(fields, "RMC")) {  // time, status, lat, N/S, lon, E/W, speed, course, date, ...
-    if (fields.size() < 7 || fields[2] != "A" || !parseTimeOfDay(fields[1], fix.seconds_of_day) ||
+    if (fields.size() < 7 || fields[2] != "A" || !parseNmeaTimeOfDay(fields[1], fix.seconds_of_day) ||
         !parseAngle(fields[3], fields[4], 2, 'N', 'S', 90.0, fix.latitude_deg) ||
         !parseAngle(fields[5], fields[6], 3, 'E', 'W', 180.0, fix.longitude_deg)) {
       return std::nullopt;
@@ -89,7 +88,7 @@ std::optional<GgaFix> parseNmeaPosition(const std::string& sentence) {
     return fix;
   }
   if (isSentence(fields, "GLL")) {  // lat, N/S, lon, E/W, time, status[, mode]
-    if (fields.size() < 7 || fields[6] != "A" || !parseTimeOfDay(fields[5], fix.seconds_of_day) ||
+    if (fields.size() < 7 || fields[6] != "A" || !parseNmeaTimeOfDay(fields[5], fix.seconds_of_day) ||
         !parseAngle(fields[1], fields[2], 2, 'N', 'S', 90.0, fix.latitude_deg) ||
         !parseAngle(fields[3], fields[4], 3, 'E', 'W', 180.0, fix.longitude_deg)) {
       return std::nullopt;
@@ -106,7 +105,7 @@ std::optional<GgaFix> parseGga(const std::string& sentence) {
   if (fields.size() < 10 || !isSentence(fields, "GGA")) return std::nullopt;
   GgaFix fix;
   double quality = 0.0;
-  if (!parseTimeOfDay(fields[1], fix.seconds_of_day)) return std::nullopt;
+  if (!parseNmeaTimeOfDay(fields[1], fix.seconds_of_day)) return std::nullopt;
   if (!parseAngle(fields[2], fields[3], 2, 'N', 'S', 90.0, fix.latitude_deg) ||
       !parseAngle(fields[4], fields[5], 3, 'E', 'W', 180.0, fix.longitude_deg) || !parseNumber(fields[6], quality)) {
     return std::nullopt;

@@ -6,6 +6,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 
 namespace sss::ins {
 
@@ -27,5 +28,8 @@ std::optional<GgaFix> parseGga(const std::string& sentence);
 // file's NMEA feed may carry only one of them. RMC and GLL carry no quality, satellites or HDOP:
 // quality 1, the rest 0. nullopt for other sentences, malformed ones, no fix or status V.
 std::optional<GgaFix> parseNmeaPosition(const std::string& sentence);
+
+// hhmmss[.ss] as seconds of the day; false when it is not a time of day.
+bool parseNmeaTimeOfDay(std::string_view text, double& seconds_of_day);
 
 }  // namespace sss::ins

@@ -28,18 +28,6 @@ bool parseNumber(std::string_view text, double& value) {
   return end == copy.c_str() + copy.size() && std::isfinite(value);
 }
 
-// hhmmss[.ss] as seconds of the day.
-bool parseTimeOfDay(std::string_view text, double& seconds) {
-  double value = 0.0;
-  // Below 24 h before the casts: a corrupt field holds any number (fuzzed: 1e69).
-  if (text.size() < 6 || !parseNumber(text, value) || value < 0.0 || value >= 240000.0) return false;
-  const int hh = static_cast<int>(value / 10000), mm = static_cast<int>(std::fmod(value / 100, 100));
-  const double ss = std::fmod(value, 100.0);
-  if (hh > 23 || mm > 59 || ss >= 61.0) return false;
-  seconds = hh * 3600.0 + mm * 60.0 + ss;
-  return true;
-}
-
 // Days since 1970-01-01 of a Gregorian date; nullopt when it is not a date.
 std::optional<int64_t> daysSinceEpoch(int year, int month, int day) {
   if (year < 1970 || year > 2200 || month < 1 || month > 12 || day < 1 || day > 31) return std::nullopt;
@@ -197,7 +185,7 @@ void PositionFixReader::addSentence(const std::string& body) {
   } else if (type == "GST") {
     // GST,time,rms,semi-major,semi-minor,orientation,sigma_lat,sigma_lon,sigma_alt
     double seconds = 0.0, sigma_lat = 0.0, sigma_lon = 0.0;
-    if (fields.size() < 8 || !parseTimeOfDay(fields[1], seconds) || !parseNumber(fields[6], sigma_lat) ||
+    if (fields.size() < 8 || !parseNmeaTimeOfDay(fields[1], seconds) || !parseNumber(fields[6], sigma_lat) ||
         !parseNumber(fields[7], sigma_lon) || !(sigma_lat > 0.0) || !(sigma_lon > 0.0)) {
       malformed("GST");
       return;
@@ -211,13 +199,13 @@ void PositionFixReader::addSentence(const std::string& body) {
     // ZDA,time,dd,mm,yyyy,...   RMC,time,status,lat,N,lon,E,sog,cog,ddmmyy,...
     double seconds = 0.0;
     std::optional<int64_t> days;
-    if (fields.size() >= 5 && type == "ZDA" && parseTimeOfDay(fields[1], seconds)) {
+    if (fields.size() >= 5 && type == "ZDA" && parseNmeaTimeOfDay(fields[1], seconds)) {
       double dd = 0, mm = 0, yyyy = 0;
       // Range-checked before the casts: a corrupt field holds any number (fuzzed: a day of 4e69).
       if (parseNumber(fields[2], dd) && parseNumber(fields[3], mm) && parseNumber(fields[4], yyyy) && dd >= 1.0 &&
           dd <= 31.0 && mm >= 1.0 && mm <= 12.0 && yyyy >= 1970.0 && yyyy <= 2200.0)
         days = daysSinceEpoch(static_cast<int>(yyyy), static_cast<int>(mm), static_cast<int>(dd));
-    } else if (fields.size() >= 10 && type == "RMC" && parseTimeOfDay(fields[1], seconds) && fields[9].size() == 6) {
+    } else if (fields.size() >= 10 && type == "RMC" && parseNmeaTimeOfDay(fields[1], seconds) && fields[9].size() == 6) {
       double ddmmyy = 0;
       if (parseNumber(fields[9], ddmmyy) && ddmmyy >= 0.0 && ddmmyy < 1e6) {
         const int value = static_cast<int>(ddmmyy);

@@ -33,6 +33,12 @@ struct XtfReaderOptions {
   size_t read_chunk_bytes = 256 * 1024;
 };
 
+// XtfReaderOptions::nav_units for a configuration's name of it: "latlon", "metres", else (the
+// configurations' "file") -1.
+inline int xtfNavUnitsFromName(const std::string& name) {
+  return name == "latlon" ? kNavUnitsLatLon : name == "metres" ? kNavUnitsMetres : -1;
+}
+
 struct XtfReaderCounters {
   uint64_t packets = 0;                 // framed packets of any type
   uint64_t pings = 0;                   // DriverPings handed out

@@ -171,7 +171,7 @@ struct PoseGraphOptions {
   // A GNSS receiver's error (ionosphere, satellite orbits and clocks, multipath) changes over
   // minutes, not from one fix to the next: a vehicle logging 1 Hz GGA for five minutes at the
   // surface has a few independent fixes' worth of information, not 300. Treated as independent they
-  // would pin the survey to their common error with a tenth of its sigma. The error is modelled as
+  // would pin the survey to their common error with a seventeenth of its sigma. The error is modelled as
   // first-order Gauss-Markov with this correlation time per source (0: independent fixes): a fix dt
   // after the previous fix of its source, rho = exp(-dt / tau), enters the solve with its information
   // times (1 - rho) / (1 + rho). Summed over a run of fixes that is exactly the information a

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <random>
 
 #include "pipeline/optimiser/pose_graph.hpp"
@@ -325,20 +326,26 @@ TEST(PositionFixGraph, CorrelatedGnssFixesCountAsTheInformationTheyHold) {
                         Eigen::Vector2d(receiver_noise(random), receiver_noise(random));
     minute.push_back(fix);
   }
+  // The first node with the minute's fixes, three more nodes (after_first_update runs once the
+  // second is in the estimate), then full smoothing.
+  auto solveWithTheMinute = [&](SlidingWindowPoseGraph& graph, const std::function<void()>& after_first_update) {
+    ASSERT_TRUE(graph.setFirstNodeHorizontalSigma(10.0, 10.0).ok);  // the INS barely knew the start
+    ASSERT_TRUE(graph.addNode(first.subframe_id, first.utime_us, first.dr, first.distance_m).ok);
+    for (const AbsoluteFix& fix : minute) ASSERT_TRUE(graph.addFix(fix).ok);
+    for (size_t i = 1; i < 4; ++i) {
+      const synthetic::Node& n = mission.nodes[i];
+      ASSERT_TRUE(graph.addNode(n.subframe_id, n.utime_us, n.dr, n.distance_m).ok);
+      ASSERT_TRUE(graph.optimize().ok);
+      if (i == 1) after_first_update();
+    }
+    ASSERT_TRUE(graph.fullSmoothing().ok);
+  };
   auto startNees = [&](double correlation_s, double* sigma_north_m) {
     PoseGraphOptions options = graphOptions();
     options.gnss_fix_correlation_s = correlation_s;
     options.calibration = "never";  // the start's position alone: no DVL scale or heading error to share it with
     SlidingWindowPoseGraph graph(options);
-    EXPECT_TRUE(graph.setFirstNodeHorizontalSigma(10.0, 10.0).ok);  // the INS barely knew the start
-    EXPECT_TRUE(graph.addNode(first.subframe_id, first.utime_us, first.dr, first.distance_m).ok);
-    for (const AbsoluteFix& fix : minute) EXPECT_TRUE(graph.addFix(fix).ok);
-    for (size_t i = 1; i < 4; ++i) {
-      const synthetic::Node& n = mission.nodes[i];
-      EXPECT_TRUE(graph.addNode(n.subframe_id, n.utime_us, n.dr, n.distance_m).ok);
-      EXPECT_TRUE(graph.optimize().ok);
-    }
-    EXPECT_TRUE(graph.fullSmoothing().ok);
+    solveWithTheMinute(graph, [] {});
     EXPECT_EQ(graph.fixCounters().accepted, 60u);
     const Eigen::Matrix2d covariance = graph.covariance(first.subframe_id)->topLeftCorner<2, 2>();
     const Eigen::Vector2d error = (graph.nodes()[0].T_world_body.translation - first.truth.translation).head<2>();
@@ -361,25 +368,16 @@ TEST(PositionFixGraph, CorrelatedGnssFixesCountAsTheInformationTheyHold) {
 
   PoseGraphOptions options = graphOptions();
   SlidingWindowPoseGraph graph(options);
-  ASSERT_TRUE(graph.setFirstNodeHorizontalSigma(10.0, 10.0).ok);
-  ASSERT_TRUE(graph.addNode(first.subframe_id, first.utime_us, first.dr, first.distance_m).ok);
-  for (const AbsoluteFix& fix : minute) ASSERT_TRUE(graph.addFix(fix).ok);
-  for (size_t i = 1; i < 4; ++i) {
-    const synthetic::Node& n = mission.nodes[i];
-    ASSERT_TRUE(graph.addNode(n.subframe_id, n.utime_us, n.dr, n.distance_m).ok);
-    ASSERT_TRUE(graph.optimize().ok);
-    if (i == 1) {  // the minute is in the estimate: two late fixes of its last second
-      AbsoluteFix far = minute.back();
-      far.utime_us += 500000;
-      far.position_ne_m += Eigen::Vector2d(15.0, 0.0);
-      ASSERT_TRUE(graph.addFix(far).ok);
-      AbsoluteFix usbl = minute.back();
-      usbl.utime_us += 700000;
-      usbl.source = "usbl";
-      ASSERT_TRUE(graph.addFix(usbl).ok);
-    }
-  }
-  ASSERT_TRUE(graph.fullSmoothing().ok);
+  solveWithTheMinute(graph, [&] {  // the minute is in the estimate: two late fixes of its last second
+    AbsoluteFix far = minute.back();
+    far.utime_us += 500000;
+    far.position_ne_m += Eigen::Vector2d(15.0, 0.0);
+    ASSERT_TRUE(graph.addFix(far).ok);
+    AbsoluteFix usbl = minute.back();
+    usbl.utime_us += 700000;
+    usbl.source = "usbl";
+    ASSERT_TRUE(graph.addFix(usbl).ok);
+  });
   const std::vector<FixRecord> records = graph.fixes();
   ASSERT_EQ(records.size(), 62u);
   EXPECT_DOUBLE_EQ(records[0].information_weight, 1.0);

@@ -6,6 +6,36 @@
 
 namespace {
 
+// One JSF sonar data message of a seabed at altitude_m (3 cm samples, 1/range fall-off, one-look
+// speckle) with the record's header fields, appended to the file.
+void writeJsfSeabedRecord(std::ofstream& out, sss::sonar::SonarChannelRecord record, double altitude_m,
+                          std::mt19937& random, uint8_t& sequence) {
+  std::exponential_distribution<double> speckle(1.0);
+  record.sample_interval_s = 4e-5;  // 3 cm
+  std::vector<float> magnitudes;
+  for (int k = 0; k < 2500; ++k) {
+    const double r = k * 0.03;
+    magnitudes.push_back(static_cast<float>((r < altitude_m ? 2.0 : 400.0 * altitude_m / r) * speckle(random)));
+  }
+  int16_t weighting = 0;
+  const auto codes = sss::edgetech::quantiseEnvelope(magnitudes, weighting);
+  record.weighting_factor = weighting;
+  const auto bytes = sss::edgetech::encodeSonarData(record, codes, sequence++);
+  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+}
+
+// The largest difference between the poses' heading and course_rad, in degrees.
+template <typename Poses>
+double worstHeadingErrorDeg(const Poses& poses, double course_rad) {
+  double worst_deg = 0.0;
+  for (const auto& pose : poses) {
+    const Eigen::Matrix3d r = pose.T_world_body.rotation.toRotationMatrix();
+    worst_deg = std::max(worst_deg, std::abs(std::remainder(std::atan2(r(1, 0), r(0, 0)) - course_rad, 2.0 * M_PI)) *
+                                        180.0 / M_PI);
+  }
+  return worst_deg;
+}
+
 // A recorder that stamps every ping with its newest GPS fix: a 1 Hz GPS under a 4 Hz sonar repeats
 // each position for four pings, then jumps 2 m (the real Iver2 XTF repeats its fixes for 2-6 pings).
 // The repeats are no new fixes: they are placed between the fixes in time, so the track advances
@@ -342,7 +372,6 @@ TEST_F(OfflineRunnerTest, JsfSituationOrNmeaMessagesPositionPingsWithoutPosition
   {
     std::ofstream out(path, std::ios::binary);
     std::mt19937 random(8);
-    std::exponential_distribution<double> speckle(1.0);
     uint8_t sequence = 0;
     for (int i = 0; i < 600; ++i) {
       const double t_s = 0.25 * i;
@@ -387,19 +416,9 @@ TEST_F(OfflineRunnerTest, JsfSituationOrNmeaMessagesPositionPingsWithoutPosition
         record.channel = channel;
         record.ping_time_us = utime_us;
         record.ping_number = static_cast<uint32_t>(i);
-        record.sample_interval_s = 4e-5;  // 3 cm
         record.validity = sss::sonar::kValidHeading | sss::sonar::kValidSoundSpeed;  // no position, no altitude
         record.heading_rad = heading_rad;
-        std::vector<float> magnitudes;
-        for (int k = 0; k < 2500; ++k) {
-          const double r = k * 0.03;
-          magnitudes.push_back(static_cast<float>((r < 15.0 ? 2.0 : 400.0 * 15.0 / r) * speckle(random)));
-        }
-        int16_t weighting = 0;
-        const auto codes = sss::edgetech::quantiseEnvelope(magnitudes, weighting);
-        record.weighting_factor = weighting;
-        const auto bytes = sss::edgetech::encodeSonarData(record, codes, sequence++);
-        out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+        writeJsfSeabedRecord(out, record, 15.0, random, sequence);
       }
     }
   }
@@ -439,7 +458,6 @@ TEST_F(OfflineRunnerTest, JsfWithoutAValidHeadingTakesTheCourseOverGround) {
     {
       std::ofstream out(path, std::ios::binary);
       std::mt19937 random(9);
-      std::exponential_distribution<double> speckle(1.0);
       uint8_t sequence = 0;
       for (int i = 0; i < 600; ++i) {  // 150 s at 4 Hz, 1.5 m/s
         const double fix_s = std::floor(0.25 * i);
@@ -449,7 +467,6 @@ TEST_F(OfflineRunnerTest, JsfWithoutAValidHeadingTakesTheCourseOverGround) {
           record.channel = channel;
           record.ping_time_us = 1780300800000000LL + i * 250000LL;
           record.ping_number = static_cast<uint32_t>(i);
-          record.sample_interval_s = 4e-5;  // 3 cm
           record.validity = sss::sonar::kValidLatLon | sss::sonar::kValidAltitude | sss::sonar::kValidDepth |
                             sss::sonar::kValidSoundSpeed | (course_recorded ? sss::sonar::kValidCourse : 0);
           record.latitude_deg = geo.latitude_deg;
@@ -458,16 +475,7 @@ TEST_F(OfflineRunnerTest, JsfWithoutAValidHeadingTakesTheCourseOverGround) {
           record.altitude_m = 12.0;
           record.heading_rad = 0.0;  // no compass: the field is left 0
           record.course_rad = course_rad;
-          std::vector<float> magnitudes;
-          for (int k = 0; k < 2500; ++k) {
-            const double r = k * 0.03;
-            magnitudes.push_back(static_cast<float>((r < 12.0 ? 2.0 : 400.0 * 12.0 / r) * speckle(random)));
-          }
-          int16_t weighting = 0;
-          const auto codes = sss::edgetech::quantiseEnvelope(magnitudes, weighting);
-          record.weighting_factor = weighting;
-          const auto bytes = sss::edgetech::encodeSonarData(record, codes, sequence++);
-          out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+          writeJsfSeabedRecord(out, record, 12.0, random, sequence);
         }
       }
     }
@@ -490,12 +498,7 @@ TEST_F(OfflineRunnerTest, JsfWithoutAValidHeadingTakesTheCourseOverGround) {
     const auto dr = sss::eval::readTum(out_dir + "/dead_reckoning.tum");
     ASSERT_TRUE(dr.ok) << dr.error;
     ASSERT_GT(dr.poses.size(), 500u);
-    double worst_deg = 0.0;
-    for (const auto& pose : dr.poses) {
-      const Eigen::Matrix3d r = pose.T_world_body.rotation.toRotationMatrix();
-      const double heading_rad = std::atan2(r(1, 0), r(0, 0));
-      worst_deg = std::max(worst_deg, std::abs(std::remainder(heading_rad - course_rad, 2.0 * M_PI)) * 180.0 / M_PI);
-    }
+    const double worst_deg = worstHeadingErrorDeg(dr.poses, course_rad);
     std::printf("no compass, %s: heading worst %.2f deg off the 60 deg run\n",
                 course_recorded ? "course recorded" : "course from the track", worst_deg);
     // The recorded course: 60 in whole degrees. The track's: a JSF position is quantised to 1e-4 arc
@@ -533,13 +536,7 @@ TEST_F(OfflineRunnerTest, XtfWithHeadingZeroInEveryPingTakesTheTracksDirection) 
   EXPECT_EQ(result.summary.nav_headings_from_track, 400u);
   const auto dr = sss::eval::readTum(root_ + "/run_no_compass_xtf/dead_reckoning.tum");
   ASSERT_TRUE(dr.ok) << dr.error;
-  double worst_deg = 0.0;
-  for (const auto& pose : dr.poses) {
-    const Eigen::Matrix3d r = pose.T_world_body.rotation.toRotationMatrix();
-    worst_deg = std::max(worst_deg, std::abs(std::remainder(std::atan2(r(1, 0), r(0, 0)) - course_rad, 2.0 * M_PI)) *
-                                        180.0 / M_PI);
-  }
-  EXPECT_LT(worst_deg, 0.01);
+  EXPECT_LT(worstHeadingErrorDeg(dr.poses, course_rad), 0.01);
 }
 
 // The towed record of the real-file issue, rebuilt: an XTF in latitude/longitude with altitude and

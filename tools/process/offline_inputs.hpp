@@ -275,8 +275,8 @@ class EmbeddedNavigation {
     nav.utime_us = utime_us;
     nav.origin = origin_;
     nav.position_ned_m = plane_->toNed({side.latitude_deg, side.longitude_deg, side.depth_m});
-    fillAttitude(nav, side);
-    hold({std::move(nav), heading_from_track_}, Eigen::Vector2d(side.latitude_deg, side.longitude_deg));
+    const bool heading_from_track = fillAttitude(nav, side);
+    hold({std::move(nav), heading_from_track}, Eigen::Vector2d(side.latitude_deg, side.longitude_deg));
     return true;
   }
 
@@ -290,28 +290,25 @@ class EmbeddedNavigation {
     nav.utime_us = utime_us;
     nav.position_ned_m = Eigen::Vector3d(side.northing_m - projected_origin_->y(), side.easting_m - projected_origin_->x(),
                                          side.depth_m);
-    fillAttitude(nav, side);
-    hold({std::move(nav), heading_from_track_}, Eigen::Vector2d(side.northing_m, side.easting_m));
+    const bool heading_from_track = fillAttitude(nav, side);
+    hold({std::move(nav), heading_from_track}, Eigen::Vector2d(side.northing_m, side.easting_m));
     return true;
   }
-  void fillAttitude(NavInput& nav, const sss::sonar::SonarChannelRecord& side) {
+  // True when the header has no heading and the track's direction must stand in (emit).
+  bool fillAttitude(NavInput& nav, const sss::sonar::SonarChannelRecord& side) {
     nav.roll_rad = side.roll_rad;
     nav.pitch_rad = side.pitch_rad;
     nav.heading_rad = side.heading_rad;
-    // A header whose heading is flagged invalid (JSF validity bit 3 clear: a towfish without a
-    // compass) holds a 0 that would turn every image to north. The recorded course over ground
-    // stands in for it, else the track's own direction (emit); neither sees a crab angle.
-    heading_from_track_ = false;
-    if (!(side.validity & sss::sonar::kValidHeading)) {
-      if (side.validity & sss::sonar::kValidCourse) {
-        nav.heading_rad = side.course_rad;
-        ++headings_from_course_;
-      } else {
-        heading_from_track_ = true;
-      }
-    }
     nav.altitude_m = side.altitude_m;
     nav.altitude_valid = (side.validity & sss::sonar::kValidAltitude) != 0 && side.altitude_m > 0.0;
+    // A header whose heading is flagged invalid (JSF validity bit 3 clear: a towfish without a
+    // compass) holds a 0 that would turn every image to north. The recorded course over ground
+    // stands in for it, else the track's own direction; neither sees a crab angle.
+    if (side.validity & sss::sonar::kValidHeading) return false;
+    if (!(side.validity & sss::sonar::kValidCourse)) return true;
+    nav.heading_rad = side.course_rad;
+    ++headings_from_course_;
+    return false;
   }
   // A navigation sample on its way out; heading_from_track: its header had no heading of its own.
   struct Sample {
@@ -400,7 +397,6 @@ class EmbeddedNavigation {
   std::vector<Sample> held_;               // samples repeating last_new_'s position, after it in time
   std::vector<NavInput> ready_;
   uint64_t positions_interpolated_ = 0;
-  bool heading_from_track_ = false;        // the sample being built has no heading of its own
   std::deque<Eigen::Vector2d> track_;      // emitted positions of those, back to kCourseBaseM
   std::vector<NavInput> awaiting_course_;  // emitted before the track was kCourseBaseM long
   uint64_t headings_from_course_ = 0, headings_from_track_ = 0, headings_unknown_ = 0;

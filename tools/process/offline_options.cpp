@@ -39,8 +39,7 @@ sss::core::Status readOptions(const std::string& path, Options& options) {
     // XTF NavUnits as the file says (file), or forced: a header saying metres over pings in degrees.
     std::string nav_units = "file";
     sonar.optional("xtf_nav_units", nav_units, {oneOf({"file", "latlon", "metres"})});
-    if (nav_units == "latlon") options.xtf.nav_units = sss::xtf::kNavUnitsLatLon;
-    if (nav_units == "metres") options.xtf.nav_units = sss::xtf::kNavUnitsMetres;
+    options.xtf.nav_units = sss::xtf::xtfNavUnitsFromName(nav_units);
     ConfigSection ins = config.section("ins_bridge");
     sss::ins::readInsBridgeOptions(ins, options.ins);
     ConfigSection buffer = config.section("subframe_buffer");
