@@ -507,6 +507,51 @@ TEST_F(OfflineRunnerTest, JsfWithoutAValidHeadingTakesTheCourseOverGround) {
   }
 }
 
+// A JSF of the high frequency only (subsystem 21, the configuration's 20) is processed, and the
+// run says which subsystem it took; one holding two other frequencies (21 and 22) is not guessed
+// between: no pings, and the error names the records ignored and the key to set.
+TEST_F(OfflineRunnerTest, JsfOfAnotherFrequencyIsTakenAndTwoOthersAreNamed) {
+  const sss::core::LocalTangentPlane plane(43.1, 5.9);
+  auto write = [&](const std::string& path, const std::vector<uint8_t>& subsystems) {
+    std::ofstream out(path, std::ios::binary);
+    std::mt19937 random(10);
+    uint8_t sequence = 0;
+    for (int i = 0; i < 400; ++i) {  // 100 s at 4 Hz, 1.5 m/s east
+      const auto geo = plane.toGeodetic(Eigen::Vector3d(0.0, 0.375 * i, 0.0));
+      for (const uint8_t subsystem : subsystems) {
+        for (uint8_t channel : {sss::sonar::kChannelPort, sss::sonar::kChannelStarboard}) {
+          sss::sonar::SonarChannelRecord record;
+          record.subsystem = subsystem;
+          record.channel = channel;
+          record.ping_time_us = 1780300800000000LL + i * 250000LL;
+          record.ping_number = static_cast<uint32_t>(i);
+          record.validity = sss::sonar::kValidLatLon | sss::sonar::kValidHeading | sss::sonar::kValidAltitude |
+                            sss::sonar::kValidSoundSpeed;
+          record.latitude_deg = geo.latitude_deg;
+          record.longitude_deg = geo.longitude_deg;
+          record.altitude_m = 12.0;
+          record.heading_rad = 0.5 * M_PI;
+          writeJsfSeabedRecord(out, record, 12.0, random, sequence);
+        }
+      }
+    }
+  };
+  const std::string high = root_ + "/high_only.jsf", two = root_ + "/two_others.jsf";
+  write(high, {sss::sonar::kSubsystemSideScanHigh});
+  write(two, {sss::sonar::kSubsystemSideScanHigh, sss::sonar::kSubsystemSideScanHigh + 1});
+  const auto taken = runSonarFileOnly(high, root_ + "/run_high_only");
+  ASSERT_TRUE(taken.ok) << taken.error;
+  EXPECT_EQ(taken.summary.pings, 400u);
+  EXPECT_EQ(taken.summary.jsf_adopted_subsystem, sss::sonar::kSubsystemSideScanHigh);
+  EXPECT_NE(std::find_if(taken.summary.findings.begin(), taken.summary.findings.end(),
+                         [](const std::string& f) { return f.find("only of subsystem 21") != std::string::npos; }),
+            taken.summary.findings.end());
+  const auto refused = runSonarFileOnly(two, root_ + "/run_two_others");
+  EXPECT_FALSE(refused.ok);
+  EXPECT_NE(refused.error.find("1600 sonar records of other subsystems"), std::string::npos) << refused.error;
+  EXPECT_NE(refused.error.find("set sonar_driver.subsystem"), std::string::npos) << refused.error;
+}
+
 // The same fish in an XTF, which has no validity flags: its SensorHeading is 0 in every ping.
 // Exactly 0 is taken as no heading, and the track's direction stands in.
 TEST_F(OfflineRunnerTest, XtfWithHeadingZeroInEveryPingTakesTheTracksDirection) {

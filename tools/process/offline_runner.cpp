@@ -235,9 +235,9 @@ OfflineResult runOffline(const OfflineRequest& request) {
       result.error = "no usable pings in " + request.sonar_path;
       if (jsf_source && jsf_source->assemblerCounters().other_subsystem > 0) {
         result.error += ": " + std::to_string(jsf_source->assemblerCounters().other_subsystem) +
-                        " sonar records of other subsystems than sonar.subsystem (" +
+                        " sonar records of other subsystems than sonar_driver.subsystem (" +
                         std::to_string(options.sonar.assembler.subsystem) +
-                        ") were ignored; set sonar.subsystem to the side-scan frequency wanted (20 low, 21 high)";
+                        ") were ignored; set sonar_driver.subsystem to the side-scan frequency wanted (20 low, 21 high)";
       }
       return result;
     }

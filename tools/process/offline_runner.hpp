@@ -142,7 +142,7 @@ struct OfflineSummary {
   uint64_t nav_headings_from_course = 0;
   uint64_t nav_headings_from_track = 0;
   uint64_t nav_headings_unknown = 0;
-  // JSF: the side-scan subsystem used because the file holds none of sonar.subsystem (-1: none).
+  // JSF: the side-scan subsystem used because the file holds none of sonar_driver.subsystem (-1: none).
   int jsf_adopted_subsystem = -1;
   uint64_t survey_lines = 0;
   // Lines holding fewer pings than one full subframe: short lines, or the pieces a turn slower than

@@ -70,7 +70,7 @@ std::vector<std::string> explainRun(const OfflineSummary& s, const Options& opti
     findings.push_back(text);
   }
   if (s.jsf_adopted_subsystem >= 0) {
-    findings.push_back("the file holds no side-scan records of sonar.subsystem " +
+    findings.push_back("the file holds no side-scan records of sonar_driver.subsystem " +
                        std::to_string(options.sonar.assembler.subsystem) + ", only of subsystem " +
                        std::to_string(s.jsf_adopted_subsystem) + " (another frequency): that one was used");
   }
