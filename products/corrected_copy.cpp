@@ -109,10 +109,8 @@ Status writeCorrectedJsf(const std::string& in_path, const std::string& out_path
 }
 
 Status writeCorrectedXtf(const std::string& in_path, const std::string& out_path, const NavigationAt& navigation,
-                         CorrectedCopyCounters& counters, int xtf_pair_index) {
-  sss::xtf::XtfReaderOptions options;
-  options.pair_index = xtf_pair_index;
-  sss::xtf::XtfReader reader(in_path, options);
+                         CorrectedCopyCounters& counters, const sss::xtf::XtfReaderOptions& reader_options) {
+  sss::xtf::XtfReader reader(in_path, reader_options);
   if (!reader.isOpen()) {
     return Status::error(reader.error());
   }
@@ -139,6 +137,8 @@ Status writeCorrectedXtf(const std::string& in_path, const std::string& out_path
     fields.roll_deg = static_cast<float>(nav->roll_rad * kRadToDeg);
     fields.heading_deg = static_cast<float>(wrapDegrees(nav->heading_rad * kRadToDeg));
     sss::xtf::encodePingNavigation(fields, header.data());
+    const auto& side = ping.ping.port ? *ping.ping.port : *ping.ping.starboard;
+    if (side.layback_m > 0.0) sss::xtf::encodePingLayback(0.0f, header.data());
     if (!patch(out.get(), offset, header.data(), header.size())) {
       return fail(out, out_path, "cannot write " + out_path);
     }

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 
+#include "drivers/xtf/xtf_reader.hpp"
 #include "pipeline/core/status.hpp"
 
 namespace sss::products {
@@ -32,11 +33,13 @@ struct CorrectedCopyCounters {
 
 // Copies in_path to out_path, then rewrites the navigation of every ping the project's reader
 // finds (JSF type 80 messages; XTF sonar packets of the side-scan pair read). Fails with a message
-// when a file cannot be read or written; out_path is removed then.
+// when a file cannot be read or written; out_path is removed then. XTF: read with the run's reader
+// options; a ping whose Layback the reader applied gets Layback 0 in the copy, since the position
+// written is the fish's (a reader following Isis would move it back a second time).
 sss::core::Status writeCorrectedJsf(const std::string& in_path, const std::string& out_path,
                                     const NavigationAt& navigation, CorrectedCopyCounters& counters);
 sss::core::Status writeCorrectedXtf(const std::string& in_path, const std::string& out_path,
                                     const NavigationAt& navigation, CorrectedCopyCounters& counters,
-                                    int xtf_pair_index = 0);
+                                    const sss::xtf::XtfReaderOptions& reader_options = {});
 
 }  // namespace sss::products

@@ -41,6 +41,8 @@ std::string readNodeOptions(const std::string& config_path, NodeOptions& options
   std::string nav_units = "file";
   section.optional("xtf_nav_units", nav_units, {oneOf({"file", "latlon", "metres"})});
   options.input.xtf_nav_units = sss::xtf::xtfNavUnitsFromName(nav_units);
+  std::string layback = "auto";  // read so that one configuration serves sss-process as well
+  section.optional("xtf_layback", layback, {oneOf({"auto", "ignore"})});
   section.rejectUnknownKeys();
   return config.problemReport();
 }

@@ -56,6 +56,9 @@ struct SonarChannelRecord {
   double altitude_m = 0.0;
   double heading_rad = 0.0;        // [0, 2 pi)
   double course_rad = 0.0;         // course over ground [0, 2 pi), with kValidCourse (JSF)
+  // A towed sensor whose recorded position is the ship's: it trails that position by this many
+  // metres over the ground, along its heading (XTF Layback; 0: the position is the sensor's).
+  double layback_m = 0.0;
   double pitch_rad = 0.0;          // bow up positive
   double roll_rad = 0.0;           // port up positive
   std::vector<float> samples;      // envelope magnitude (JSF: 2^-N applied; I/Q: sqrt(I^2 + Q^2))

@@ -343,6 +343,11 @@ SonarDecodeResult decodeSonarPacket(const XtfFileInfo& info, const SonarDecodeOp
   }
   double sensor_y = readF64(p, offset::kSensorY);
   double sensor_x = readF64(p, offset::kSensorX);
+  const double ship_y = readF64(p, offset::kShipY);
+  const double ship_x = readF64(p, offset::kShipX);
+  // SensorY/X that are the ship's own (a writer copying the GPS without applying the layback).
+  const bool sensor_is_ship = sensor_y == ship_y && sensor_x == ship_x;
+  const bool ship_unset = ship_y == 0.0 && ship_x == 0.0;
   if (sensor_y == 0.0 && sensor_x == 0.0) {
     // No sensor position: the vessel's (a hull-mounted sonar, or a tow without layback).
     sensor_y = readF64(p, offset::kShipY);
@@ -363,6 +368,16 @@ SonarDecodeResult decodeSonarPacket(const XtfFileInfo& info, const SonarDecodeOp
     common.projected_position = true;
     common.northing_m = sensor_y;
     common.easting_m = sensor_x;
+  }
+  const float layback_m = readF32(p, offset::kLayback);
+  if (std::isfinite(layback_m) && layback_m > 0.0f && layback_m <= kMaxLaybackM &&
+      (common.validity & sss::sonar::kValidLatLon || common.projected_position)) {
+    if (result.ship_coordinates || sensor_is_ship || ship_unset) {
+      result.layback_to_apply = options.apply_layback;
+      if (options.apply_layback) common.layback_m = layback_m;
+    } else {
+      result.layback_in_position = true;
+    }
   }
   const float depth_m = readF32(p, offset::kSensorDepth);
   if (std::isfinite(depth_m)) {

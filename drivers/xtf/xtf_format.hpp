@@ -28,8 +28,11 @@
 //   14 Year u16  16 Month u8  17 Day u8  18 Hour u8  19 Minute u8  20 Second u8
 //   21 HSeconds u8 (1/100 s)  22 JulianDay u16  24 EventNumber u32  28 PingNumber u32
 //   32 SoundVelocity f32 ("m/s, Isis uses 750 (one way), some XTF files use 1500")
+//   128 ShipYcoordinate f64  136 ShipXcoordinate f64 (the vessel's, same units as the sensor's)
 //   160 SensorYcoordinate f64 (latitude deg, or northing m)  168 SensorXcoordinate f64 (longitude
-//   deg, or easting m)  192 SensorDepth f32 m  196 SensorPrimaryAltitude f32 m
+//   deg, or easting m)  184 Layback f32 m ("distance over ground from ship to fish. When this
+//   value is non-zero, Isis assumes that SensorYcoordinate and SensorXcoordinate need to be
+//   adjusted with the Layback", along the sensor heading)  192 SensorDepth f32 m  196 SensorPrimaryAltitude f32 m
 //   204 SensorPitch f32 deg (positive nose up)  208 SensorRoll f32 deg (positive: roll to
 //   starboard, i.e. starboard down)  212 SensorHeading f32 deg (from true north, clockwise)
 // Channel header XTFPINGCHANHEADER (64 bytes, one before each channel's samples):
@@ -111,6 +114,7 @@ constexpr size_t kShipY = 128;
 constexpr size_t kShipX = 136;
 constexpr size_t kSensorY = 160;
 constexpr size_t kSensorX = 168;
+constexpr size_t kLayback = 184;
 constexpr size_t kSensorDepth = 192;
 constexpr size_t kSensorPrimaryAltitude = 196;
 constexpr size_t kSensorPitch = 204;
@@ -188,7 +192,13 @@ struct SonarDecodeOptions {
   uint8_t subsystem = sss::sonar::kSubsystemSideScanLow;  // stamped on the records
   float fallback_sound_speed_m_s = 1500.0f;
   bool polar_as_signed = false;  // UniPolar = 0 channels carry signed samples (magnitude taken)
+  // Layback of a towfish whose SensorY/X are still the ship's: handed on in layback_m (see
+  // decodeSonarPacket); false: positions as recorded, Layback ignored.
+  bool apply_layback = true;
 };
+
+// Larger Layback values are not a tow cable's (deep tows run out a few km): ignored.
+constexpr float kMaxLaybackM = 10000.0f;
 
 struct SonarDecodeResult {
   std::optional<sss::sonar::DriverPing> ping;  // empty on error or when no chosen channel
@@ -196,8 +206,15 @@ struct SonarDecodeResult {
   bool no_selected_channel = false;  // valid packet without the chosen port or starboard
   bool sound_speed_fallback = false; // SoundVelocity unusable: the fallback was used
   bool ship_coordinates = false;     // SensorY/X unset: the ping has ShipY/X instead
+  bool layback_to_apply = false;     // Layback set over the ship's position: handed on in layback_m
+  bool layback_in_position = false;  // Layback set, SensorY/X already apart from ShipY/X: not applied again
 };
 // Decodes one whole sonar packet (header type 0) of `size` bytes (NumBytesThisRecord).
+// Layback: Isis, the format's owner, takes a non-zero Layback to mean that SensorY/X are the ship's
+// and still need moving back along the sensor heading. Writers that computed the fish's position
+// themselves leave SensorY/X apart from ShipY/X; those are used as they are. So the layback is
+// handed on (SonarChannelRecord::layback_m) when SensorY/X are unset (ShipY/X used), equal to
+// ShipY/X, or the only position there is.
 SonarDecodeResult decodeSonarPacket(const XtfFileInfo& info, const SonarDecodeOptions& options, const uint8_t* packet,
                                     size_t size);
 

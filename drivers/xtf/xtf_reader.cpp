@@ -107,6 +107,7 @@ void XtfReader::openWith() {
   decode_.subsystem = static_cast<uint8_t>(sss::sonar::kSubsystemSideScanLow + std::min(options_.pair_index, 1));
   decode_.fallback_sound_speed_m_s = options_.fallback_sound_speed_m_s;
   decode_.polar_as_signed = options_.polar_as_signed;
+  decode_.apply_layback = options_.apply_layback;
   consume(std::min(info_.header_bytes, buffer_.size() - start_));
   open_ = true;
 }
@@ -259,6 +260,8 @@ bool XtfReader::next(sss::sonar::DriverPing& ping) {
     }
     ++counters_.pings;
     if (result.ship_coordinates) ++counters_.pings_ship_coordinates;
+    if (result.layback_to_apply) ++counters_.pings_layback_to_apply;
+    if (result.layback_in_position) ++counters_.pings_layback_in_position;
     ping = std::move(*result.ping);
     last_ping_offset_ = packet_offset;
     return true;
@@ -295,6 +298,10 @@ std::string XtfReader::summary() const {
     types += (types.empty() ? "" : ", ") + std::to_string(type) + ": " + std::to_string(counters_.skipped_by_type[type]);
   }
   if (!types.empty()) text += " (" + types + ")";
+  if (counters_.pings_layback_to_apply > 0)
+    text += ", " + std::to_string(counters_.pings_layback_to_apply) + " pings with a Layback over the ship's position";
+  if (counters_.pings_layback_in_position > 0)
+    text += ", " + std::to_string(counters_.pings_layback_in_position) + " pings with a Layback already in SensorY/X";
   text += ", " + std::to_string(counters_.corruptRecords()) + " corrupt records (" +
           std::to_string(counters_.bad_headers) + " impossible headers, " + std::to_string(counters_.truncated_packets) +
           " truncated, " + std::to_string(counters_.sonar_decode_errors) + " undecodable), " +

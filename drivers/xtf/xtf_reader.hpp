@@ -30,6 +30,9 @@ struct XtfReaderOptions {
   // The file header's NavUnits, unless set here: kNavUnitsMetres (0) or kNavUnitsLatLon (3), for a
   // file whose header says one and whose pings hold the other (-1: as the file says).
   int nav_units = -1;
+  // A towfish's Layback over positions that are the ship's: handed on with the ping to be applied
+  // along the heading (SonarDecodeOptions::apply_layback; false: positions as recorded).
+  bool apply_layback = true;
   size_t read_chunk_bytes = 256 * 1024;
 };
 
@@ -53,6 +56,8 @@ struct XtfReaderCounters {
   uint64_t sound_speed_fallbacks = 0;   // pings that used fallback_sound_speed_m_s
   uint64_t navigation_packets = 0;      // attitude (3), navigation (42), raw position (107) decoded
   uint64_t pings_ship_coordinates = 0;  // pings positioned by ShipY/X (SensorY/X unset)
+  uint64_t pings_layback_to_apply = 0;  // Layback over the ship's position: handed on (layback_m)
+  uint64_t pings_layback_in_position = 0;  // Layback with SensorY/X apart from ShipY/X: already applied
   uint64_t bytes_before_first_packet = 0;  // header padding or an unexpected header size
   // Corrupt records in the file: impossible headers, truncated packets, undecodable pings.
   uint64_t corruptRecords() const { return bad_headers + truncated_packets + sonar_decode_errors; }

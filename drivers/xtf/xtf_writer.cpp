@@ -56,6 +56,8 @@ std::vector<uint8_t> encodeFileHeader(const XtfWriterOptions& options) {
   return bytes;
 }
 
+void encodePingLayback(float layback_m, uint8_t* p) { writeF32(p, offset::kLayback, layback_m); }
+
 void encodePingNavigation(const XtfPingInput& ping, uint8_t* p) {
   writeF64(p, offset::kSensorY, ping.sensor_y);
   writeF64(p, offset::kSensorX, ping.sensor_x);
@@ -95,6 +97,9 @@ std::vector<uint8_t> encodeSonarPacket(const XtfWriterOptions& options, const Xt
   writeU32(p, offset::kPingNumber, ping.ping_number);
   writeF32(p, offset::kSoundVelocity, ping.sound_velocity);
   writeF32(p, offset::kSensorPrimaryAltitude, ping.altitude_m);
+  writeF64(p, offset::kShipY, ping.ship_y);
+  writeF64(p, offset::kShipX, ping.ship_x);
+  encodePingLayback(ping.layback_m, p);
   encodePingNavigation(ping, p);
 
   size_t at = kPingHeaderBytes;

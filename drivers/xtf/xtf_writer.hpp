@@ -49,6 +49,9 @@ struct XtfPingInput {
   float pitch_deg = 0.0f;        // XTF: nose up positive
   float roll_deg = 0.0f;         // XTF: starboard down positive
   float heading_deg = 0.0f;      // clockwise from north
+  double ship_y = 0.0;           // ShipY/Xcoordinate: the vessel's position (0: unset)
+  double ship_x = 0.0;
+  float layback_m = 0.0f;        // Layback: a towfish's distance behind the ship (0: none)
   std::vector<XtfChannelData> channels;
 };
 
@@ -59,6 +62,8 @@ std::vector<uint8_t> encodeSonarPacket(const XtfWriterOptions& options, const Xt
 // Writes the ping header's navigation in place (packet = the packet start): SensorY/X, depth,
 // pitch, roll, heading; nothing else (the altitude is the sonar's own measurement).
 void encodePingNavigation(const XtfPingInput& ping, uint8_t* packet);
+// Writes the ping header's Layback in place.
+void encodePingLayback(float layback_m, uint8_t* packet);
 // A packet of another type (notes, attitude, ...) of total_bytes zero-filled bytes (>= 14).
 std::vector<uint8_t> encodeOtherPacket(uint8_t header_type, size_t total_bytes);
 

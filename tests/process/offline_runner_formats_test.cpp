@@ -584,6 +584,125 @@ TEST_F(OfflineRunnerTest, XtfWithHeadingZeroInEveryPingTakesTheTracksDirection) 
   EXPECT_LT(worstHeadingErrorDeg(dr.poses, course_rad), 0.01);
 }
 
+// A towfish 40 m behind the ship, recorded as Isis records a tow: SensorY/X are the ship's GPS
+// (equal to ShipY/X) and Layback says how far back the fish is. Every pose is the fish's, 40 m
+// back along the heading, and the run says so; with sonar_driver.xtf_layback: ignore the poses stay
+// on the ship's positions; a file whose writer already put the fish apart from the ship is not
+// moved a second time; the corrected copy holds the fish's position with Layback 0, so that a
+// reader following Isis does not move it back again.
+TEST_F(OfflineRunnerTest, TowfishLaybackOverTheShipsPositionPutsTheFishBehindTheShip) {
+  const sss::xtf::XtfWriterOptions options = sss::test::makeXtfOptions({100.0f}, 2, sss::xtf::kNavUnitsMetres);
+  const double course_rad = 60.0 * M_PI / 180.0, layback_m = 40.0, step_m = 1.5 * 0.25;
+  const Eigen::Vector2d along(std::cos(course_rad), std::sin(course_rad));  // north, east
+  const Eigen::Vector2d ship0(6580456.0, 650123.0);
+  auto write = [&](const std::string& path, bool fish_apart_from_ship, float heading_deg = 60.0f) {
+    sss::xtf::XtfWriter writer(path, options);
+    ASSERT_TRUE(writer.isOpen());
+    std::mt19937 random(8);
+    for (int i = 0; i < 400; ++i) {  // 100 s at 4 Hz, 1.5 m/s
+      const Eigen::Vector2d ship = ship0 + step_m * i * along;
+      const Eigen::Vector2d sensor = fish_apart_from_ship ? Eigen::Vector2d(ship - layback_m * along) : ship;
+      sss::xtf::XtfPingInput ping;
+      ping.ping_number = static_cast<uint32_t>(i);
+      ping.ping_time_us = 1780300800000000LL + i * 250000LL;
+      ping.sound_velocity = 750.0f;
+      ping.ship_y = ship.x();
+      ping.ship_x = ship.y();
+      ping.sensor_y = sensor.x();
+      ping.sensor_x = sensor.y();
+      ping.layback_m = static_cast<float>(layback_m);
+      ping.depth_m = 20.0f;
+      ping.altitude_m = 12.0f;
+      ping.heading_deg = heading_deg;
+      addSeabedChannels(ping, 2500, 0.03, 12.0, random);
+      ASSERT_TRUE(writer.write(ping));
+    }
+  };
+  // The worst distance of the run's DR poses from the ship's track moved back by `back_m`, in the
+  // frame of the first recorded position (the origin of a projected run).
+  auto worstFromTrack = [&](const std::string& dir, double back_m) {
+    const auto dr = sss::eval::readTum(dir + "/dead_reckoning.tum");
+    EXPECT_TRUE(dr.ok) << dr.error;
+    EXPECT_GT(dr.poses.size(), 300u);
+    double worst_m = 0.0;
+    for (const auto& pose : dr.poses) {
+      const double i = static_cast<double>(pose.utime_us - 1780300800000000LL) / 250000.0;
+      const Eigen::Vector2d expected = (step_m * i - back_m) * along;
+      worst_m = std::max(worst_m, (pose.T_world_body.translation.head<2>() - expected).norm());
+    }
+    return worst_m;
+  };
+  auto hasFinding = [](const sss::offline::OfflineResult& r, const std::string& text) {
+    return std::any_of(r.summary.findings.begin(), r.summary.findings.end(),
+                       [&](const std::string& f) { return f.find(text) != std::string::npos; });
+  };
+
+  const std::string ship_file = root_ + "/towed_ship_position.xtf";
+  write(ship_file, false);
+  sss::offline::OfflineRequest towed;
+  towed.sonar_path = ship_file;
+  towed.out_dir = root_ + "/run_towed_layback";
+  towed.write_mosaics = false;
+  towed.corrected_dir = towed.out_dir + "/corrected";
+  const auto applied = sss::offline::runOffline(towed);
+  ASSERT_TRUE(applied.ok) << applied.error;
+  EXPECT_EQ(applied.summary.xtf_layback_pings, 400u);
+  EXPECT_EQ(applied.summary.nav_laybacks_applied, 400u);
+  EXPECT_DOUBLE_EQ(applied.summary.nav_max_layback_m, layback_m);
+  EXPECT_TRUE(hasFinding(applied, "xtf_layback: ignore"));
+  EXPECT_LT(worstFromTrack(towed.out_dir, layback_m), 0.01);
+
+  // The corrected copy: the fish's position (the run's poses) and Layback 0.
+  const auto slam = sss::eval::readTum(towed.out_dir + "/slam.tum");
+  ASSERT_TRUE(slam.ok) << slam.error;
+  std::map<int64_t, Eigen::Vector3d> slam_at;
+  for (const auto& p : slam.poses) slam_at[p.utime_us] = p.T_world_body.translation;
+  sss::xtf::XtfReader copy(towed.corrected_dir + "/towed_ship_position.xtf");
+  ASSERT_TRUE(copy.isOpen()) << copy.error();
+  sss::sonar::DriverPing ping;
+  size_t compared = 0;
+  double worst_m = 0.0;
+  while (copy.next(ping)) {
+    const auto found = slam_at.find(ping.utime_us);
+    if (found == slam_at.end()) continue;
+    const auto& side = *ping.ping.port;
+    EXPECT_EQ(side.layback_m, 0.0);  // apart from the ship now: nothing left to apply
+    worst_m = std::max(worst_m, (Eigen::Vector2d(side.northing_m, side.easting_m) - ship0 - found->second.head<2>()).norm());
+    ++compared;
+  }
+  EXPECT_EQ(compared, applied.summary.pings_with_pose);
+  EXPECT_EQ(copy.counters().pings_layback_to_apply, 0u);
+  EXPECT_LT(worst_m, 1e-3);
+
+  const std::string config = root_ + "/layback_ignore.yaml";
+  std::ofstream(config) << "sonar_driver:\n  xtf_layback: ignore\n";
+  towed.config_path = config;
+  towed.out_dir = root_ + "/run_towed_ignore";
+  towed.corrected_dir.clear();
+  const auto ignored = sss::offline::runOffline(towed);
+  ASSERT_TRUE(ignored.ok) << ignored.error;
+  EXPECT_EQ(ignored.summary.nav_laybacks_applied, 0u);
+  EXPECT_FALSE(hasFinding(ignored, "layback"));
+  EXPECT_LT(worstFromTrack(towed.out_dir, 0.0), 0.01);
+
+  const std::string fish_file = root_ + "/towed_fish_position.xtf";
+  write(fish_file, true);
+  const auto as_recorded = runSonarFileOnly(fish_file, root_ + "/run_towed_fish");
+  ASSERT_TRUE(as_recorded.ok) << as_recorded.error;
+  EXPECT_EQ(as_recorded.summary.nav_laybacks_applied, 0u);
+  EXPECT_EQ(as_recorded.summary.xtf_layback_in_position_pings, 400u);
+  EXPECT_LT(worstFromTrack(root_ + "/run_towed_fish", 0.0), 0.01);  // origin: the fish's first position
+
+  // A towfish without a compass (heading 0 in every ping): moved back along the track's direction.
+  const std::string no_compass_file = root_ + "/towed_no_compass.xtf";
+  write(no_compass_file, false, 0.0f);
+  const auto along_track = runSonarFileOnly(no_compass_file, root_ + "/run_towed_no_compass");
+  ASSERT_TRUE(along_track.ok) << along_track.error;
+  EXPECT_EQ(along_track.summary.nav_headings_from_track, 400u);
+  EXPECT_EQ(along_track.summary.nav_laybacks_applied, 400u);
+  EXPECT_LT(worstFromTrack(root_ + "/run_towed_no_compass", layback_m), 0.01);
+}
+
 // The towed record of the real-file issue, rebuilt: an XTF in latitude/longitude with altitude and
 // depth 0 in every ping, 1446 pings along a 311 m line that curves through 30 degrees. Every ping
 // gets a pose, the bottom track gives the altitude, and the curve still makes subframes.

@@ -200,5 +200,58 @@ TEST(XtfFormat, DelayedRecordSpansTimeDurationFromTheDelay) {
   EXPECT_NEAR(port.slantRangeM(100), 80.0, 0.5 * spacing_m);
 }
 
+
+// Layback (Isis: "distance over ground from ship to fish"; non-zero means SensorY/X still need
+// moving back). Handed on with the ping when the sensor position is the ship's (SensorY/X equal to
+// ShipY/X, unset so that ShipY/X stand in, or no ShipY/X to tell); not when the writer already put
+// the fish apart from the ship; never with apply_layback false, a layback beyond kMaxLaybackM or no
+// position at all.
+TEST(XtfFormat, LaybackIsHandedOnOnlyOverTheShipsOwnPosition) {
+  const xtf::XtfWriterOptions options = test::makeXtfOptions({100.0f}, 2);
+  const std::vector<uint8_t> header = xtf::encodeFileHeader(options);
+  const sss::core::Result<xtf::XtfFileInfo> info = xtf::parseFileHeader(header.data(), header.size());
+  ASSERT_OK(info);
+  struct Case {
+    const char* name;
+    double sensor_y, sensor_x, ship_y, ship_x;
+    float layback_m;
+    bool apply;
+    double expected_layback_m;  // handed on
+    bool in_position;           // counted as applied by the writer
+  };
+  const double lat = 59.91, lon = 10.71;
+  const Case cases[] = {
+      {"sensor equal to ship", lat, lon, lat, lon, 42.5f, true, 42.5, false},
+      {"sensor unset, ship used", 0.0, 0.0, lat, lon, 42.5f, true, 42.5, false},
+      {"no ship position", lat, lon, 0.0, 0.0, 42.5f, true, 42.5, false},
+      {"fish already apart from the ship", lat - 3e-4, lon, lat, lon, 42.5f, true, 0.0, true},
+      {"ignored by configuration", lat, lon, lat, lon, 42.5f, false, 0.0, false},
+      {"no layback", lat, lon, lat, lon, 0.0f, true, 0.0, false},
+      {"negative layback", lat, lon, lat, lon, -5.0f, true, 0.0, false},
+      {"beyond any tow cable", lat, lon, lat, lon, 2.0f * xtf::kMaxLaybackM, true, 0.0, false},
+      {"no position at all", 0.0, 0.0, 0.0, 0.0, 42.5f, true, 0.0, false},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    xtf::XtfPingInput input = test::makeXtfPing(options, 1, 100);
+    input.sensor_y = c.sensor_y;
+    input.sensor_x = c.sensor_x;
+    input.ship_y = c.ship_y;
+    input.ship_x = c.ship_x;
+    input.layback_m = c.layback_m;
+    const std::vector<uint8_t> packet = xtf::encodeSonarPacket(options, input);
+    xtf::SonarDecodeOptions decode;
+    decode.port_channel = 0;
+    decode.starboard_channel = 1;
+    decode.apply_layback = c.apply;
+    const xtf::SonarDecodeResult result = xtf::decodeSonarPacket(*info, decode, packet.data(), packet.size());
+    ASSERT_TRUE(result.ping) << result.error;
+    EXPECT_FLOAT_EQ(result.ping->ping.port->layback_m, c.expected_layback_m);
+    EXPECT_FLOAT_EQ(result.ping->ping.starboard->layback_m, c.expected_layback_m);
+    EXPECT_EQ(result.layback_to_apply, c.expected_layback_m > 0.0);
+    EXPECT_EQ(result.layback_in_position, c.in_position);
+  }
+}
+
 }  // namespace
 }  // namespace sss

@@ -258,6 +258,11 @@ class EmbeddedNavigation {
   uint64_t headingsFromCourse() const { return headings_from_course_; }
   uint64_t headingsFromTrack() const { return headings_from_track_; }
   uint64_t headingsUnknown() const { return headings_unknown_; }
+  // Samples moved back by their towfish's layback (SonarChannelRecord::layback_m), the largest
+  // layback, and samples left at the ship's position for want of a heading to move them along.
+  uint64_t laybacksApplied() const { return laybacks_applied_; }
+  double maxLaybackM() const { return max_layback_m_; }
+  uint64_t laybacksWithoutHeading() const { return laybacks_without_heading_; }
   // Long enough that a JSF position's quantisation (1e-4 arc minute: 0.19 m) turns it by under a degree.
   static constexpr double kCourseBaseM = 10.0;
 
@@ -276,7 +281,7 @@ class EmbeddedNavigation {
     nav.origin = origin_;
     nav.position_ned_m = plane_->toNed({side.latitude_deg, side.longitude_deg, side.depth_m});
     const bool heading_from_track = fillAttitude(nav, side);
-    hold({std::move(nav), heading_from_track}, Eigen::Vector2d(side.latitude_deg, side.longitude_deg));
+    hold({std::move(nav), heading_from_track, side.layback_m}, Eigen::Vector2d(side.latitude_deg, side.longitude_deg));
     return true;
   }
 
@@ -291,7 +296,7 @@ class EmbeddedNavigation {
     nav.position_ned_m = Eigen::Vector3d(side.northing_m - projected_origin_->y(), side.easting_m - projected_origin_->x(),
                                          side.depth_m);
     const bool heading_from_track = fillAttitude(nav, side);
-    hold({std::move(nav), heading_from_track}, Eigen::Vector2d(side.northing_m, side.easting_m));
+    hold({std::move(nav), heading_from_track, side.layback_m}, Eigen::Vector2d(side.northing_m, side.easting_m));
     return true;
   }
   // True when the header has no heading and the track's direction must stand in (emit).
@@ -310,10 +315,12 @@ class EmbeddedNavigation {
     ++headings_from_course_;
     return false;
   }
-  // A navigation sample on its way out; heading_from_track: its header had no heading of its own.
+  // A navigation sample on its way out; heading_from_track: its header had no heading of its own;
+  // layback_m: the sensor trails the recorded (ship's) position by this much along its heading.
   struct Sample {
     NavInput nav;
     bool heading_from_track = false;
+    double layback_m = 0.0;
   };
   // recorded: the position as the file holds it (compared exactly: a repeat is the same bytes).
   void hold(Sample sample, const Eigen::Vector2d& recorded) {
@@ -348,6 +355,8 @@ class EmbeddedNavigation {
     for (Sample& h : held_) emit(std::move(h));
     held_.clear();
   }
+  // The distance travelled and the track's direction follow the recorded positions (the ship's,
+  // when a layback is applied): the layback moves a sample once its heading is final.
   void emit(Sample sample) {
     NavInput& nav = sample.nav;
     if (last_) distance_m_ += (nav.position_ned_m - *last_).head<2>().norm();
@@ -355,7 +364,7 @@ class EmbeddedNavigation {
     nav.distance_travelled_m = distance_m_;
     if (!sample.heading_from_track) {
       releaseAwaitingCourse();  // in time order (a file whose headers gain a heading part way)
-      ready_.push_back(std::move(nav));
+      release(std::move(sample));
       return;
     }
     // The direction from the newest earlier position at least kCourseBaseM behind: over one ping
@@ -363,13 +372,13 @@ class EmbeddedNavigation {
     track_.push_back(nav.position_ned_m.head<2>());
     while (track_.size() > 2 && (track_.back() - track_[1]).norm() >= kCourseBaseM) track_.pop_front();
     const Eigen::Vector2d travelled = track_.back() - track_.front();
-    awaiting_course_.push_back(std::move(nav));
+    awaiting_course_.push_back(std::move(sample));
     if (travelled.norm() >= kCourseBaseM) {
       const double course_rad = std::atan2(travelled.y(), travelled.x());
-      for (NavInput& waiting : awaiting_course_) {
-        waiting.heading_rad = course_rad < 0.0 ? course_rad + 2.0 * M_PI : course_rad;
+      for (Sample& waiting : awaiting_course_) {
+        waiting.nav.heading_rad = course_rad < 0.0 ? course_rad + 2.0 * M_PI : course_rad;
         ++headings_from_track_;
-        ready_.push_back(std::move(waiting));
+        release(std::move(waiting));
       }
       awaiting_course_.clear();
     } else if (awaiting_course_.size() >= kMaxHeldSamples) {
@@ -377,11 +386,24 @@ class EmbeddedNavigation {
     }
   }
   void releaseAwaitingCourse() {
-    for (NavInput& waiting : awaiting_course_) {
+    for (Sample& waiting : awaiting_course_) {
       ++headings_unknown_;
-      ready_.push_back(std::move(waiting));
+      if (waiting.layback_m > 0.0) ++laybacks_without_heading_;  // no direction to move it in
+      ready_.push_back(std::move(waiting.nav));
     }
     awaiting_course_.clear();
+  }
+  // Out with a final heading: a towfish whose position is the ship's is put layback_m behind it,
+  // along its heading (as Isis does with XTF's Layback; a cross-current's offset is not seen).
+  void release(Sample sample) {
+    if (sample.layback_m > 0.0) {
+      const double h = sample.nav.heading_rad;
+      sample.nav.position_ned_m.x() -= sample.layback_m * std::cos(h);
+      sample.nav.position_ned_m.y() -= sample.layback_m * std::sin(h);
+      ++laybacks_applied_;
+      max_layback_m_ = std::max(max_layback_m_, sample.layback_m);
+    }
+    ready_.push_back(std::move(sample.nav));
   }
   std::optional<Eigen::Vector2d> projected_origin_;
   sss::sonar::SonarChannelRecord last_side_;  // the last ping's header (depth, altitude, attitude)
@@ -398,8 +420,10 @@ class EmbeddedNavigation {
   std::vector<NavInput> ready_;
   uint64_t positions_interpolated_ = 0;
   std::deque<Eigen::Vector2d> track_;      // emitted positions of those, back to kCourseBaseM
-  std::vector<NavInput> awaiting_course_;  // emitted before the track was kCourseBaseM long
+  std::vector<Sample> awaiting_course_;    // emitted before the track was kCourseBaseM long
   uint64_t headings_from_course_ = 0, headings_from_track_ = 0, headings_unknown_ = 0;
+  uint64_t laybacks_applied_ = 0, laybacks_without_heading_ = 0;
+  double max_layback_m_ = 0.0;
   std::optional<Eigen::Vector3d> last_;
   double distance_m_ = 0.0;
 };

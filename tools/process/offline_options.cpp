@@ -40,6 +40,10 @@ sss::core::Status readOptions(const std::string& path, Options& options) {
     std::string nav_units = "file";
     sonar.optional("xtf_nav_units", nav_units, {oneOf({"file", "latlon", "metres"})});
     options.xtf.nav_units = sss::xtf::xtfNavUnitsFromName(nav_units);
+    // A towfish's Layback over SensorY/X that are the ship's: applied (auto) or not (ignore).
+    std::string layback = "auto";
+    sonar.optional("xtf_layback", layback, {oneOf({"auto", "ignore"})});
+    options.xtf.apply_layback = layback == "auto";
     ConfigSection ins = config.section("ins_bridge");
     sss::ins::readInsBridgeOptions(ins, options.ins);
     ConfigSection buffer = config.section("subframe_buffer");

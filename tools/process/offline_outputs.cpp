@@ -132,8 +132,7 @@ Status Runner::writeCorrectedCopy(const std::vector<sss::optimiser::StampedPose>
   sss::products::CorrectedCopyCounters counters;
   const Status written =
       hasExtension(request_.sonar_path, ".xtf")
-          ? sss::products::writeCorrectedXtf(request_.sonar_path, out_path, navigation, counters,
-                                             options_.xtf.pair_index)
+          ? sss::products::writeCorrectedXtf(request_.sonar_path, out_path, navigation, counters, options_.xtf)
           : sss::products::writeCorrectedJsf(request_.sonar_path, out_path, navigation, counters);
   if (!written) return written;
   summary_.corrected_copy = out_path;

@@ -120,12 +120,14 @@ OfflineResult runOffline(const OfflineRequest& request) {
   } else {
     std::unique_ptr<PingSource> pings;
     const JsfSource* jsf_source = nullptr;  // the JSF reader, when the file is one
+    const XtfSource* xtf_source = nullptr;  // the XTF reader, when the file is one
     if (hasExtension(request.sonar_path, ".xtf")) {
       auto xtf = std::make_unique<XtfSource>(request.sonar_path, options.xtf);
       if (!xtf->reader().isOpen()) {
         result.error = "cannot read " + request.sonar_path + ": " + xtf->reader().error();
         return result;
       }
+      xtf_source = xtf.get();
       pings = std::move(xtf);
     } else if (hasExtension(request.sonar_path, ".jsf")) {
       auto jsf = std::make_unique<JsfSource>(request.sonar_path, options.sonar);
@@ -228,6 +230,13 @@ OfflineResult runOffline(const OfflineRequest& request) {
       runner.summary().nav_headings_from_course = embedded->headingsFromCourse();
       runner.summary().nav_headings_from_track = embedded->headingsFromTrack();
       runner.summary().nav_headings_unknown = embedded->headingsUnknown();
+      runner.summary().nav_laybacks_applied = embedded->laybacksApplied();
+      runner.summary().nav_max_layback_m = embedded->maxLaybackM();
+      runner.summary().nav_laybacks_without_heading = embedded->laybacksWithoutHeading();
+    }
+    if (xtf_source) {
+      runner.summary().xtf_layback_pings = xtf_source->reader().counters().pings_layback_to_apply;
+      runner.summary().xtf_layback_in_position_pings = xtf_source->reader().counters().pings_layback_in_position;
     }
     faults += pings->faults() + (ins ? ins->faults() : 0);
     if (jsf_source) runner.summary().jsf_adopted_subsystem = jsf_source->assemblerCounters().adopted_subsystem;

@@ -142,6 +142,16 @@ struct OfflineSummary {
   uint64_t nav_headings_from_course = 0;
   uint64_t nav_headings_from_track = 0;
   uint64_t nav_headings_unknown = 0;
+  // Embedded navigation of a towfish whose recorded positions are the ship's (XTF Layback over
+  // SensorY/X equal to ShipY/X): samples moved back along their heading, the largest layback, and
+  // samples left at the ship's position (no heading). xtf_layback_pings: pings that carried such
+  // a layback (0 with sonar_driver.xtf_layback: ignore); xtf_layback_in_position_pings: a layback
+  // over SensorY/X apart from ShipY/X (the writer applied it: used as recorded).
+  uint64_t nav_laybacks_applied = 0;
+  double nav_max_layback_m = 0.0;
+  uint64_t nav_laybacks_without_heading = 0;
+  uint64_t xtf_layback_pings = 0;
+  uint64_t xtf_layback_in_position_pings = 0;
   // JSF: the side-scan subsystem used because the file holds none of sonar_driver.subsystem (-1: none).
   int jsf_adopted_subsystem = -1;
   uint64_t survey_lines = 0;
