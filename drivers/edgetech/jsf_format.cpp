@@ -70,6 +70,39 @@ std::vector<uint16_t> quantiseEnvelope(const std::vector<float>& magnitudes, int
   return codes;
 }
 
+namespace {
+// Seconds since 1970 of a calendar time given as the day of the year; 0 when it is impossible.
+int64_t calendarSeconds(int year, int day_of_year, int hour, int minute, int second) {
+  if (!(year >= 1970 && year <= 2200 && day_of_year >= 1 && day_of_year <= 366 && hour >= 0 && hour <= 23 &&
+        minute >= 0 && minute <= 59 && second >= 0 && second <= 60))
+    return 0;
+  tm calendar{};
+  calendar.tm_year = year - 1900;
+  calendar.tm_mon = 0;
+  calendar.tm_mday = day_of_year;  // timegm carries days past January into the right month
+  calendar.tm_hour = hour;
+  calendar.tm_min = minute;
+  calendar.tm_sec = second;
+  return static_cast<int64_t>(timegm(&calendar));
+}
+
+// Envelope (u16) or I/Q (2 x i16) samples scaled by 2^-weighting_factor.
+void decodeSamples(const uint8_t* samples, size_t num_samples, uint16_t data_format, int16_t weighting_factor,
+                   std::vector<float>& out) {
+  const double scale = std::ldexp(1.0, -weighting_factor);
+  out.resize(num_samples);
+  if (data_format == 0) {
+    for (size_t i = 0; i < num_samples; ++i) out[i] = static_cast<float>(readLe<uint16_t>(samples, 2 * i) * scale);
+  } else {
+    for (size_t i = 0; i < num_samples; ++i) {
+      const double in_phase = readLe<int16_t>(samples, 4 * i);
+      const double quadrature = readLe<int16_t>(samples, 4 * i + 2);
+      out[i] = static_cast<float>(std::hypot(in_phase, quadrature) * scale);
+    }
+  }
+}
+}  // namespace
+
 void encodeHeader(const JsfMessageHeader& header, uint8_t* bytes) {
   std::memset(bytes, 0, kJsfHeaderSize);
   writeLe<uint16_t>(bytes, 0, kJsfStartMarker);
@@ -183,19 +216,8 @@ sss::core::Result<SonarChannelRecord> decodeSonarData(const JsfMessageHeader& he
   if (seconds == 0) {
     // Before protocol 8 bytes 0-3 held a trace sequence number (always 0) and the time was only the
     // calendar: year, day of the year, hour, minute, second (MB-System reads such files so).
-    const int year = readLe<int16_t>(body, 156), day_of_year = readLe<int16_t>(body, 158);
-    const int hour = readLe<int16_t>(body, 160), minute = readLe<int16_t>(body, 162), second = readLe<int16_t>(body, 164);
-    if (year >= 1970 && year <= 2200 && day_of_year >= 1 && day_of_year <= 366 && hour >= 0 && hour <= 23 &&
-        minute >= 0 && minute <= 59 && second >= 0 && second <= 60) {
-      tm calendar{};
-      calendar.tm_year = year - 1900;
-      calendar.tm_mon = 0;
-      calendar.tm_mday = day_of_year;  // timegm carries days past January into the right month
-      calendar.tm_hour = hour;
-      calendar.tm_min = minute;
-      calendar.tm_sec = second;
-      seconds = static_cast<int64_t>(timegm(&calendar));
-    }
+    seconds = calendarSeconds(readLe<int16_t>(body, 156), readLe<int16_t>(body, 158), readLe<int16_t>(body, 160),
+                              readLe<int16_t>(body, 162), readLe<int16_t>(body, 164));
   }
   r.ping_time_us = seconds * 1000000 + static_cast<int64_t>(ms_today % 1000) * 1000;
   r.start_depth_samples = readLe<uint32_t>(body, 4);
@@ -258,19 +280,104 @@ sss::core::Result<SonarChannelRecord> decodeSonarData(const JsfMessageHeader& he
     return sss::core::Status::error("weighting factor " + std::to_string(r.weighting_factor) +
                                     " is outside [-30, 30]");
   }
-  const double scale = std::ldexp(1.0, -r.weighting_factor);
-  const uint8_t* samples = body + kSonarDataHeaderSize;
-  r.samples.resize(num_samples);
-  if (r.data_format == 0) {
-    for (size_t i = 0; i < num_samples; ++i) r.samples[i] = static_cast<float>(readLe<uint16_t>(samples, 2 * i) * scale);
-  } else {
-    for (size_t i = 0; i < num_samples; ++i) {
-      const double in_phase = readLe<int16_t>(samples, 4 * i);
-      const double quadrature = readLe<int16_t>(samples, 4 * i + 2);
-      r.samples[i] = static_cast<float>(std::hypot(in_phase, quadrature) * scale);
-    }
-  }
+  decodeSamples(body + kSonarDataHeaderSize, num_samples, r.data_format, r.weighting_factor, r.samples);
   return r;
+}
+
+sss::core::Result<SonarChannelRecord> decodeOldSideScanData(const JsfMessageHeader& header, const uint8_t* body,
+                                                            size_t body_size) {
+  if (body_size < kOldSideScanHeaderSize) {
+    return sss::core::Status::error("side-scan message 82 of " + std::to_string(body_size) +
+                                    " bytes is shorter than its 80-byte header");
+  }
+  SonarChannelRecord r;
+  r.subsystem = header.subsystem;
+  r.channel = header.channel;
+  r.ping_number = readLe<uint32_t>(body, 4);
+  const uint64_t num_samples = readLe<uint32_t>(body, 12);
+  r.sample_interval_s = readLe<uint32_t>(body, 16) * 1e-9;
+  r.start_depth_samples = readLe<uint32_t>(body, 20);
+  r.weighting_factor = readLe<int16_t>(body, 24);
+  r.data_format = readLe<uint16_t>(body, 36);
+  const int64_t seconds = calendarSeconds(readLe<int16_t>(body, 44), readLe<uint16_t>(body, 46),
+                                          readLe<uint16_t>(body, 48), readLe<uint16_t>(body, 50), readLe<uint16_t>(body, 52));
+  if (seconds == 0) {
+    return sss::core::Status::error("side-scan message 82 has an impossible date (year " +
+                                    std::to_string(readLe<int16_t>(body, 44)) + ", day " +
+                                    std::to_string(readLe<uint16_t>(body, 46)) + ")");
+  }
+  r.ping_time_us = seconds * 1000000 + static_cast<int64_t>(readLe<uint32_t>(body, 40) % 1000) * 1000;
+  constexpr double kMinutesToRad = kDegToRad / 60.0;
+  const int16_t heading_minutes = readLe<int16_t>(body, 54);
+  if (heading_minutes != 0) {
+    r.heading_rad = degrees0To360(heading_minutes / 60.0) * kDegToRad;
+    r.validity |= kValidHeading;
+  }
+  r.pitch_rad = readLe<int16_t>(body, 56) * kMinutesToRad;
+  r.roll_rad = readLe<int16_t>(body, 58) * kMinutesToRad;
+  r.validity |= kValidPitchRoll;
+  const uint32_t depth_cm = readLe<uint32_t>(body, 64);
+  if (depth_cm > 0 && depth_cm < 1200000) {  // within 12 km
+    r.depth_m = depth_cm * 0.01;
+    r.validity |= kValidDepth;
+  }
+  if (r.data_format != 0 && r.data_format != 1) {
+    return sss::core::Status::error("side-scan message 82 data format " + std::to_string(r.data_format) +
+                                    " is not supported (0 envelope, 1 I/Q)");
+  }
+  const uint64_t needed = kOldSideScanHeaderSize + num_samples * (r.data_format == 1 ? 4 : 2);
+  if (needed > body_size) {
+    return sss::core::Status::error("side-scan message 82 of " + std::to_string(num_samples) + " samples needs " +
+                                    std::to_string(needed) + " bytes, the message has " + std::to_string(body_size));
+  }
+  if (r.weighting_factor < -30 || r.weighting_factor > 30) {
+    return sss::core::Status::error("weighting factor " + std::to_string(r.weighting_factor) +
+                                    " is outside [-30, 30]");
+  }
+  decodeSamples(body + kOldSideScanHeaderSize, static_cast<size_t>(num_samples), r.data_format, r.weighting_factor,
+                r.samples);
+  return r;
+}
+
+std::vector<uint8_t> encodeOldSideScanData(const SonarChannelRecord& record, const std::vector<uint16_t>& envelope_codes,
+                                           uint8_t sequence) {
+  const size_t body_size = kOldSideScanHeaderSize + 2 * envelope_codes.size();
+  std::vector<uint8_t> bytes(kJsfHeaderSize + body_size, 0);
+  JsfMessageHeader header;
+  header.message_type = kJsfOldSideScanData;
+  header.subsystem = record.subsystem;
+  header.channel = record.channel;
+  header.sequence = sequence;
+  header.byte_count = static_cast<int32_t>(body_size);
+  encodeHeader(header, bytes.data());
+  uint8_t* b = bytes.data() + kJsfHeaderSize;
+  writeLe<uint16_t>(b, 0, record.subsystem);
+  writeLe<uint16_t>(b, 2, record.channel);
+  writeLe<uint32_t>(b, 4, record.ping_number);
+  writeLe<uint16_t>(b, 8, 1);  // packet 1
+  writeLe<uint32_t>(b, 12, static_cast<uint32_t>(envelope_codes.size()));
+  writeLe<uint32_t>(b, 16, static_cast<uint32_t>(std::llround(record.sample_interval_s * 1e9)));
+  writeLe<uint32_t>(b, 20, record.start_depth_samples);
+  writeLe<int16_t>(b, 24, record.weighting_factor);
+  writeLe<uint16_t>(b, 36, 0);  // envelope
+  const int64_t seconds = record.ping_time_us >= 0 ? record.ping_time_us / 1000000 : (record.ping_time_us - 999999) / 1000000;
+  const int64_t millis = (record.ping_time_us - seconds * 1000000) / 1000;
+  const time_t t = static_cast<time_t>(seconds);
+  tm utc{};
+  gmtime_r(&t, &utc);
+  writeLe<uint32_t>(b, 40, static_cast<uint32_t>(((utc.tm_hour * 60 + utc.tm_min) * 60 + utc.tm_sec) * 1000 + millis));
+  writeLe<int16_t>(b, 44, static_cast<int16_t>(utc.tm_year + 1900));
+  writeLe<uint16_t>(b, 46, static_cast<uint16_t>(utc.tm_yday + 1));
+  writeLe<uint16_t>(b, 48, static_cast<uint16_t>(utc.tm_hour));
+  writeLe<uint16_t>(b, 50, static_cast<uint16_t>(utc.tm_min));
+  writeLe<uint16_t>(b, 52, static_cast<uint16_t>(utc.tm_sec));
+  writeLe<int16_t>(b, 54, clampToInt16(degrees0To360(record.heading_rad * kRadToDeg) * 60.0));
+  writeLe<int16_t>(b, 56, clampToInt16(record.pitch_rad * kRadToDeg * 60.0));
+  writeLe<int16_t>(b, 58, clampToInt16(record.roll_rad * kRadToDeg * 60.0));
+  writeLe<uint32_t>(b, 64, static_cast<uint32_t>(std::max(0.0, std::round(record.depth_m * 100.0))));
+  uint8_t* samples = b + kOldSideScanHeaderSize;
+  for (size_t i = 0; i < envelope_codes.size(); ++i) writeLe<uint16_t>(samples, 2 * i, envelope_codes[i]);
+  return bytes;
 }
 
 }  // namespace sss::edgetech

@@ -1,5 +1,6 @@
-// EdgeTech JSF: the 16-byte message header and type 80 sonar data (one channel of one ping),
-// decoded into plain records and encoded back to the exact wire bytes. Little-endian throughout.
+// EdgeTech JSF: the 16-byte message header and type 80 sonar data (one channel of one ping; the
+// older side-scan message 82 as well), decoded into plain records and encoded back to the exact
+// wire bytes. Little-endian throughout.
 // Layout from EdgeTech's public JSF description (0023492) as collected in
 // shared/reference/sonar-formats.md.
 #pragma once
@@ -35,12 +36,16 @@ using sss::sonar::SonarChannelRecord;
 constexpr uint16_t kJsfStartMarker = 0x1601;
 constexpr size_t kJsfHeaderSize = 16;
 constexpr size_t kSonarDataHeaderSize = 240;
+// Message 82, the side-scan data message of older EdgeTech systems: an 80-byte header, then the
+// samples as in type 80.
+constexpr size_t kOldSideScanHeaderSize = 80;
 // No 2205 message comes near this: 2 channels are separate messages, 65535 samples of I/Q are
 // 256 KiB. A larger byte count is corrupt and must not make us allocate.
 constexpr int32_t kMaxJsfBodyBytes = 4 * 1024 * 1024;
 
 enum JsfMessageType : uint16_t {
   kJsfSonarData = 80,
+  kJsfOldSideScanData = 82,
   kJsfNmea = 2002,
   kJsfPitchRoll = 2020,
   kJsfPressure = 2060,
@@ -86,5 +91,24 @@ void encodeHeader(const JsfMessageHeader& header, uint8_t* bytes);
 // body is too short for its header or its samples, or the data format is unknown.
 sss::core::Result<SonarChannelRecord> decodeSonarData(const JsfMessageHeader& header, const uint8_t* body,
                                                       size_t body_size);
+
+// Message 82 (older side-scan systems), header laid out as MB-System's mbsys_jstar.h reads it
+// (EdgeTech's public description of the older protocol): 0 subsystem u16  2 channel u16  4 ping
+// number u32  8 packet number u16  10 trigger source u16  12 samples u32  16 sample interval ns u32
+// 20 start depth (window offset) in samples u32  24 weighting factor i16 (samples x 2^-N)  26 ADC
+// gain  28 ADC max  30 range setting (m x 10)  32 pulse id  34 mark number  36 data format u16 (0
+// envelope, 1 I/Q)  38 reserved  40 milliseconds today u32  44 year i16  46 day of the year u16
+// 48 hour  50 minute  52 second  54 heading i16 (minutes of arc)  56 pitch i16 (minutes, bow up +)
+// 58 roll i16 (minutes, port up +)  60 heave i16 cm  62 yaw i16 minutes  64 vehicle depth u32 cm
+// 68 temperature  70-79 reserved. No position, altitude, sound speed or frequency: the position
+// comes from the file's NMEA (2002) or situation (2090/2091) messages, the altitude from the bottom
+// track. A heading of exactly 0 is taken as none (no validity flags), as in XTF.
+sss::core::Result<SonarChannelRecord> decodeOldSideScanData(const JsfMessageHeader& header, const uint8_t* body,
+                                                            size_t body_size);
+// The exact wire bytes of one message 82 (envelope format) from u16 codes, for tests and the
+// emulators: time, ping number, sample interval, start depth, weighting factor, heading, pitch, roll
+// (rounded to minutes of arc) and depth (to cm) from the record.
+std::vector<uint8_t> encodeOldSideScanData(const SonarChannelRecord& record, const std::vector<uint16_t>& envelope_codes,
+                                           uint8_t sequence = 0);
 
 }  // namespace sss::edgetech

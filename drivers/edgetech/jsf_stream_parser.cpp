@@ -28,10 +28,25 @@ bool JsfStreamParser::plausibleHeader(const JsfMessageHeader& h) const {
     const bool known_subsystem = h.subsystem == 0 || (h.subsystem >= 20 && h.subsystem <= 22);
     return known_subsystem && h.channel <= 1 && h.byte_count >= static_cast<int32_t>(kSonarDataHeaderSize);
   }
+  if (h.message_type == kJsfOldSideScanData) {
+    return h.channel <= 1 && h.byte_count >= static_cast<int32_t>(kOldSideScanHeaderSize);
+  }
   return h.message_type != 0;
 }
 
+bool JsfStreamParser::sonarHeaderAvailable(const JsfMessageHeader& header, size_t body_bytes) {
+  return (header.message_type == kJsfSonarData && body_bytes >= kSonarDataHeaderSize) ||
+         (header.message_type == kJsfOldSideScanData && body_bytes >= kOldSideScanHeaderSize);
+}
+
 bool JsfStreamParser::sonarSizeConsistent(const JsfMessageHeader& header, const uint8_t* body) {
+  if (header.message_type == kJsfOldSideScanData) {  // message 82: samples u32 at 12, format at 36
+    const uint64_t samples = static_cast<uint64_t>(body[12]) | static_cast<uint64_t>(body[13]) << 8 |
+                             static_cast<uint64_t>(body[14]) << 16 | static_cast<uint64_t>(body[15]) << 24;
+    const uint16_t format = static_cast<uint16_t>(body[36] | body[37] << 8);
+    return kOldSideScanHeaderSize + samples * (format == 1 ? 4 : 2) == static_cast<uint64_t>(header.byte_count) ||
+           (format != 0 && format != 1);
+  }
   const size_t num_samples = (static_cast<size_t>(body[115]) << 8 | body[114]) | (static_cast<size_t>(body[17] & 0xF) << 16);
   const int16_t format = static_cast<int16_t>(body[34] | body[35] << 8);
   const size_t bytes_per_sample = format == 1 ? 4 : 2;  // other formats: sized as 16-bit samples
@@ -43,7 +58,7 @@ bool JsfStreamParser::plausibleHeaderAt(size_t position) const {
   if (position + kJsfHeaderSize > buffer_.size()) return false;
   const auto header = decodeHeader(buffer_.data() + position);
   if (!header || !plausibleHeader(*header)) return false;
-  if (header->message_type == kJsfSonarData && position + kJsfHeaderSize + kSonarDataHeaderSize <= buffer_.size()) {
+  if (sonarHeaderAvailable(*header, buffer_.size() - position - kJsfHeaderSize)) {
     return sonarSizeConsistent(*header, buffer_.data() + position + kJsfHeaderSize);
   }
   return true;
@@ -102,7 +117,7 @@ JsfStreamParser::Framing JsfStreamParser::frameOne(std::vector<JsfMessage>& out,
   const JsfMessageHeader header = *decodeHeader(buffer_.data() + start_);
   bool plausible = plausibleHeader(header);
   // Type 80 describes its own size: 240 + samples x bytes per sample must equal the byte count.
-  if (plausible && header.message_type == kJsfSonarData && available >= kJsfHeaderSize + kSonarDataHeaderSize) {
+  if (plausible && sonarHeaderAvailable(header, available - kJsfHeaderSize)) {
     plausible = sonarSizeConsistent(header, buffer_.data() + start_ + kJsfHeaderSize);
   }
   if (!plausible) {

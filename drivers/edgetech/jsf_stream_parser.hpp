@@ -53,6 +53,8 @@ class JsfStreamParser {
   bool plausibleHeaderAt(size_t position) const;
   // Position of the first plausible header in (from, to], or npos.
   size_t findPlausibleHeader(size_t from, size_t to) const;
+  // Sonar data (80) and older side-scan (82) describe their own size: the header, then samples.
+  static bool sonarHeaderAvailable(const JsfMessageHeader& header, size_t body_bytes);
   static bool sonarSizeConsistent(const JsfMessageHeader& header, const uint8_t* body);
   void skip(size_t count);
   void beginSkipping(const std::string& kind, const std::string& message);

@@ -53,12 +53,15 @@ void SonarDriver::handleMessages(int64_t host_utime_us, int64_t monotonic_us) {
       }
       continue;
     }
-    if (message.header.message_type != kJsfSonarData) {
+    const bool old_side_scan = message.header.message_type == kJsfOldSideScanData;
+    if (message.header.message_type != kJsfSonarData && !old_side_scan) {
       ++other_messages_;  // system info, bathymetry, ...: skipped by their byte count
       continue;
     }
+    if (old_side_scan) ++old_side_scan_messages_;
     sss::core::Result<SonarChannelRecord> decoded =
-        decodeSonarData(message.header, message.body.data(), message.body.size());
+        old_side_scan ? decodeOldSideScanData(message.header, message.body.data(), message.body.size())
+                      : decodeSonarData(message.header, message.body.data(), message.body.size());
     if (!decoded) {
       ++sonar_decode_errors_;
       if (!decode_error_reported_) {

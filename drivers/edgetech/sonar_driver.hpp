@@ -60,6 +60,8 @@ class SonarDriver {
   uint64_t sonarDecodeErrors() const { return sonar_decode_errors_; }
   uint64_t navigationMessages() const { return navigation_messages_; }
   uint64_t otherMessages() const { return other_messages_; }
+  // Side-scan messages of the older type 82 (decoded like type 80; they carry no position).
+  uint64_t oldSideScanMessages() const { return old_side_scan_messages_; }
   // The newest navigation message of the sonar's own sensors (2020/2080/2090/2091/2002).
   const std::optional<JsfNavigationRecord>& latestNavigation() const { return latest_navigation_; }
   // With keepNavigation(true), every navigation message decoded since the last call, in stream
@@ -87,6 +89,7 @@ class SonarDriver {
   uint64_t sonar_decode_errors_ = 0;
   uint64_t navigation_messages_ = 0;
   uint64_t other_messages_ = 0;
+  uint64_t old_side_scan_messages_ = 0;
   std::optional<JsfNavigationRecord> latest_navigation_;
   std::vector<JsfNavigationRecord> navigation_records_;
   bool keep_navigation_ = false;

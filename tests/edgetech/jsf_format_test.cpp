@@ -93,7 +93,7 @@ TEST(JsfFormat, DecodeGivesBackTheRecordWithinTheWireResolution) {
 // course over ground (whole degrees, signed, byte 192) comes back too.
 TEST(JsfFormat, RecordsBeforeProtocolEightTakeTheCalendarTime) {
   SonarChannelRecord sent = test::makeRecord(12, kChannelPort);
-  sent.ping_time_us = 1780387199987000LL;  // 2026-06-01T23:59:59.987Z: day 152
+  sent.ping_time_us = 1780387199987000LL;  // 2026-06-02T07:59:59.987Z: day 153
   sent.course_rad = 271.0 * M_PI / 180.0;
   std::vector<uint8_t> bytes = test::encodeRecord(sent, 10);
   const int32_t trace_sequence = 0;
@@ -171,6 +171,86 @@ TEST(JsfFormat, BadBodiesAreErrorsNotCrashes) {
   std::vector<uint8_t> wrong_marker = bytes;
   wrong_marker[1] = 0x17;
   EXPECT_FALSE(decodeHeader(wrong_marker.data()));
+}
+
+// Message 82 of older EdgeTech side-scan systems, at its byte offsets (MB-System's mbsys_jstar.h):
+// the 80-byte header and the samples. Time from the calendar fields and the milliseconds of the
+// day, heading, pitch and roll in minutes of arc, depth in cm, samples scaled by 2^-N; no position.
+TEST(JsfFormat, OlderSideScanMessage82DecodesAtItsByteOffsets) {
+  SonarChannelRecord sent;
+  sent.subsystem = kSubsystemSideScanHigh;
+  sent.channel = kChannelStarboard;
+  sent.ping_number = 4711;
+  sent.ping_time_us = 1780358399987000LL;  // 2026-06-01T23:59:59.987Z: day 152
+  sent.sample_interval_s = 2.5e-5;
+  sent.start_depth_samples = 12;
+  sent.heading_rad = 250.5 * M_PI / 180.0;
+  sent.pitch_rad = -1.5 * M_PI / 180.0;
+  sent.roll_rad = 2.25 * M_PI / 180.0;
+  sent.depth_m = 31.27;
+  sent.weighting_factor = 3;
+  const std::vector<uint16_t> codes = {0, 8, 800, 65535};
+  const std::vector<uint8_t> bytes = encodeOldSideScanData(sent, codes, 9);
+  ASSERT_EQ(bytes.size(), 16u + 80u + 8u);
+  EXPECT_EQ(at<uint16_t>(bytes, 4), 82);
+  EXPECT_EQ(bytes[7], kSubsystemSideScanHigh);
+  EXPECT_EQ(bytes[8], kChannelStarboard);
+  EXPECT_EQ(at<int32_t>(bytes, 12), 88);
+  const size_t b = 16;
+  EXPECT_EQ(at<uint32_t>(bytes, b + 4), 4711u);
+  EXPECT_EQ(at<uint32_t>(bytes, b + 12), 4u);        // samples
+  EXPECT_EQ(at<uint32_t>(bytes, b + 16), 25000u);    // ns
+  EXPECT_EQ(at<uint32_t>(bytes, b + 20), 12u);
+  EXPECT_EQ(at<int16_t>(bytes, b + 24), 3);
+  EXPECT_EQ(at<uint32_t>(bytes, b + 40), 86399987u);  // ms of the day
+  EXPECT_EQ(at<int16_t>(bytes, b + 44), 2026);
+  EXPECT_EQ(at<uint16_t>(bytes, b + 46), 152);
+  EXPECT_EQ(at<uint16_t>(bytes, b + 48), 23);
+  EXPECT_EQ(at<uint16_t>(bytes, b + 50), 59);
+  EXPECT_EQ(at<uint16_t>(bytes, b + 52), 59);
+  EXPECT_EQ(at<int16_t>(bytes, b + 54), 15030);       // 250.5 deg in minutes
+  EXPECT_EQ(at<int16_t>(bytes, b + 56), -90);
+  EXPECT_EQ(at<int16_t>(bytes, b + 58), 135);
+  EXPECT_EQ(at<uint32_t>(bytes, b + 64), 3127u);
+  EXPECT_EQ(at<uint16_t>(bytes, b + 80 + 6), 65535);
+
+  const auto header = decodeHeader(bytes.data());
+  ASSERT_TRUE(header);
+  const sss::core::Result<SonarChannelRecord> r = decodeOldSideScanData(*header, bytes.data() + 16, bytes.size() - 16);
+  ASSERT_OK(r);
+  EXPECT_EQ(r->subsystem, kSubsystemSideScanHigh);
+  EXPECT_EQ(r->channel, kChannelStarboard);
+  EXPECT_EQ(r->ping_number, 4711u);
+  EXPECT_EQ(r->ping_time_us, sent.ping_time_us);
+  EXPECT_DOUBLE_EQ(r->sample_interval_s, 2.5e-5);
+  EXPECT_EQ(r->start_depth_samples, 12u);
+  EXPECT_NEAR(r->heading_rad, sent.heading_rad, 1e-12);
+  EXPECT_NEAR(r->pitch_rad, sent.pitch_rad, 1e-12);
+  EXPECT_NEAR(r->roll_rad, sent.roll_rad, 1e-12);
+  EXPECT_NEAR(r->depth_m, 31.27, 1e-9);
+  EXPECT_EQ(r->validity, kValidHeading | kValidPitchRoll | kValidDepth);  // no position, altitude or sound speed
+  ASSERT_EQ(r->samples.size(), 4u);
+  EXPECT_FLOAT_EQ(r->samples[1], 1.0f);   // 8 x 2^-3
+  EXPECT_FLOAT_EQ(r->samples[3], 65535.0f / 8.0f);
+
+  // Heading exactly 0 is no heading (no validity flags); bad bodies are errors, not crashes.
+  SonarChannelRecord north = sent;
+  north.heading_rad = 0.0;
+  const std::vector<uint8_t> north_bytes = encodeOldSideScanData(north, codes);
+  const auto no_heading = decodeOldSideScanData(*header, north_bytes.data() + 16, north_bytes.size() - 16);
+  ASSERT_OK(no_heading);
+  EXPECT_FALSE(no_heading->validity & kValidHeading);
+  EXPECT_NE(decodeOldSideScanData(*header, bytes.data() + 16, 60).message().find("shorter than its 80-byte header"),
+            std::string::npos);
+  EXPECT_NE(decodeOldSideScanData(*header, bytes.data() + 16, 84).message().find("needs 88 bytes"), std::string::npos);
+  std::vector<uint8_t> odd = bytes;
+  odd[b + 36] = 7;
+  EXPECT_NE(decodeOldSideScanData(*header, odd.data() + 16, odd.size() - 16).message().find("format 7"), std::string::npos);
+  std::vector<uint8_t> no_date = bytes;
+  no_date[b + 46] = 0;
+  no_date[b + 47] = 0;  // day 0
+  EXPECT_NE(decodeOldSideScanData(*header, no_date.data() + 16, no_date.size() - 16).message().find("impossible date"),
+            std::string::npos);
 }
 
 }  // namespace

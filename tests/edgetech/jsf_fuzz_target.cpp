@@ -26,6 +26,10 @@ int fuzzJsf(const uint8_t* data, size_t size) {
     if (message.header.message_type == kJsfSonarData) {
       const sss::core::Result<SonarChannelRecord> result = decodeSonarData(message.header, message.body.data(), message.body.size());
       if (result) ++decoded;
+    } else if (message.header.message_type == kJsfOldSideScanData) {
+      const sss::core::Result<SonarChannelRecord> result =
+          decodeOldSideScanData(message.header, message.body.data(), message.body.size());
+      if (result) ++decoded;
     } else if (isNavigationType(message.header.message_type)) {
       static_cast<void>(decodeNavigation(message.header, message.body.data(), message.body.size()));
     }

@@ -172,6 +172,13 @@ TEST(JsfFuzzRegression, CorpusAndMutationsRunClean) {
     ++files;
   }
   EXPECT_GT(files, 0);
+  {
+    // The older side-scan message 82, port and starboard (bytes written from its public layout):
+    // both framed by their own sample count and decoded.
+    std::ifstream file(std::string(JSF_CORPUS_DIR) + "/old_side_scan_82", std::ios::binary);
+    const std::vector<uint8_t> bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(test::fuzzJsf(bytes.data(), bytes.size()), 2);
+  }
   // Deterministic mutations of a valid stream: flips, insertions, deletions.
   const std::vector<uint8_t> valid = test::concatenate(test::makeMessages(6, 200));
   EXPECT_EQ(test::fuzzJsf(valid.data(), valid.size()), 12);

@@ -74,7 +74,7 @@ class OfflineRunnerTest : public ::testing::Test {
                                 " --line-spacing-m 50 --seed 2 > " + root_ + "/sim.log 2>&1";
     ASSERT_EQ(std::system(command.c_str()), 0) << "sss-sim failed, see " << root_ << "/sim.log";
   }
-  static void TearDownTestSuite() { fs::remove_all(root_); }
+  static void TearDownTestSuite() { if (!std::getenv("SSS_KEEP_TEST_DIR")) fs::remove_all(root_); }
 
   static sss::offline::OfflineRequest request(const std::string& out) {
     sss::offline::OfflineRequest r;

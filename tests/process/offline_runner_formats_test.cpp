@@ -7,9 +7,9 @@
 namespace {
 
 // One JSF sonar data message of a seabed at altitude_m (3 cm samples, 1/range fall-off, one-look
-// speckle) with the record's header fields, appended to the file.
+// speckle) with the record's header fields, appended to the file: type 80, or the older type 82.
 void writeJsfSeabedRecord(std::ofstream& out, sss::sonar::SonarChannelRecord record, double altitude_m,
-                          std::mt19937& random, uint8_t& sequence) {
+                          std::mt19937& random, uint8_t& sequence, bool old_message = false) {
   std::exponential_distribution<double> speckle(1.0);
   record.sample_interval_s = 4e-5;  // 3 cm
   std::vector<float> magnitudes;
@@ -20,7 +20,8 @@ void writeJsfSeabedRecord(std::ofstream& out, sss::sonar::SonarChannelRecord rec
   int16_t weighting = 0;
   const auto codes = sss::edgetech::quantiseEnvelope(magnitudes, weighting);
   record.weighting_factor = weighting;
-  const auto bytes = sss::edgetech::encodeSonarData(record, codes, sequence++);
+  const auto bytes = old_message ? sss::edgetech::encodeOldSideScanData(record, codes, sequence++)
+                                 : sss::edgetech::encodeSonarData(record, codes, sequence++);
   out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
 }
 
@@ -365,8 +366,11 @@ TEST_F(OfflineRunnerTest, XtfNavigationPacketsOrShipCoordinatesPositionPingsWith
 // between them (latitude, longitude, depth, heading at 4 Hz, as the sonar's own INS sends), or
 // 2002 NMEA messages with GGA sentences: those messages are the navigation.
 TEST_F(OfflineRunnerTest, JsfSituationOrNmeaMessagesPositionPingsWithoutPosition) {
- for (const bool nmea : {false, true}) {
-  const std::string path = root_ + (nmea ? "/nmea.jsf" : "/situation.jsf");
+ // Situation (2090) or NMEA (2002) messages with type 80 side-scan; and NMEA with the older
+ // side-scan message 82, which has no position field at all.
+ for (const int mode : {0, 1, 2}) {
+  const bool nmea = mode >= 1, old_side_scan = mode == 2;
+  const std::string path = root_ + (old_side_scan ? "/old_side_scan.jsf" : nmea ? "/nmea.jsf" : "/situation.jsf");
   const sss::core::LocalTangentPlane plane(-12.5, 130.8);
   const double heading_rad = 250.0 * M_PI / 180.0;
   {
@@ -418,15 +422,20 @@ TEST_F(OfflineRunnerTest, JsfSituationOrNmeaMessagesPositionPingsWithoutPosition
         record.ping_number = static_cast<uint32_t>(i);
         record.validity = sss::sonar::kValidHeading | sss::sonar::kValidSoundSpeed;  // no position, no altitude
         record.heading_rad = heading_rad;
-        writeJsfSeabedRecord(out, record, 15.0, random, sequence);
+        writeJsfSeabedRecord(out, record, 15.0, random, sequence, old_side_scan);
       }
     }
   }
-  const std::string out_dir = root_ + (nmea ? "/run_nmea" : "/run_situation");
+  const std::string out_dir = root_ + (old_side_scan ? "/run_old_side_scan" : nmea ? "/run_nmea" : "/run_situation");
+  SCOPED_TRACE(out_dir);
   const auto result = runSonarFileOnly(path, out_dir);
   ASSERT_TRUE(result.ok) << result.error;
   const auto& s = result.summary;
   EXPECT_EQ(s.pings, 600u);
+  EXPECT_EQ(s.jsf_old_side_scan_messages, old_side_scan ? 1200u : 0u);
+  const auto dr = sss::eval::readTum(out_dir + "/dead_reckoning.tum");
+  ASSERT_TRUE(dr.ok) << dr.error;
+  EXPECT_LT(worstHeadingErrorDeg(dr.poses, heading_rad), 0.02) << "the ping headers' heading";
   EXPECT_GE(s.pings_with_pose, 570u) << "95 % of the pings";
   EXPECT_GE(s.nav_from_packets, 600u);
   EXPECT_GE(s.subframes, 2u);

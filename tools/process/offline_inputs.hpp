@@ -98,6 +98,7 @@ class JsfSource : public PingSource {
     return c.bad_headers + c.truncated_messages + driver_.sonarDecodeErrors();
   }
   const sss::edgetech::PingAssemblerCounters& assemblerCounters() const { return driver_.assemblerCounters(); }
+  uint64_t oldSideScanMessages() const { return driver_.oldSideScanMessages(); }
 
  private:
   std::ifstream file_;
@@ -258,6 +259,9 @@ class EmbeddedNavigation {
   uint64_t headingsFromCourse() const { return headings_from_course_; }
   uint64_t headingsFromTrack() const { return headings_from_track_; }
   uint64_t headingsUnknown() const { return headings_unknown_; }
+  // Samples before the first header with a heading (navigation messages ahead of the first ping):
+  // given that first heading.
+  uint64_t headingsFromNext() const { return headings_from_next_; }
   // Samples moved back by their towfish's layback (SonarChannelRecord::layback_m), the largest
   // layback, and samples left at the ship's position for want of a heading to move them along.
   uint64_t laybacksApplied() const { return laybacks_applied_; }
@@ -363,7 +367,14 @@ class EmbeddedNavigation {
     last_ = nav.position_ned_m;
     nav.distance_travelled_m = distance_m_;
     if (!sample.heading_from_track) {
-      releaseAwaitingCourse();  // in time order (a file whose headers gain a heading part way)
+      // In time order: samples still waiting for the track's direction (navigation messages before
+      // the first ping header, which gives the heading) take this first heading that came after them.
+      for (Sample& waiting : awaiting_course_) {
+        waiting.nav.heading_rad = nav.heading_rad;
+        ++headings_from_next_;
+        release(std::move(waiting));
+      }
+      awaiting_course_.clear();
       release(std::move(sample));
       return;
     }
@@ -421,7 +432,7 @@ class EmbeddedNavigation {
   uint64_t positions_interpolated_ = 0;
   std::deque<Eigen::Vector2d> track_;      // emitted positions of those, back to kCourseBaseM
   std::vector<Sample> awaiting_course_;    // emitted before the track was kCourseBaseM long
-  uint64_t headings_from_course_ = 0, headings_from_track_ = 0, headings_unknown_ = 0;
+  uint64_t headings_from_course_ = 0, headings_from_track_ = 0, headings_unknown_ = 0, headings_from_next_ = 0;
   uint64_t laybacks_applied_ = 0, laybacks_without_heading_ = 0;
   double max_layback_m_ = 0.0;
   std::optional<Eigen::Vector3d> last_;

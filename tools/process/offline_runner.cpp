@@ -230,6 +230,7 @@ OfflineResult runOffline(const OfflineRequest& request) {
       runner.summary().nav_headings_from_course = embedded->headingsFromCourse();
       runner.summary().nav_headings_from_track = embedded->headingsFromTrack();
       runner.summary().nav_headings_unknown = embedded->headingsUnknown();
+      runner.summary().nav_headings_from_next = embedded->headingsFromNext();
       runner.summary().nav_laybacks_applied = embedded->laybacksApplied();
       runner.summary().nav_max_layback_m = embedded->maxLaybackM();
       runner.summary().nav_laybacks_without_heading = embedded->laybacksWithoutHeading();
@@ -239,7 +240,10 @@ OfflineResult runOffline(const OfflineRequest& request) {
       runner.summary().xtf_layback_in_position_pings = xtf_source->reader().counters().pings_layback_in_position;
     }
     faults += pings->faults() + (ins ? ins->faults() : 0);
-    if (jsf_source) runner.summary().jsf_adopted_subsystem = jsf_source->assemblerCounters().adopted_subsystem;
+    if (jsf_source) {
+      runner.summary().jsf_adopted_subsystem = jsf_source->assemblerCounters().adopted_subsystem;
+      runner.summary().jsf_old_side_scan_messages = jsf_source->oldSideScanMessages();
+    }
     if (runner.summary().pings == 0) {
       result.error = "no usable pings in " + request.sonar_path;
       if (jsf_source && jsf_source->assemblerCounters().other_subsystem > 0) {

@@ -142,6 +142,8 @@ struct OfflineSummary {
   uint64_t nav_headings_from_course = 0;
   uint64_t nav_headings_from_track = 0;
   uint64_t nav_headings_unknown = 0;
+  // Samples before the first header with a heading (navigation messages ahead of the first ping).
+  uint64_t nav_headings_from_next = 0;
   // Embedded navigation of a towfish whose recorded positions are the ship's (XTF Layback over
   // SensorY/X equal to ShipY/X): samples moved back along their heading, the largest layback, and
   // samples left at the ship's position (no heading). xtf_layback_pings: pings that carried such
@@ -154,6 +156,8 @@ struct OfflineSummary {
   uint64_t xtf_layback_in_position_pings = 0;
   // JSF: the side-scan subsystem used because the file holds none of sonar_driver.subsystem (-1: none).
   int jsf_adopted_subsystem = -1;
+  // JSF side-scan messages of the older type 82 (no position of their own: NMEA, situation or --ins).
+  uint64_t jsf_old_side_scan_messages = 0;
   uint64_t survey_lines = 0;
   // Lines holding fewer pings than one full subframe: short lines, or the pieces a turn slower than
   // the turn-rate threshold is cut into (a new line at every max_heading_deviation_rad of heading).

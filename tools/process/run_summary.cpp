@@ -25,7 +25,12 @@ std::vector<std::string> explainRun(const OfflineSummary& s, const Options& opti
     const std::pair<uint64_t, std::string> causes[] = {
         {s.nav_from_packets > 0 ? 0 : s.pings_without_position,
          count(s.pings_without_position) + " of " + count(pings) + " ping headers carry no position: the file has no "
-         "navigation of its own; give the INS file with --ins"},
+         "navigation of its own" +
+             std::string(s.jsf_old_side_scan_messages > 0
+                             ? " (its side-scan is in the older JSF message 82, which has no position field, and "
+                               "it holds no NMEA or situation messages)"
+                             : "") +
+             "; give the INS file with --ins"},
         {fusion.dropped_no_altitude,
          count(fusion.dropped_no_altitude) + " of " + count(pings) + " pings have no altitude: the navigation and "
          "the ping headers carry none" +
@@ -324,11 +329,13 @@ sss::core::Status writeSummaryJson(const std::string& path, const OfflineRequest
   navigation_json["headings_from_course"] = jsonValue(s.nav_headings_from_course);
   navigation_json["headings_from_track"] = jsonValue(s.nav_headings_from_track);
   navigation_json["headings_unknown"] = jsonValue(s.nav_headings_unknown);
+  navigation_json["headings_from_next_header"] = jsonValue(s.nav_headings_from_next);
   // a towfish's layback applied to positions that were the ship's (XTF Layback)
   navigation_json["laybacks_applied"] = jsonValue(s.nav_laybacks_applied);
   navigation_json["max_layback_m"] = jsonValue(s.nav_max_layback_m);
   navigation_json["laybacks_without_heading"] = jsonValue(s.nav_laybacks_without_heading);
   navigation_json["xtf_layback_in_position"] = jsonValue(s.xtf_layback_in_position_pings);
+  json["jsf_old_side_scan_messages"] = jsonValue(s.jsf_old_side_scan_messages);
   json["jsf_subsystem_adopted"] = s.jsf_adopted_subsystem >= 0 ? jsonValue(static_cast<uint64_t>(s.jsf_adopted_subsystem)) : Json();
   navigation_json["samples_without_position"] = jsonValue(fusion.nav_without_position);
   Json& pings_dropped_json = (json["pings_dropped"] = Json::object());
