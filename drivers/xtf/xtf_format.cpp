@@ -488,6 +488,15 @@ SonarDecodeResult decodeSonarPacket(const XtfFileInfo& info, const SonarDecodeOp
       for (size_t s = 0; s < record.samples.size(); ++s) {
         record.samples[s] = sampleMagnitude(data + s * bytes_per_sample, channel.sample_type, as_signed);
       }
+      // EdgeTech (and Kongsberg SA) sonar types: the ADC's block floating point exponent, which
+      // changes with the gain from ping to ping; unscaled, the image has steps of powers of two.
+      const int16_t weight = static_cast<int16_t>(readU16(header, offset::kWeight));
+      if (sonarTypeUsesWeight(info.sonar_type) && weight != 0 && weight >= -30 && weight <= 30) {
+        const float scale = static_cast<float>(std::ldexp(1.0, -weight));
+        for (float& sample : record.samples) sample *= scale;
+        record.weighting_factor = weight;
+        result.weight_applied = true;
+      }
       side = std::move(record);
     }
     at += kPingChannelHeaderBytes + static_cast<size_t>(data_bytes);

@@ -41,6 +41,9 @@
 //   12 TimeDelay f32 s (ping to first sample)  16 TimeDuration f32 s ("range / 750 (one way)", so
 //   two-way travel time)  20 SecondsPerPing f32  24 ProcessingFlags u16  26 Frequency u16
 //   42 NumSamples u32 (0 in old files: the count was CHANINFO.Reserved at byte 8)
+//   58 Weight i16 ("weighting factor passed by some sonars, this value is mandatory for Edgetech
+//   digital sonars types 24, 35, 38, 48 and Kongsberg SA type 48": the samples are scaled by
+//   2^-Weight, as JSF's weighting factor)
 #pragma once
 
 #include <cstddef>
@@ -127,6 +130,7 @@ constexpr size_t kTimeDelay = 12;
 constexpr size_t kTimeDuration = 16;
 constexpr size_t kChanFrequency = 26;
 constexpr size_t kNumSamples = 42;
+constexpr size_t kWeight = 58;
 }  // namespace offset
 
 enum class SampleType { kUnsigned8, kUnsigned16, kUnsigned32, kFloat32, kIbmFloat32, kUnsupported };
@@ -197,6 +201,11 @@ struct SonarDecodeOptions {
   bool apply_layback = true;
 };
 
+// SonarType values (file header, byte 34) whose channel Weight scales the samples by 2^-Weight.
+inline bool sonarTypeUsesWeight(uint16_t sonar_type) {
+  return sonar_type == 24 || sonar_type == 35 || sonar_type == 38 || sonar_type == 48;
+}
+
 // Larger Layback values are not a tow cable's (deep tows run out a few km): ignored.
 constexpr float kMaxLaybackM = 10000.0f;
 
@@ -208,6 +217,7 @@ struct SonarDecodeResult {
   bool ship_coordinates = false;     // SensorY/X unset: the ping has ShipY/X instead
   bool layback_to_apply = false;     // Layback set over the ship's position: handed on in layback_m
   bool layback_in_position = false;  // Layback set, SensorY/X already apart from ShipY/X: not applied again
+  bool weight_applied = false;       // a chosen channel's samples scaled by 2^-Weight (sonarTypeUsesWeight)
 };
 // Decodes one whole sonar packet (header type 0) of `size` bytes (NumBytesThisRecord).
 // Layback: Isis, the format's owner, takes a non-zero Layback to mean that SensorY/X are the ship's

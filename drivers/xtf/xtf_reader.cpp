@@ -261,6 +261,7 @@ bool XtfReader::next(sss::sonar::DriverPing& ping) {
     ++counters_.pings;
     if (result.ship_coordinates) ++counters_.pings_ship_coordinates;
     if (result.layback_to_apply) ++counters_.pings_layback_to_apply;
+    if (result.weight_applied) ++counters_.pings_weighted;
     if (result.layback_in_position) ++counters_.pings_layback_in_position;
     ping = std::move(*result.ping);
     last_ping_offset_ = packet_offset;
@@ -300,6 +301,9 @@ std::string XtfReader::summary() const {
   if (!types.empty()) text += " (" + types + ")";
   if (counters_.pings_layback_to_apply > 0)
     text += ", " + std::to_string(counters_.pings_layback_to_apply) + " pings with a Layback over the ship's position";
+  if (counters_.pings_weighted > 0)
+    text += ", " + std::to_string(counters_.pings_weighted) + " pings scaled by their channels' Weight (sonar type " +
+            std::to_string(info_.sonar_type) + ")";
   if (counters_.pings_layback_in_position > 0)
     text += ", " + std::to_string(counters_.pings_layback_in_position) + " pings with a Layback already in SensorY/X";
   text += ", " + std::to_string(counters_.corruptRecords()) + " corrupt records (" +

@@ -58,6 +58,7 @@ struct XtfReaderCounters {
   uint64_t pings_ship_coordinates = 0;  // pings positioned by ShipY/X (SensorY/X unset)
   uint64_t pings_layback_to_apply = 0;  // Layback over the ship's position: handed on (layback_m)
   uint64_t pings_layback_in_position = 0;  // Layback with SensorY/X apart from ShipY/X: already applied
+  uint64_t pings_weighted = 0;          // samples scaled by 2^-Weight (EdgeTech sonar types)
   uint64_t bytes_before_first_packet = 0;  // header padding or an unexpected header size
   // Corrupt records in the file: impossible headers, truncated packets, undecodable pings.
   uint64_t corruptRecords() const { return bad_headers + truncated_packets + sonar_decode_errors; }

@@ -35,6 +35,7 @@ std::vector<uint8_t> encodeFileHeader(const XtfWriterOptions& options) {
   writeString(bytes.data() + 10, "1", 8);
   writeString(bytes.data() + 18, options.sonar_name, 16);
   writeU16(bytes.data(), offset::kNavUnits, options.nav_units);
+  writeU16(bytes.data(), 34, options.sonar_type);
   uint16_t sonar = 0;
   uint16_t bathymetry = 0;
   for (const XtfWriterChannel& c : options.channels) (c.type_of_channel == kChannelBathymetry ? bathymetry : sonar)++;
@@ -119,6 +120,7 @@ std::vector<uint8_t> encodeSonarPacket(const XtfWriterOptions& options, const Xt
       writeU16(header, offset::kChanFrequency, static_cast<uint16_t>(options.channels[channel.channel_number].frequency));
     }
     writeU32(header, offset::kNumSamples, static_cast<uint32_t>(channel.samples.size()));
+    writeU16(header, offset::kWeight, static_cast<uint16_t>(channel.weight));
     at += kPingChannelHeaderBytes;
     for (const float sample : channel.samples) {
       writeSample(p + at, sample, bytes_per_sample);

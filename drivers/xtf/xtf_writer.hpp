@@ -26,6 +26,7 @@ struct XtfWriterOptions {
   uint16_t nav_units = kNavUnitsLatLon;
   std::string recording_program = "sss-slam";
   std::string sonar_name = "simulated";
+  uint16_t sonar_type = 0;  // SonarType (byte 34); EdgeTech types use each channel's Weight
 };
 
 // One channel of one ping as stored: samples are rounded and clamped to the channel's sample size.
@@ -34,6 +35,7 @@ struct XtfChannelData {
   float slant_range_m = 50.0f;
   float time_delay_s = 0.0f;
   float time_duration_s = 0.0f;  // 0: written as slant range / (SoundVelocity as stored)
+  int16_t weight = 0;            // Weight (byte 58): samples stand for sample x 2^-weight (sonarTypeUsesWeight)
   std::vector<float> samples;
 };
 

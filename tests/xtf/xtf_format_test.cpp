@@ -253,5 +253,38 @@ TEST(XtfFormat, LaybackIsHandedOnOnlyOverTheShipsOwnPosition) {
   }
 }
 
+// EdgeTech sonar types (24, 35, 38, 48) store the ADC's block floating point exponent in each
+// channel header's Weight, "mandatory" to apply: sample x 2^-Weight, as JSF's weighting factor. A
+// ping-to-ping change of Weight is then no step in the image. Other sonar types keep their samples
+// as stored whatever the field holds.
+TEST(XtfFormat, EdgeTechSonarTypesScaleSamplesByTheirWeight) {
+  for (const uint16_t sonar_type : {uint16_t{35}, uint16_t{0}}) {
+    SCOPED_TRACE(sonar_type);
+    xtf::XtfWriterOptions options = test::makeXtfOptions({100.0f}, 2);
+    options.sonar_type = sonar_type;
+    const std::vector<uint8_t> header = xtf::encodeFileHeader(options);
+    const sss::core::Result<xtf::XtfFileInfo> info = xtf::parseFileHeader(header.data(), header.size());
+    ASSERT_OK(info);
+    EXPECT_EQ(info->sonar_type, sonar_type);
+    for (const int16_t weight : {int16_t{0}, int16_t{3}, int16_t{-2}}) {
+      xtf::XtfPingInput input = test::makeXtfPing(options, 1, 100);
+      for (auto& channel : input.channels) channel.weight = weight;
+      const std::vector<uint8_t> packet = xtf::encodeSonarPacket(options, input);
+      xtf::SonarDecodeOptions decode;
+      decode.port_channel = 0;
+      decode.starboard_channel = 1;
+      const xtf::SonarDecodeResult result = xtf::decodeSonarPacket(*info, decode, packet.data(), packet.size());
+      ASSERT_TRUE(result.ping) << result.error;
+      const bool scaled = sonar_type == 35 && weight != 0;
+      EXPECT_EQ(result.weight_applied, scaled);
+      const double factor = scaled ? std::ldexp(1.0, -weight) : 1.0;
+      for (const size_t s : {size_t{1}, size_t{57}, size_t{99}}) {
+        EXPECT_FLOAT_EQ(result.ping->ping.port->samples[s], input.channels[0].samples[s] * factor) << s;
+        EXPECT_FLOAT_EQ(result.ping->ping.starboard->samples[s], input.channels[1].samples[s] * factor) << s;
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace sss
