@@ -63,7 +63,7 @@ double wrapDegrees(double degrees) {
 }  // namespace
 
 Status writeCorrectedJsf(const std::string& in_path, const std::string& out_path, const NavigationAt& navigation,
-                         CorrectedCopyCounters& counters) {
+                         CorrectedCopyCounters& counters, bool layback_applied) {
   sss::edgetech::JsfFileReader reader(in_path);
   if (!reader.isOpen()) {
     return Status::error(reader.error());
@@ -99,6 +99,7 @@ Status writeCorrectedJsf(const std::string& in_path, const std::string& out_path
     record.validity = validity;
     std::vector<uint8_t> header(message.body.begin(), message.body.begin() + sss::edgetech::kSonarDataHeaderSize);
     sss::edgetech::encodeSonarNavigation(record, header.data());
+    if (layback_applied) sss::edgetech::encodeSonarLayback(0.0f, header.data());
     if (!patch(out.get(), message.stream_offset + sss::edgetech::kJsfHeaderSize, header.data(), header.size())) {
       return fail(out, out_path, "cannot write " + out_path);
     }

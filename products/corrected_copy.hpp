@@ -36,8 +36,10 @@ struct CorrectedCopyCounters {
 // when a file cannot be read or written; out_path is removed then. XTF: read with the run's reader
 // options; a ping whose Layback the reader applied gets Layback 0 in the copy, since the position
 // written is the fish's (a reader following Isis would move it back a second time).
+// JSF: layback_applied (sonar_driver.jsf_layback: apply) writes layback 0 over the fish's position.
 sss::core::Status writeCorrectedJsf(const std::string& in_path, const std::string& out_path,
-                                    const NavigationAt& navigation, CorrectedCopyCounters& counters);
+                                    const NavigationAt& navigation, CorrectedCopyCounters& counters,
+                                    bool layback_applied = false);
 sss::core::Status writeCorrectedXtf(const std::string& in_path, const std::string& out_path,
                                     const NavigationAt& navigation, CorrectedCopyCounters& counters,
                                     const sss::xtf::XtfReaderOptions& reader_options = {});

@@ -130,6 +130,8 @@ std::optional<JsfMessageHeader> decodeHeader(const uint8_t* bytes) {
   return header;
 }
 
+void encodeSonarLayback(float layback_m, uint8_t* b) { writeLe<float>(b, 228, layback_m); }
+
 void encodeSonarNavigation(const SonarChannelRecord& record, uint8_t* b) {
   writeLe<uint16_t>(b, 30, record.validity);
   if (record.projected_position) {
@@ -197,6 +199,7 @@ std::vector<uint8_t> encodeSonarData(const SonarChannelRecord& record, const std
   const int64_t ms_today = (static_cast<int64_t>(utc.tm_hour) * 3600 + utc.tm_min * 60 + utc.tm_sec) * 1000 + micros / 1000;
   writeLe<uint32_t>(b, 200, static_cast<uint32_t>(ms_today));
   writeLe<int32_t>(b, 216, -1);  // spherical correction off
+  encodeSonarLayback(static_cast<float>(record.layback_m), b);
   uint8_t* samples = b + kSonarDataHeaderSize;
   for (size_t i = 0; i < num_samples; ++i) writeLe<uint16_t>(samples, 2 * i, envelope_codes[i]);
   return bytes;
@@ -258,6 +261,10 @@ sss::core::Result<SonarChannelRecord> decodeSonarData(const JsfMessageHeader& he
   r.weighting_factor = readLe<int16_t>(body, 168);
   r.heading_rad = readLe<uint16_t>(body, 172) * 0.01 * kDegToRad;
   r.course_rad = degrees0To360(readLe<int16_t>(body, 192)) * kDegToRad;  // whole degrees
+  // Layback (228, f32 m, "distance to the sonar"): as recorded; SonarDriverOptions::apply_layback
+  // decides whether it is handed on (the format does not say whose the position is).
+  const float layback_m = readLe<float>(body, 228);
+  if (std::isfinite(layback_m) && layback_m > 0.0f && layback_m <= 10000.0f) r.layback_m = layback_m;
   r.pitch_rad = readLe<int16_t>(body, 174) * kAngleScale * kDegToRad;
   r.roll_rad = readLe<int16_t>(body, 176) * kAngleScale * kDegToRad;
 

@@ -79,6 +79,9 @@ std::vector<uint8_t> encodeSonarData(const SonarChannelRecord& record, const std
 // depth (136), heading (172), pitch (174), roll (176). Nothing else is touched.
 void encodeSonarNavigation(const SonarChannelRecord& record, uint8_t* body);
 
+// Writes the layback (228, f32 m) of a type 80 body's header in place.
+void encodeSonarLayback(float layback_m, uint8_t* body);
+
 // Header from 16 bytes; nullopt when the start marker is wrong.
 std::optional<JsfMessageHeader> decodeHeader(const uint8_t* bytes);
 void encodeHeader(const JsfMessageHeader& header, uint8_t* bytes);
@@ -86,7 +89,8 @@ void encodeHeader(const JsfMessageHeader& header, uint8_t* bytes);
 // On the wire a type 80 header stores the ping time as seconds (offset 0) + milliseconds (200),
 // the sample interval in ns (116), frequencies in 10 Hz, the position in minutes of arc x 10000
 // (coordinate units 2) or mm (1), depth and altitude in mm, heading in 0.01 degree, pitch and roll
-// in 180/32768 degree; SonarChannelRecord holds them in plain units.
+// in 180/32768 degree; SonarChannelRecord holds them in plain units. The layback (228, f32 m, kept
+// when within (0, 10 km]) goes to layback_m as recorded.
 // Decodes a type 80 body (everything after the 16-byte header). Fails with the reason when the
 // body is too short for its header or its samples, or the data format is unknown.
 sss::core::Result<SonarChannelRecord> decodeSonarData(const JsfMessageHeader& header, const uint8_t* body,

@@ -71,6 +71,11 @@ void SonarDriver::handleMessages(int64_t host_utime_us, int64_t monotonic_us) {
       }
       continue;
     }
+    if (decoded->layback_m > 0.0) {
+      ++records_with_layback_;
+      max_layback_m_ = std::max(max_layback_m_, decoded->layback_m);
+      if (!options_.apply_layback) decoded->layback_m = 0.0;
+    }
     const SonarChannelRecord& r = *decoded;
     // The clock sees every channel: the end of acquisition is the last sample's time.
     const int64_t acquisition_us = static_cast<int64_t>(static_cast<double>(r.start_depth_samples + r.samples.size()) *
@@ -148,6 +153,9 @@ void readSonarDriverOptions(sss::core::ConfigSection& section, SonarDriverOption
   std::string time_source = options.time_source == TimeSource::kSonarClock ? "sonar" : "estimate";
   section.optional("time_source", time_source, {oneOf({"estimate", "sonar"})});
   options.time_source = time_source == "sonar" ? TimeSource::kSonarClock : TimeSource::kEstimateOffset;
+  std::string layback = options.apply_layback ? "apply" : "ignore";
+  section.optional("jsf_layback", layback, {oneOf({"ignore", "apply"})});
+  options.apply_layback = layback == "apply";
   section.optional("record_directory", options.recorder.directory);
   double record_max_file_mb = static_cast<double>(options.recorder.max_file_bytes) / (1024.0 * 1024.0);
   section.optional("record_max_file_mb", record_max_file_mb, {inRange(1.0, 1e6)});

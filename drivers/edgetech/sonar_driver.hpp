@@ -27,6 +27,11 @@ struct SonarDriverOptions {
   ClockOffsetOptions clock;
   RawRecorderOptions recorder;
   TimeSource time_source = TimeSource::kEstimateOffset;
+  // A towfish's layback in the type 80 headers (bytes 228-231). JSF does not say whether the
+  // header's position is the ship's GPS or the fish's: false (default) uses the positions as
+  // recorded and only counts the pings that carry one; true hands the layback on to be applied
+  // along the heading (SonarChannelRecord::layback_m), for files whose positions are the ship's.
+  bool apply_layback = false;
 };
 
 using sss::sonar::DriverPing;  // drivers/sonar/sonar_ping.hpp: what the driver hands out
@@ -62,6 +67,9 @@ class SonarDriver {
   uint64_t otherMessages() const { return other_messages_; }
   // Side-scan messages of the older type 82 (decoded like type 80; they carry no position).
   uint64_t oldSideScanMessages() const { return old_side_scan_messages_; }
+  // Side-scan records carrying a layback (applied or not, see apply_layback) and the largest.
+  uint64_t recordsWithLayback() const { return records_with_layback_; }
+  double maxLaybackM() const { return max_layback_m_; }
   // The newest navigation message of the sonar's own sensors (2020/2080/2090/2091/2002).
   const std::optional<JsfNavigationRecord>& latestNavigation() const { return latest_navigation_; }
   // With keepNavigation(true), every navigation message decoded since the last call, in stream
@@ -90,6 +98,8 @@ class SonarDriver {
   uint64_t navigation_messages_ = 0;
   uint64_t other_messages_ = 0;
   uint64_t old_side_scan_messages_ = 0;
+  uint64_t records_with_layback_ = 0;
+  double max_layback_m_ = 0.0;
   std::optional<JsfNavigationRecord> latest_navigation_;
   std::vector<JsfNavigationRecord> navigation_records_;
   bool keep_navigation_ = false;

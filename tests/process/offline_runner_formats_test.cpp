@@ -3,6 +3,7 @@
 // JSF situation or NMEA messages as the only navigation, a towed fish on a curved line.
 #include "tests/process/offline_runner_fixture.hpp"
 #include "tests/xtf/xtf_test_data.hpp"
+#include "drivers/edgetech/jsf_file_reader.hpp"
 
 namespace {
 
@@ -514,6 +515,93 @@ TEST_F(OfflineRunnerTest, JsfWithoutAValidHeadingTakesTheCourseOverGround) {
     // minute (0.19 m north, 0.14 m east here), which turns a 10 m base by up to ~0.9 deg.
     EXPECT_LT(worst_deg, course_recorded ? 0.01 : 1.0);
   }
+}
+
+// A towed JSF whose headers carry a 25 m layback (bytes 228-231). JSF does not say whether the
+// header's position is the ship's GPS or the fish's: by default the positions are used as recorded
+// and the run names the layback and the key; with sonar_driver.jsf_layback: apply the fish is put
+// 25 m back along its heading, and the corrected copy holds that position with layback 0.
+TEST_F(OfflineRunnerTest, JsfLaybackIsNamedAndAppliedOnRequest) {
+  const sss::core::LocalTangentPlane plane(43.1, 5.9);
+  const double heading_rad = 120.0 * M_PI / 180.0, layback_m = 25.0;
+  const Eigen::Vector2d along(std::cos(heading_rad), std::sin(heading_rad));
+  const std::string path = root_ + "/towed_layback.jsf";
+  {
+    std::ofstream out(path, std::ios::binary);
+    std::mt19937 random(12);
+    uint8_t sequence = 0;
+    for (int i = 0; i < 400; ++i) {  // 100 s at 4 Hz, 1.5 m/s
+      const Eigen::Vector2d ship = 0.375 * i * along;
+      const auto geo = plane.toGeodetic(Eigen::Vector3d(ship.x(), ship.y(), 0.0));
+      for (uint8_t channel : {sss::sonar::kChannelPort, sss::sonar::kChannelStarboard}) {
+        sss::sonar::SonarChannelRecord record;
+        record.channel = channel;
+        record.ping_time_us = 1780300800000000LL + i * 250000LL;
+        record.ping_number = static_cast<uint32_t>(i);
+        record.validity = sss::sonar::kValidLatLon | sss::sonar::kValidAltitude | sss::sonar::kValidDepth |
+                          sss::sonar::kValidSoundSpeed | sss::sonar::kValidHeading;
+        record.latitude_deg = geo.latitude_deg;
+        record.longitude_deg = geo.longitude_deg;
+        record.depth_m = 20.0;
+        record.altitude_m = 12.0;
+        record.heading_rad = heading_rad;
+        record.layback_m = layback_m;
+        writeJsfSeabedRecord(out, record, 12.0, random, sequence);
+      }
+    }
+  }
+  // The worst distance of the DR poses from the ship's track moved back by back_m (origin: the
+  // first recorded position).
+  auto worstFromTrack = [&](const std::string& dir, double back_m) {
+    const auto dr = sss::eval::readTum(dir + "/dead_reckoning.tum");
+    EXPECT_TRUE(dr.ok) << dr.error;
+    EXPECT_GT(dr.poses.size(), 300u);
+    double worst_m = 0.0;
+    for (const auto& pose : dr.poses) {
+      const double i = static_cast<double>(pose.utime_us - 1780300800000000LL) / 250000.0;
+      worst_m = std::max(worst_m, (pose.T_world_body.translation.head<2>() - (0.375 * i - back_m) * along).norm());
+    }
+    return worst_m;
+  };
+  auto finding = [](const sss::offline::OfflineResult& r, const std::string& text) {
+    return std::any_of(r.summary.findings.begin(), r.summary.findings.end(),
+                       [&](const std::string& f) { return f.find(text) != std::string::npos; });
+  };
+  const auto as_recorded = runSonarFileOnly(path, root_ + "/run_jsf_layback_ignored");
+  ASSERT_TRUE(as_recorded.ok) << as_recorded.error;
+  EXPECT_EQ(as_recorded.summary.jsf_records_with_layback, 800u);
+  EXPECT_DOUBLE_EQ(as_recorded.summary.jsf_max_layback_m, layback_m);
+  EXPECT_EQ(as_recorded.summary.nav_laybacks_applied, 0u);
+  EXPECT_TRUE(finding(as_recorded, "jsf_layback: apply"));
+  EXPECT_LT(worstFromTrack(root_ + "/run_jsf_layback_ignored", 0.0), 0.3);  // JSF positions: 1e-4 arc minute
+
+  const std::string config = root_ + "/jsf_layback_apply.yaml";
+  std::ofstream(config) << "sonar_driver:\n  jsf_layback: apply\n";
+  sss::offline::OfflineRequest apply;
+  apply.sonar_path = path;
+  apply.config_path = config;
+  apply.out_dir = root_ + "/run_jsf_layback_applied";
+  apply.write_mosaics = false;
+  apply.corrected_dir = apply.out_dir + "/corrected";
+  const auto applied = sss::offline::runOffline(apply);
+  ASSERT_TRUE(applied.ok) << applied.error;
+  EXPECT_GE(applied.summary.nav_laybacks_applied, 390u);
+  EXPECT_TRUE(finding(applied, "jsf_layback: ignore"));
+  EXPECT_LT(worstFromTrack(apply.out_dir, layback_m), 0.3);
+  // The corrected copy: layback 0 in every record it patched.
+  sss::edgetech::JsfFileReader copy(apply.corrected_dir + "/towed_layback.jsf");
+  ASSERT_TRUE(copy.isOpen()) << copy.error();
+  sss::edgetech::JsfMessage message;
+  size_t patched = 0, with_layback = 0;
+  while (copy.next(message)) {
+    if (message.header.message_type != sss::edgetech::kJsfSonarData) continue;
+    const auto record = sss::edgetech::decodeSonarData(message.header, message.body.data(), message.body.size());
+    ASSERT_TRUE(record.ok()) << record.message();
+    if (record->layback_m > 0.0) ++with_layback;
+    ++patched;
+  }
+  EXPECT_EQ(patched, 800u);
+  EXPECT_EQ(with_layback, 800u - applied.summary.corrected_records);
 }
 
 // A JSF of the high frequency only (subsystem 21, the configuration's 20) is processed, and the

@@ -99,6 +99,8 @@ class JsfSource : public PingSource {
   }
   const sss::edgetech::PingAssemblerCounters& assemblerCounters() const { return driver_.assemblerCounters(); }
   uint64_t oldSideScanMessages() const { return driver_.oldSideScanMessages(); }
+  uint64_t recordsWithLayback() const { return driver_.recordsWithLayback(); }
+  double maxLaybackM() const { return driver_.maxLaybackM(); }
 
  private:
   std::ifstream file_;

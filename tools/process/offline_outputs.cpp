@@ -133,7 +133,8 @@ Status Runner::writeCorrectedCopy(const std::vector<sss::optimiser::StampedPose>
   const Status written =
       hasExtension(request_.sonar_path, ".xtf")
           ? sss::products::writeCorrectedXtf(request_.sonar_path, out_path, navigation, counters, options_.xtf)
-          : sss::products::writeCorrectedJsf(request_.sonar_path, out_path, navigation, counters);
+          : sss::products::writeCorrectedJsf(request_.sonar_path, out_path, navigation, counters,
+                                             options_.sonar.apply_layback);
   if (!written) return written;
   summary_.corrected_copy = out_path;
   summary_.corrected_records = counters.records_corrected;

@@ -243,6 +243,8 @@ OfflineResult runOffline(const OfflineRequest& request) {
     if (jsf_source) {
       runner.summary().jsf_adopted_subsystem = jsf_source->assemblerCounters().adopted_subsystem;
       runner.summary().jsf_old_side_scan_messages = jsf_source->oldSideScanMessages();
+      runner.summary().jsf_records_with_layback = jsf_source->recordsWithLayback();
+      runner.summary().jsf_max_layback_m = jsf_source->maxLaybackM();
     }
     if (runner.summary().pings == 0) {
       result.error = "no usable pings in " + request.sonar_path;

@@ -158,6 +158,10 @@ struct OfflineSummary {
   int jsf_adopted_subsystem = -1;
   // JSF side-scan messages of the older type 82 (no position of their own: NMEA, situation or --ins).
   uint64_t jsf_old_side_scan_messages = 0;
+  // JSF side-scan records whose header carries a towfish layback, and the largest (applied only
+  // with sonar_driver.jsf_layback: apply).
+  uint64_t jsf_records_with_layback = 0;
+  double jsf_max_layback_m = 0.0;
   uint64_t survey_lines = 0;
   // Lines holding fewer pings than one full subframe: short lines, or the pieces a turn slower than
   // the turn-rate threshold is cut into (a new line at every max_heading_deviation_rad of heading).

@@ -79,17 +79,27 @@ std::vector<std::string> explainRun(const OfflineSummary& s, const Options& opti
                        std::to_string(options.sonar.assembler.subsystem) + ", only of subsystem " +
                        std::to_string(s.jsf_adopted_subsystem) + " (another frequency): that one was used");
   }
+  if (s.jsf_records_with_layback > 0 && !options.sonar.apply_layback) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.1f m", s.jsf_max_layback_m);
+    findings.push_back(count(s.jsf_records_with_layback) + " JSF side-scan records carry a towfish layback (up to " +
+                       std::string(text) + "); their positions are used as recorded. If those are the ship's GPS "
+                       "rather than the fish's, set sonar_driver.jsf_layback: apply to move the fish back along its "
+                       "heading");
+  }
   if (s.nav_laybacks_applied > 0 || s.nav_laybacks_without_heading > 0) {
     char text[160];
     std::snprintf(text, sizeof text, "%.1f m", s.nav_max_layback_m);
+    const bool jsf = s.jsf_records_with_layback > 0;
     findings.push_back(
-        "the file's positions are the ship's with a towfish layback (XTF Layback, up to " + std::string(text) +
-        ", SensorY/X equal to ShipY/X or unset): " + count(s.nav_laybacks_applied) +
-        " ping positions were moved back by it along the heading" +
+        "the file's positions are the ship's with a towfish layback (" +
+        std::string(jsf ? "JSF layback, up to " : "XTF Layback, up to ") + std::string(text) +
+        (jsf ? ", sonar_driver.jsf_layback: apply" : ", SensorY/X equal to ShipY/X or unset") + "): " +
+        count(s.nav_laybacks_applied) + " ping positions were moved back by it along the heading" +
         (s.nav_laybacks_without_heading > 0
              ? ", " + count(s.nav_laybacks_without_heading) + " left at the ship's for want of a heading"
              : std::string()) +
-        "; if they are already the fish's, set sonar_driver.xtf_layback: ignore");
+        "; if they are already the fish's, set sonar_driver." + (jsf ? "jsf_layback: ignore" : "xtf_layback: ignore"));
   }
   const uint64_t headings_missing = s.nav_headings_from_course + s.nav_headings_from_track + s.nav_headings_unknown;
   // A header or two (an XTF compass reading exactly north) is no missing compass.
@@ -336,6 +346,8 @@ sss::core::Status writeSummaryJson(const std::string& path, const OfflineRequest
   navigation_json["laybacks_without_heading"] = jsonValue(s.nav_laybacks_without_heading);
   navigation_json["xtf_layback_in_position"] = jsonValue(s.xtf_layback_in_position_pings);
   json["jsf_old_side_scan_messages"] = jsonValue(s.jsf_old_side_scan_messages);
+  json["jsf_records_with_layback"] = jsonValue(s.jsf_records_with_layback);
+  json["jsf_max_layback_m"] = jsonValue(s.jsf_max_layback_m);
   json["jsf_subsystem_adopted"] = s.jsf_adopted_subsystem >= 0 ? jsonValue(static_cast<uint64_t>(s.jsf_adopted_subsystem)) : Json();
   navigation_json["samples_without_position"] = jsonValue(fusion.nav_without_position);
   Json& pings_dropped_json = (json["pings_dropped"] = Json::object());
