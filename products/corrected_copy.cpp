@@ -63,7 +63,7 @@ double wrapDegrees(double degrees) {
 }  // namespace
 
 Status writeCorrectedJsf(const std::string& in_path, const std::string& out_path, const NavigationAt& navigation,
-                         CorrectedCopyCounters& counters, bool layback_applied) {
+                         CorrectedCopyCounters& counters, bool laybacks_applied) {
   sss::edgetech::JsfFileReader reader(in_path);
   if (!reader.isOpen()) {
     return Status::error(reader.error());
@@ -73,6 +73,7 @@ Status writeCorrectedJsf(const std::string& in_path, const std::string& out_path
   File out = std::move(*copy);
   sss::edgetech::JsfMessage message;
   while (reader.next(message)) {
+    if (message.header.message_type == sss::edgetech::kJsfOldSideScanData) ++counters.records_without_position_field;
     if (message.header.message_type != sss::edgetech::kJsfSonarData) continue;
     const sss::core::Result<sss::sonar::SonarChannelRecord> decoded =
         sss::edgetech::decodeSonarData(message.header, message.body.data(), message.body.size());
@@ -99,7 +100,7 @@ Status writeCorrectedJsf(const std::string& in_path, const std::string& out_path
     record.validity = validity;
     std::vector<uint8_t> header(message.body.begin(), message.body.begin() + sss::edgetech::kSonarDataHeaderSize);
     sss::edgetech::encodeSonarNavigation(record, header.data());
-    if (layback_applied) sss::edgetech::encodeSonarLayback(0.0f, header.data());
+    if (laybacks_applied && record.layback_m > 0.0) sss::edgetech::encodeSonarLayback(0.0f, header.data());
     if (!patch(out.get(), message.stream_offset + sss::edgetech::kJsfHeaderSize, header.data(), header.size())) {
       return fail(out, out_path, "cannot write " + out_path);
     }
@@ -110,7 +111,8 @@ Status writeCorrectedJsf(const std::string& in_path, const std::string& out_path
 }
 
 Status writeCorrectedXtf(const std::string& in_path, const std::string& out_path, const NavigationAt& navigation,
-                         CorrectedCopyCounters& counters, const sss::xtf::XtfReaderOptions& reader_options) {
+                         CorrectedCopyCounters& counters, const sss::xtf::XtfReaderOptions& reader_options,
+                         bool laybacks_applied) {
   sss::xtf::XtfReader reader(in_path, reader_options);
   if (!reader.isOpen()) {
     return Status::error(reader.error());
@@ -139,7 +141,7 @@ Status writeCorrectedXtf(const std::string& in_path, const std::string& out_path
     fields.heading_deg = static_cast<float>(wrapDegrees(nav->heading_rad * kRadToDeg));
     sss::xtf::encodePingNavigation(fields, header.data());
     const auto& side = ping.ping.port ? *ping.ping.port : *ping.ping.starboard;
-    if (side.layback_m > 0.0) sss::xtf::encodePingLayback(0.0f, header.data());
+    if (laybacks_applied && side.layback_m > 0.0) sss::xtf::encodePingLayback(0.0f, header.data());
     if (!patch(out.get(), offset, header.data(), header.size())) {
       return fail(out, out_path, "cannot write " + out_path);
     }

@@ -29,19 +29,22 @@ using NavigationAt = std::function<std::optional<PingNavigation>(int64_t utime_u
 struct CorrectedCopyCounters {
   uint64_t records_corrected = 0;  // JSF type 80 messages (one per channel) or XTF sonar packets
   uint64_t records_without_pose = 0;  // pings left with their recorded navigation (no pose at their time)
+  uint64_t records_without_position_field = 0;  // JSF message 82: no position to write (left as recorded)
 };
 
 // Copies in_path to out_path, then rewrites the navigation of every ping the project's reader
 // finds (JSF type 80 messages; XTF sonar packets of the side-scan pair read). Fails with a message
-// when a file cannot be read or written; out_path is removed then. XTF: read with the run's reader
-// options; a ping whose Layback the reader applied gets Layback 0 in the copy, since the position
-// written is the fish's (a reader following Isis would move it back a second time).
-// JSF: layback_applied (sonar_driver.jsf_layback: apply) writes layback 0 over the fish's position.
+// when a file cannot be read or written; out_path is removed then. laybacks_applied: the run moved
+// towfish positions back by their layback (summary navigation.laybacks_applied > 0); every record
+// whose layback the reader hands on (XTF: read with the run's reader options; JSF: the run applied
+// the JSF layback) then gets layback 0 in the copy, since the position written is the fish's and a
+// reader following Isis would move it back a second time.
 sss::core::Status writeCorrectedJsf(const std::string& in_path, const std::string& out_path,
                                     const NavigationAt& navigation, CorrectedCopyCounters& counters,
-                                    bool layback_applied = false);
+                                    bool laybacks_applied = false);
 sss::core::Status writeCorrectedXtf(const std::string& in_path, const std::string& out_path,
                                     const NavigationAt& navigation, CorrectedCopyCounters& counters,
-                                    const sss::xtf::XtfReaderOptions& reader_options = {});
+                                    const sss::xtf::XtfReaderOptions& reader_options = {},
+                                    bool laybacks_applied = false);
 
 }  // namespace sss::products

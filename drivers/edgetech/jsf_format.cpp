@@ -264,7 +264,7 @@ sss::core::Result<SonarChannelRecord> decodeSonarData(const JsfMessageHeader& he
   // Layback (228, f32 m, "distance to the sonar"): as recorded; SonarDriverOptions::apply_layback
   // decides whether it is handed on (the format does not say whose the position is).
   const float layback_m = readLe<float>(body, 228);
-  if (std::isfinite(layback_m) && layback_m > 0.0f && layback_m <= 10000.0f) r.layback_m = layback_m;
+  if (std::isfinite(layback_m) && layback_m > 0.0f && layback_m <= sss::sonar::kMaxLaybackM) r.layback_m = layback_m;
   r.pitch_rad = readLe<int16_t>(body, 174) * kAngleScale * kDegToRad;
   r.roll_rad = readLe<int16_t>(body, 176) * kAngleScale * kDegToRad;
 

@@ -1,6 +1,6 @@
 // JSF framing with resynchronisation, see jsf_stream_parser.hpp.
 //
-// A message is accepted when its header is plausible (byte count within the limit; for type 80
+// A message is accepted when its header is plausible (byte count within the limit; for types 80 and 82
 // the sample count agrees with the byte count) and either no plausible header starts inside its
 // body (a live stream hands out a ping as soon as its last byte arrives) or the bytes right
 // after its body start another plausible header. A header inside the body with a failed
@@ -29,7 +29,8 @@ bool JsfStreamParser::plausibleHeader(const JsfMessageHeader& h) const {
     return known_subsystem && h.channel <= 1 && h.byte_count >= static_cast<int32_t>(kSonarDataHeaderSize);
   }
   if (h.message_type == kJsfOldSideScanData) {
-    return h.channel <= 1 && h.byte_count >= static_cast<int32_t>(kOldSideScanHeaderSize);
+    const bool known_subsystem = h.subsystem == 0 || (h.subsystem >= 20 && h.subsystem <= 22);
+    return known_subsystem && h.channel <= 1 && h.byte_count >= static_cast<int32_t>(kOldSideScanHeaderSize);
   }
   return h.message_type != 0;
 }
@@ -116,7 +117,7 @@ JsfStreamParser::Framing JsfStreamParser::frameOne(std::vector<JsfMessage>& out,
 
   const JsfMessageHeader header = *decodeHeader(buffer_.data() + start_);
   bool plausible = plausibleHeader(header);
-  // Type 80 describes its own size: 240 + samples x bytes per sample must equal the byte count.
+  // Types 80 and 82 describe their own size: header + samples x bytes per sample must equal the byte count.
   if (plausible && sonarHeaderAvailable(header, available - kJsfHeaderSize)) {
     plausible = sonarSizeConsistent(header, buffer_.data() + start_ + kJsfHeaderSize);
   }

@@ -31,6 +31,9 @@ constexpr uint16_t kValidAltitude = 1u << 6;
 constexpr uint16_t kValidDepth = 1u << 9;
 constexpr uint16_t kValidSoundSpeed = 1u << 14;
 
+// Larger laybacks are not a tow cable's (deep tows run out a few km): readers ignore them.
+constexpr float kMaxLaybackM = 10000.0f;
+
 // One channel (port or starboard) of one ping.
 struct SonarChannelRecord {
   uint8_t subsystem = kSubsystemSideScanLow;
@@ -57,7 +60,8 @@ struct SonarChannelRecord {
   double heading_rad = 0.0;        // [0, 2 pi)
   double course_rad = 0.0;         // course over ground [0, 2 pi), with kValidCourse (JSF)
   // A towed sensor whose recorded position is the ship's: it trails that position by this many
-  // metres over the ground, along its heading (XTF Layback; 0: the position is the sensor's).
+  // metres over the ground, along its heading (XTF Layback, JSF layback with jsf_layback: apply;
+  // 0: the position is the sensor's).
   double layback_m = 0.0;
   double pitch_rad = 0.0;          // bow up positive
   double roll_rad = 0.0;           // port up positive

@@ -201,13 +201,13 @@ struct SonarDecodeOptions {
   bool apply_layback = true;
 };
 
-// SonarType values (file header, byte 34) whose channel Weight scales the samples by 2^-Weight.
+// SonarType values (file header, byte 34) whose channel Weight scales the samples by 2^-Weight:
+// EdgeTech's digital sonars (24, 35, 38) and 48 (EdgeTech, or Kongsberg SA, by the format's note).
 inline bool sonarTypeUsesWeight(uint16_t sonar_type) {
   return sonar_type == 24 || sonar_type == 35 || sonar_type == 38 || sonar_type == 48;
 }
 
-// Larger Layback values are not a tow cable's (deep tows run out a few km): ignored.
-constexpr float kMaxLaybackM = 10000.0f;
+using sss::sonar::kMaxLaybackM;
 
 struct SonarDecodeResult {
   std::optional<sss::sonar::DriverPing> ping;  // empty on error or when no chosen channel

@@ -434,6 +434,19 @@ TEST_F(OfflineRunnerTest, JsfSituationOrNmeaMessagesPositionPingsWithoutPosition
   const auto& s = result.summary;
   EXPECT_EQ(s.pings, 600u);
   EXPECT_EQ(s.jsf_old_side_scan_messages, old_side_scan ? 1200u : 0u);
+  if (old_side_scan) {
+    // Message 82 has no position field: a corrected copy cannot hold the track, and says so.
+    sss::offline::OfflineRequest copy;
+    copy.sonar_path = path;
+    copy.out_dir = out_dir + "_copy";
+    copy.write_mosaics = false;
+    copy.corrected_dir = copy.out_dir + "/corrected";
+    const auto copied = sss::offline::runOffline(copy);
+    ASSERT_TRUE(copied.ok) << copied.error;
+    EXPECT_EQ(copied.summary.corrected_records_without_position_field, 1200u);
+    EXPECT_TRUE(std::any_of(copied.summary.findings.begin(), copied.summary.findings.end(),
+                            [](const std::string& f) { return f.find("no position field") != std::string::npos; }));
+  }
   const auto dr = sss::eval::readTum(out_dir + "/dead_reckoning.tum");
   ASSERT_TRUE(dr.ok) << dr.error;
   EXPECT_LT(worstHeadingErrorDeg(dr.poses, heading_rad), 0.02) << "the ping headers' heading";
@@ -775,12 +788,20 @@ TEST_F(OfflineRunnerTest, TowfishLaybackOverTheShipsPositionPutsTheFishBehindThe
   std::ofstream(config) << "sonar_driver:\n  xtf_layback: ignore\n";
   towed.config_path = config;
   towed.out_dir = root_ + "/run_towed_ignore";
-  towed.corrected_dir.clear();
+  towed.corrected_dir = towed.out_dir + "/corrected";
   const auto ignored = sss::offline::runOffline(towed);
   ASSERT_TRUE(ignored.ok) << ignored.error;
   EXPECT_EQ(ignored.summary.nav_laybacks_applied, 0u);
   EXPECT_FALSE(hasFinding(ignored, "layback"));
   EXPECT_LT(worstFromTrack(towed.out_dir, 0.0), 0.01);
+  {
+    // Not applied: the copy keeps its Layback over the (ship's) positions it writes.
+    sss::xtf::XtfReader kept(towed.corrected_dir + "/towed_ship_position.xtf");
+    ASSERT_TRUE(kept.isOpen()) << kept.error();
+    while (kept.next(ping)) {
+    }
+    EXPECT_EQ(kept.counters().pings_layback_to_apply + kept.counters().pings_layback_in_position, 400u);
+  }
 
   const std::string fish_file = root_ + "/towed_fish_position.xtf";
   write(fish_file, true);

@@ -209,6 +209,7 @@ class EmbeddedNavigation {
     last_side_.heading_rad = side.heading_rad;
     last_side_.pitch_rad = side.pitch_rad;
     last_side_.roll_rad = side.roll_rad;
+    last_side_.layback_m = side.layback_m;  // a towfish's, for positions from navigation messages too
     return fromSide(driver_ping.utime_us, side);
   }
   // A navigation packet of an XTF whose pings carry no position (types 42 and 107 give one, 3
@@ -226,6 +227,7 @@ class EmbeddedNavigation {
     side.pitch_rad = packet_pitch_rad_.value_or(side.pitch_rad);
     side.roll_rad = packet_roll_rad_.value_or(side.roll_rad);
     side.heading_rad = packet_heading_rad_.value_or(side.heading_rad);
+    if (packet_heading_rad_) side.validity |= sss::sonar::kValidHeading;  // the packets' own heading
     side.depth_m = packet_depth_m_.value_or(side.depth_m);
     if (packet_altitude_m_ && *packet_altitude_m_ > 0.0) {
       side.altitude_m = *packet_altitude_m_;
@@ -261,8 +263,8 @@ class EmbeddedNavigation {
   uint64_t headingsFromCourse() const { return headings_from_course_; }
   uint64_t headingsFromTrack() const { return headings_from_track_; }
   uint64_t headingsUnknown() const { return headings_unknown_; }
-  // Samples before the first header with a heading (navigation messages ahead of the first ping):
-  // given that first heading.
+  // Samples without a heading of their own that took the next one to come (navigation messages
+  // ahead of the first ping header, or headers without a heading before a valid one).
   uint64_t headingsFromNext() const { return headings_from_next_; }
   // Samples moved back by their towfish's layback (SonarChannelRecord::layback_m), the largest
   // layback, and samples left at the ship's position for want of a heading to move them along.
@@ -369,8 +371,9 @@ class EmbeddedNavigation {
     last_ = nav.position_ned_m;
     nav.distance_travelled_m = distance_m_;
     if (!sample.heading_from_track) {
-      // In time order: samples still waiting for the track's direction (navigation messages before
-      // the first ping header, which gives the heading) take this first heading that came after them.
+      // In time order: samples still waiting for the track's direction (a navigation message before
+      // the first ping header that gives the heading, or headers without one before this) take this
+      // first heading that came after them rather than a 0 that turns their images to north.
       for (Sample& waiting : awaiting_course_) {
         waiting.nav.heading_rad = nav.heading_rad;
         ++headings_from_next_;

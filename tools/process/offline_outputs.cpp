@@ -132,12 +132,14 @@ Status Runner::writeCorrectedCopy(const std::vector<sss::optimiser::StampedPose>
   sss::products::CorrectedCopyCounters counters;
   const Status written =
       hasExtension(request_.sonar_path, ".xtf")
-          ? sss::products::writeCorrectedXtf(request_.sonar_path, out_path, navigation, counters, options_.xtf)
+          ? sss::products::writeCorrectedXtf(request_.sonar_path, out_path, navigation, counters, options_.xtf,
+                                             summary_.nav_laybacks_applied > 0)
           : sss::products::writeCorrectedJsf(request_.sonar_path, out_path, navigation, counters,
-                                             options_.sonar.apply_layback);
+                                             options_.sonar.apply_layback && summary_.nav_laybacks_applied > 0);
   if (!written) return written;
   summary_.corrected_copy = out_path;
   summary_.corrected_records = counters.records_corrected;
+  summary_.corrected_records_without_position_field = counters.records_without_position_field;
   summary_.corrected_records_without_pose = counters.records_without_pose;
   return Status::success();
 }

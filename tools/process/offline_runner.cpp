@@ -314,7 +314,14 @@ OfflineResult runOffline(const OfflineRequest& request) {
       summary.findings.push_back("no corrected copy of " + request.sonar_path +
                                  ": the mission frame has no position on Earth; set mission.origin_latitude_deg and "
                                  "origin_longitude_deg");
-    } else if (summary.corrected_records_without_pose > 0) {
+    }
+    if (summary.corrected_records_without_position_field > 0) {
+      summary.findings.push_back(std::to_string(summary.corrected_records_without_position_field) +
+                                 " side-scan records of " + summary.corrected_copy +
+                                 " are the older JSF message 82, which has no position field: they keep their "
+                                 "recorded navigation (use navigation.csv or navigation.nmea for the corrected track)");
+    }
+    if (!summary.corrected_copy.empty() && summary.corrected_records_without_pose > 0) {
       summary.findings.push_back(std::to_string(summary.corrected_records_without_pose) + " sonar records of " +
                                  summary.corrected_copy +
                                  " keep their recorded navigation: no pose at their time (before the navigation "

@@ -128,6 +128,7 @@ struct OfflineSummary {
   std::string corrected_copy;
   uint64_t corrected_records = 0;
   uint64_t corrected_records_without_pose = 0;
+  uint64_t corrected_records_without_position_field = 0;  // JSF message 82 records: left as recorded
   uint64_t input_faults = 0;       // corrupt records, bad messages, dropped pings
   // Where the pings went: the fusion's drops by cause and altitude sources, the line builder's.
   sss::subframe::SubframeBufferCounters buffer;
@@ -142,10 +143,12 @@ struct OfflineSummary {
   uint64_t nav_headings_from_course = 0;
   uint64_t nav_headings_from_track = 0;
   uint64_t nav_headings_unknown = 0;
-  // Samples before the first header with a heading (navigation messages ahead of the first ping).
+  // Samples without a heading of their own that took the next one to come (navigation messages
+  // ahead of the first ping header, or headers without a heading before a valid one).
   uint64_t nav_headings_from_next = 0;
   // Embedded navigation of a towfish whose recorded positions are the ship's (XTF Layback over
-  // SensorY/X equal to ShipY/X): samples moved back along their heading, the largest layback, and
+  // SensorY/X equal to ShipY/X, or the JSF layback with sonar_driver.jsf_layback: apply): samples
+  // moved back along their heading, the largest layback, and
   // samples left at the ship's position (no heading). xtf_layback_pings: pings that carried such
   // a layback (0 with sonar_driver.xtf_layback: ignore); xtf_layback_in_position_pings: a layback
   // over SensorY/X apart from ShipY/X (the writer applied it: used as recorded).

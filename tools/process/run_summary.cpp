@@ -82,7 +82,7 @@ std::vector<std::string> explainRun(const OfflineSummary& s, const Options& opti
   if (s.jsf_records_with_layback > 0 && !options.sonar.apply_layback) {
     char text[64];
     std::snprintf(text, sizeof text, "%.1f m", s.jsf_max_layback_m);
-    findings.push_back(count(s.jsf_records_with_layback) + " JSF side-scan records carry a towfish layback (up to " +
+    findings.push_back(count(s.jsf_records_with_layback) + " JSF sonar records carry a towfish layback (up to " +
                        std::string(text) + "); their positions are used as recorded. If those are the ship's GPS "
                        "rather than the fish's, set sonar_driver.jsf_layback: apply to move the fish back along its "
                        "heading");
@@ -340,10 +340,11 @@ sss::core::Status writeSummaryJson(const std::string& path, const OfflineRequest
   navigation_json["headings_from_track"] = jsonValue(s.nav_headings_from_track);
   navigation_json["headings_unknown"] = jsonValue(s.nav_headings_unknown);
   navigation_json["headings_from_next_header"] = jsonValue(s.nav_headings_from_next);
-  // a towfish's layback applied to positions that were the ship's (XTF Layback)
+  // a towfish's layback applied to positions that were the ship's (XTF Layback, JSF with jsf_layback: apply)
   navigation_json["laybacks_applied"] = jsonValue(s.nav_laybacks_applied);
   navigation_json["max_layback_m"] = jsonValue(s.nav_max_layback_m);
   navigation_json["laybacks_without_heading"] = jsonValue(s.nav_laybacks_without_heading);
+  navigation_json["xtf_layback_over_ship_position"] = jsonValue(s.xtf_layback_pings);
   navigation_json["xtf_layback_in_position"] = jsonValue(s.xtf_layback_in_position_pings);
   json["jsf_old_side_scan_messages"] = jsonValue(s.jsf_old_side_scan_messages);
   json["jsf_records_with_layback"] = jsonValue(s.jsf_records_with_layback);
