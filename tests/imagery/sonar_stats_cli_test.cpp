@@ -56,6 +56,8 @@ TEST(SonarStatsCli, SimulatedJsfGivesFiguresJsonAndAWaterfall) {
                     " --waterfall " + (dir / "w.png").string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("pings 81, range 75.0 m"), std::string::npos) << r.output;
+  // What the reader found: type 80 only, no layback (the simulator's AUV carries its sonar).
+  EXPECT_NE(r.output.find("older message 82: 0; records with a towfish layback: 0;"), std::string::npos) << r.output;
   std::ifstream json(dir / "s.json");
   const std::string text((std::istreambuf_iterator<char>(json)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("\"speckle_std_over_mean\""), std::string::npos);

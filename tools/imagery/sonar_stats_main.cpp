@@ -120,6 +120,7 @@ int main(int argc, char** argv) {
   if (!block.empty()) stats_options.block_pings = block[0], stats_options.block_samples = block[1];
 
   std::vector<sss::imagery::StatisticsPing> pings;
+  std::string file_facts;  // what the reader found in the file (formats, laybacks, older messages)
   const auto full = [&] { return max_pings > 0 && pings.size() >= static_cast<size_t>(max_pings); };
   if (endsWith(sonar_path, ".xtf")) {
     sss::xtf::XtfReaderOptions options;
@@ -132,6 +133,7 @@ int main(int argc, char** argv) {
     sss::sonar::DriverPing ping;
     while (!full() && reader.next(ping)) pings.push_back(toStatisticsPing(ping.ping));
     for (const std::string& fault : reader.takeNewFaultMessages()) std::cerr << "sss-sonar-stats: " << fault << "\n";
+    file_facts = reader.summary();
   } else {
     std::ifstream file(sonar_path, std::ios::binary);
     if (!file) {
@@ -158,6 +160,12 @@ int main(int argc, char** argv) {
       }
     }
     for (const std::string& fault : driver.takeNewFaultMessages()) std::cerr << "sss-sonar-stats: " << fault << "\n";
+    char layback[64];
+    std::snprintf(layback, sizeof layback, "%.1f m", driver.maxLaybackM());
+    file_facts = "JSF: side-scan records of the older message 82: " + std::to_string(driver.oldSideScanMessages()) +
+                 "; records with a towfish layback: " + std::to_string(driver.recordsWithLayback()) +
+                 (driver.recordsWithLayback() > 0 ? " (up to " + std::string(layback) + ")" : std::string()) +
+                 "; other messages: " + std::to_string(driver.otherMessages());
   }
   if (pings.empty()) {
     std::cerr << "sss-sonar-stats: " << sonar_path << " holds no side-scan ping"
@@ -166,7 +174,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   const sss::imagery::SonarStatistics stats = sss::imagery::computeSonarStatistics(pings, stats_options);
-  std::cout << sonar_path << ":\n" << sss::imagery::statisticsText(stats);
+  std::cout << sonar_path << ":\n" << file_facts << "\n" << sss::imagery::statisticsText(stats);
   if (!waterfall_path.empty() && !writeWaterfall(pings, waterfall_path)) {
     std::cerr << "sss-sonar-stats: cannot write " << waterfall_path << "\n";
     return 2;
