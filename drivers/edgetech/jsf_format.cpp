@@ -86,9 +86,13 @@ int64_t calendarSeconds(int year, int day_of_year, int hour, int minute, int sec
   return static_cast<int64_t>(timegm(&calendar));
 }
 
-// Envelope (u16) or I/Q (2 x i16) samples scaled by 2^-weighting_factor.
-void decodeSamples(const uint8_t* samples, size_t num_samples, uint16_t data_format, int16_t weighting_factor,
-                   std::vector<float>& out) {
+// Envelope (u16) or I/Q (2 x i16) samples scaled by 2^-weighting_factor (types 80 and 82).
+sss::core::Status decodeSamples(const uint8_t* samples, size_t num_samples, uint16_t data_format,
+                                int16_t weighting_factor, std::vector<float>& out) {
+  // 2^-N; N outside a sane range is corruption, not a gain setting.
+  if (weighting_factor < -30 || weighting_factor > 30) {
+    return sss::core::Status::error("weighting factor " + std::to_string(weighting_factor) + " is outside [-30, 30]");
+  }
   const double scale = std::ldexp(1.0, -weighting_factor);
   out.resize(num_samples);
   if (data_format == 0) {
@@ -100,6 +104,7 @@ void decodeSamples(const uint8_t* samples, size_t num_samples, uint16_t data_for
       out[i] = static_cast<float>(std::hypot(in_phase, quadrature) * scale);
     }
   }
+  return sss::core::Status::success();
 }
 }  // namespace
 
@@ -282,12 +287,10 @@ sss::core::Result<SonarChannelRecord> decodeSonarData(const JsfMessageHeader& he
     return sss::core::Status::error("sonar data of " + std::to_string(num_samples) + " samples needs " +
                                     std::to_string(needed) + " bytes, the message has " + std::to_string(body_size));
   }
-  // 2^-N; N outside a sane range is corruption, not a gain setting.
-  if (r.weighting_factor < -30 || r.weighting_factor > 30) {
-    return sss::core::Status::error("weighting factor " + std::to_string(r.weighting_factor) +
-                                    " is outside [-30, 30]");
-  }
-  decodeSamples(body + kSonarDataHeaderSize, num_samples, r.data_format, r.weighting_factor, r.samples);
+  if (sss::core::Status decoded =
+          decodeSamples(body + kSonarDataHeaderSize, num_samples, r.data_format, r.weighting_factor, r.samples);
+      !decoded)
+    return decoded;
   return r;
 }
 
@@ -337,12 +340,10 @@ sss::core::Result<SonarChannelRecord> decodeOldSideScanData(const JsfMessageHead
     return sss::core::Status::error("side-scan message 82 of " + std::to_string(num_samples) + " samples needs " +
                                     std::to_string(needed) + " bytes, the message has " + std::to_string(body_size));
   }
-  if (r.weighting_factor < -30 || r.weighting_factor > 30) {
-    return sss::core::Status::error("weighting factor " + std::to_string(r.weighting_factor) +
-                                    " is outside [-30, 30]");
-  }
-  decodeSamples(body + kOldSideScanHeaderSize, static_cast<size_t>(num_samples), r.data_format, r.weighting_factor,
-                r.samples);
+  if (sss::core::Status decoded = decodeSamples(body + kOldSideScanHeaderSize, static_cast<size_t>(num_samples),
+                                                r.data_format, r.weighting_factor, r.samples);
+      !decoded)
+    return decoded;
   return r;
 }
 

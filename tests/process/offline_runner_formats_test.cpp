@@ -38,6 +38,28 @@ double worstHeadingErrorDeg(const Poses& poses, double course_rad) {
   return worst_deg;
 }
 
+// The worst distance of a run's DR poses from a straight track flown from the first recorded
+// position along `along` at step_m per 4 Hz ping from 1780300800 s, moved back by back_m (a
+// towfish's layback).
+double worstFromTrack(const std::string& dir, const Eigen::Vector2d& along, double step_m, double back_m) {
+  const auto dr = sss::eval::readTum(dir + "/dead_reckoning.tum");
+  EXPECT_TRUE(dr.ok) << dr.error;
+  EXPECT_GT(dr.poses.size(), 300u);
+  double worst_m = 0.0;
+  for (const auto& pose : dr.poses) {
+    const double i = static_cast<double>(pose.utime_us - 1780300800000000LL) / 250000.0;
+    const Eigen::Vector2d expected = (step_m * i - back_m) * along;
+    worst_m = std::max(worst_m, (pose.T_world_body.translation.head<2>() - expected).norm());
+  }
+  return worst_m;
+}
+
+// True when one of the run's findings contains text.
+bool hasFinding(const sss::offline::OfflineResult& result, const std::string& text) {
+  return std::any_of(result.summary.findings.begin(), result.summary.findings.end(),
+                     [&](const std::string& f) { return f.find(text) != std::string::npos; });
+}
+
 // A recorder that stamps every ping with its newest GPS fix: a 1 Hz GPS under a 4 Hz sonar repeats
 // each position for four pings, then jumps 2 m (the real Iver2 XTF repeats its fixes for 2-6 pings).
 // The repeats are no new fixes: they are placed between the fixes in time, so the track advances
@@ -444,8 +466,7 @@ TEST_F(OfflineRunnerTest, JsfSituationOrNmeaMessagesPositionPingsWithoutPosition
     const auto copied = sss::offline::runOffline(copy);
     ASSERT_TRUE(copied.ok) << copied.error;
     EXPECT_EQ(copied.summary.corrected_records_without_position_field, 1200u);
-    EXPECT_TRUE(std::any_of(copied.summary.findings.begin(), copied.summary.findings.end(),
-                            [](const std::string& f) { return f.find("no position field") != std::string::npos; }));
+    EXPECT_TRUE(hasFinding(copied, "no position field"));
   }
   const auto dr = sss::eval::readTum(out_dir + "/dead_reckoning.tum");
   ASSERT_TRUE(dr.ok) << dr.error;
@@ -563,30 +584,14 @@ TEST_F(OfflineRunnerTest, JsfLaybackIsNamedAndAppliedOnRequest) {
       }
     }
   }
-  // The worst distance of the DR poses from the ship's track moved back by back_m (origin: the
-  // first recorded position).
-  auto worstFromTrack = [&](const std::string& dir, double back_m) {
-    const auto dr = sss::eval::readTum(dir + "/dead_reckoning.tum");
-    EXPECT_TRUE(dr.ok) << dr.error;
-    EXPECT_GT(dr.poses.size(), 300u);
-    double worst_m = 0.0;
-    for (const auto& pose : dr.poses) {
-      const double i = static_cast<double>(pose.utime_us - 1780300800000000LL) / 250000.0;
-      worst_m = std::max(worst_m, (pose.T_world_body.translation.head<2>() - (0.375 * i - back_m) * along).norm());
-    }
-    return worst_m;
-  };
-  auto finding = [](const sss::offline::OfflineResult& r, const std::string& text) {
-    return std::any_of(r.summary.findings.begin(), r.summary.findings.end(),
-                       [&](const std::string& f) { return f.find(text) != std::string::npos; });
-  };
   const auto as_recorded = runSonarFileOnly(path, root_ + "/run_jsf_layback_ignored");
   ASSERT_TRUE(as_recorded.ok) << as_recorded.error;
   EXPECT_EQ(as_recorded.summary.jsf_records_with_layback, 800u);
   EXPECT_DOUBLE_EQ(as_recorded.summary.jsf_max_layback_m, layback_m);
   EXPECT_EQ(as_recorded.summary.nav_laybacks_applied, 0u);
-  EXPECT_TRUE(finding(as_recorded, "jsf_layback: apply"));
-  EXPECT_LT(worstFromTrack(root_ + "/run_jsf_layback_ignored", 0.0), 0.3);  // JSF positions: 1e-4 arc minute
+  EXPECT_TRUE(hasFinding(as_recorded, "jsf_layback: apply"));
+  // JSF positions: 1e-4 arc minute.
+  EXPECT_LT(worstFromTrack(root_ + "/run_jsf_layback_ignored", along, 0.375, 0.0), 0.3);
 
   const std::string config = root_ + "/jsf_layback_apply.yaml";
   std::ofstream(config) << "sonar_driver:\n  jsf_layback: apply\n";
@@ -599,8 +604,8 @@ TEST_F(OfflineRunnerTest, JsfLaybackIsNamedAndAppliedOnRequest) {
   const auto applied = sss::offline::runOffline(apply);
   ASSERT_TRUE(applied.ok) << applied.error;
   EXPECT_GE(applied.summary.nav_laybacks_applied, 390u);
-  EXPECT_TRUE(finding(applied, "jsf_layback: ignore"));
-  EXPECT_LT(worstFromTrack(apply.out_dir, layback_m), 0.3);
+  EXPECT_TRUE(hasFinding(applied, "jsf_layback: ignore"));
+  EXPECT_LT(worstFromTrack(apply.out_dir, along, 0.375, layback_m), 0.3);
   // The corrected copy: layback 0 in every record it patched.
   sss::edgetech::JsfFileReader copy(apply.corrected_dir + "/towed_layback.jsf");
   ASSERT_TRUE(copy.isOpen()) << copy.error();
@@ -728,24 +733,6 @@ TEST_F(OfflineRunnerTest, TowfishLaybackOverTheShipsPositionPutsTheFishBehindThe
       ASSERT_TRUE(writer.write(ping));
     }
   };
-  // The worst distance of the run's DR poses from the ship's track moved back by `back_m`, in the
-  // frame of the first recorded position (the origin of a projected run).
-  auto worstFromTrack = [&](const std::string& dir, double back_m) {
-    const auto dr = sss::eval::readTum(dir + "/dead_reckoning.tum");
-    EXPECT_TRUE(dr.ok) << dr.error;
-    EXPECT_GT(dr.poses.size(), 300u);
-    double worst_m = 0.0;
-    for (const auto& pose : dr.poses) {
-      const double i = static_cast<double>(pose.utime_us - 1780300800000000LL) / 250000.0;
-      const Eigen::Vector2d expected = (step_m * i - back_m) * along;
-      worst_m = std::max(worst_m, (pose.T_world_body.translation.head<2>() - expected).norm());
-    }
-    return worst_m;
-  };
-  auto hasFinding = [](const sss::offline::OfflineResult& r, const std::string& text) {
-    return std::any_of(r.summary.findings.begin(), r.summary.findings.end(),
-                       [&](const std::string& f) { return f.find(text) != std::string::npos; });
-  };
 
   const std::string ship_file = root_ + "/towed_ship_position.xtf";
   write(ship_file, false);
@@ -760,7 +747,7 @@ TEST_F(OfflineRunnerTest, TowfishLaybackOverTheShipsPositionPutsTheFishBehindThe
   EXPECT_EQ(applied.summary.nav_laybacks_applied, 400u);
   EXPECT_DOUBLE_EQ(applied.summary.nav_max_layback_m, layback_m);
   EXPECT_TRUE(hasFinding(applied, "xtf_layback: ignore"));
-  EXPECT_LT(worstFromTrack(towed.out_dir, layback_m), 0.01);
+  EXPECT_LT(worstFromTrack(towed.out_dir, along, step_m, layback_m), 0.01);
 
   // The corrected copy: the fish's position (the run's poses) and Layback 0.
   const auto slam = sss::eval::readTum(towed.out_dir + "/slam.tum");
@@ -793,7 +780,7 @@ TEST_F(OfflineRunnerTest, TowfishLaybackOverTheShipsPositionPutsTheFishBehindThe
   ASSERT_TRUE(ignored.ok) << ignored.error;
   EXPECT_EQ(ignored.summary.nav_laybacks_applied, 0u);
   EXPECT_FALSE(hasFinding(ignored, "layback"));
-  EXPECT_LT(worstFromTrack(towed.out_dir, 0.0), 0.01);
+  EXPECT_LT(worstFromTrack(towed.out_dir, along, step_m, 0.0), 0.01);
   {
     // Not applied: the copy keeps its Layback over the (ship's) positions it writes.
     sss::xtf::XtfReader kept(towed.corrected_dir + "/towed_ship_position.xtf");
@@ -809,7 +796,7 @@ TEST_F(OfflineRunnerTest, TowfishLaybackOverTheShipsPositionPutsTheFishBehindThe
   ASSERT_TRUE(as_recorded.ok) << as_recorded.error;
   EXPECT_EQ(as_recorded.summary.nav_laybacks_applied, 0u);
   EXPECT_EQ(as_recorded.summary.xtf_layback_in_position_pings, 400u);
-  EXPECT_LT(worstFromTrack(root_ + "/run_towed_fish", 0.0), 0.01);  // origin: the fish's first position
+  EXPECT_LT(worstFromTrack(root_ + "/run_towed_fish", along, step_m, 0.0), 0.01);  // origin: the fish's first position
 
   // A towfish without a compass (heading 0 in every ping): moved back along the track's direction.
   const std::string no_compass_file = root_ + "/towed_no_compass.xtf";
@@ -818,7 +805,7 @@ TEST_F(OfflineRunnerTest, TowfishLaybackOverTheShipsPositionPutsTheFishBehindThe
   ASSERT_TRUE(along_track.ok) << along_track.error;
   EXPECT_EQ(along_track.summary.nav_headings_from_track, 400u);
   EXPECT_EQ(along_track.summary.nav_laybacks_applied, 400u);
-  EXPECT_LT(worstFromTrack(root_ + "/run_towed_no_compass", layback_m), 0.01);
+  EXPECT_LT(worstFromTrack(root_ + "/run_towed_no_compass", along, step_m, layback_m), 0.01);
 }
 
 // The towed record of the real-file issue, rebuilt: an XTF in latitude/longitude with altitude and

@@ -374,12 +374,7 @@ class EmbeddedNavigation {
       // In time order: samples still waiting for the track's direction (a navigation message before
       // the first ping header that gives the heading, or headers without one before this) take this
       // first heading that came after them rather than a 0 that turns their images to north.
-      for (Sample& waiting : awaiting_course_) {
-        waiting.nav.heading_rad = nav.heading_rad;
-        ++headings_from_next_;
-        release(std::move(waiting));
-      }
-      awaiting_course_.clear();
+      releaseAwaiting(nav.heading_rad, headings_from_next_);
       release(std::move(sample));
       return;
     }
@@ -391,16 +386,21 @@ class EmbeddedNavigation {
     awaiting_course_.push_back(std::move(sample));
     if (travelled.norm() >= kCourseBaseM) {
       const double course_rad = std::atan2(travelled.y(), travelled.x());
-      for (Sample& waiting : awaiting_course_) {
-        waiting.nav.heading_rad = course_rad < 0.0 ? course_rad + 2.0 * M_PI : course_rad;
-        ++headings_from_track_;
-        release(std::move(waiting));
-      }
-      awaiting_course_.clear();
+      releaseAwaiting(course_rad < 0.0 ? course_rad + 2.0 * M_PI : course_rad, headings_from_track_);
     } else if (awaiting_course_.size() >= kMaxHeldSamples) {
       releaseAwaitingCourse();  // holding still: no direction to take
     }
   }
+  // The samples waiting for a heading, given heading_rad (counted in `given`), in time order.
+  void releaseAwaiting(double heading_rad, uint64_t& given) {
+    for (Sample& waiting : awaiting_course_) {
+      waiting.nav.heading_rad = heading_rad;
+      ++given;
+      release(std::move(waiting));
+    }
+    awaiting_course_.clear();
+  }
+  // The same without a heading to give: left as recorded.
   void releaseAwaitingCourse() {
     for (Sample& waiting : awaiting_course_) {
       ++headings_unknown_;
